@@ -1,0 +1,138 @@
+//! Named small-angle thresholds and the Taylor-safe trigonometric coefficients every group uses.
+//!
+//! Each coefficient below is written once, in closed form above [`SMALL_ANGLE`] and as a
+//! Taylor series through θ⁶ below it. Below θ = 0.1 the first omitted Taylor term is under
+//! 1e-15 relative; above it the worst closed form, (θ² + 2 cos θ − 2)/(2θ⁴), loses at most
+//! ~24 ε/θ⁴ ≈ 3e-11 relative to cancellation (and far less as θ grows).
+
+/// Below this angle (radians) the coefficients switch from closed form to Taylor series.
+pub const SMALL_ANGLE: f64 = 0.1;
+
+/// sin θ / θ.
+///
+/// ```
+/// use posecov::lie::series::sinc;
+/// assert!((sinc(0.5) - 0.5f64.sin() / 0.5).abs() < 1e-15);
+/// assert_eq!(sinc(0.0), 1.0);
+/// ```
+pub fn sinc(theta: f64) -> f64 {
+    if theta.abs() < SMALL_ANGLE {
+        let t2 = theta * theta;
+        1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0))
+    } else {
+        theta.sin() / theta
+    }
+}
+
+/// A(θ) = (1 − cos θ) / θ², the coefficient of φ^ in the SO(3) Jacobians (Solà et al. 2018, eq. 143).
+///
+/// ```
+/// use posecov::lie::series::one_minus_cos_by_theta2 as a;
+/// assert!((a(1.0) - (1.0 - 1f64.cos())).abs() < 1e-15);
+/// assert_eq!(a(0.0), 0.5);
+/// ```
+pub fn one_minus_cos_by_theta2(theta: f64) -> f64 {
+    if theta.abs() < SMALL_ANGLE {
+        let t2 = theta * theta;
+        0.5 - t2 / 24.0 + t2 * t2 / 720.0 - t2 * t2 * t2 / 40320.0
+    } else {
+        let half_sin = (0.5 * theta).sin();
+        2.0 * half_sin * half_sin / (theta * theta)
+    }
+}
+
+/// B(θ) = (θ − sin θ) / θ³, the coefficient of φ^² in the SO(3) Jacobians (Solà et al. 2018, eq. 143).
+///
+/// ```
+/// use posecov::lie::series::theta_minus_sin_by_theta3 as b;
+/// assert!((b(1.0) - (1.0 - 1f64.sin())).abs() < 1e-15);
+/// assert!((b(0.0) - 1.0 / 6.0).abs() < 1e-16);
+/// ```
+pub fn theta_minus_sin_by_theta3(theta: f64) -> f64 {
+    if theta.abs() < SMALL_ANGLE {
+        let t2 = theta * theta;
+        1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0 - t2 * t2 * t2 / 362_880.0
+    } else {
+        (theta - theta.sin()) / (theta * theta * theta)
+    }
+}
+
+/// C(θ) = 1/θ² − cot(θ/2) / (2θ), the coefficient of φ^² in Jr⁻¹ and Jl⁻¹ of SO(3)
+/// (Solà et al. 2018, eq. 144; Barfoot 2017 eq. 7.77 writes it with (1 + cos θ) / (2θ sin θ),
+/// which is 0/0 at θ = π; the half-angle form is finite there).
+///
+/// ```
+/// use posecov::lie::series::jinv_coefficient as c;
+/// let t: f64 = 1.0;
+/// assert!((c(t) - (1.0 / (t * t) - (1.0 + t.cos()) / (2.0 * t * t.sin()))).abs() < 1e-15);
+/// assert!((c(0.0) - 1.0 / 12.0).abs() < 1e-16);
+/// assert!((c(std::f64::consts::PI) - 1.0 / (std::f64::consts::PI.powi(2))).abs() < 1e-15);
+/// ```
+pub fn jinv_coefficient(theta: f64) -> f64 {
+    if theta.abs() < SMALL_ANGLE {
+        let t2 = theta * theta;
+        1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1_209_600.0
+    } else {
+        let half = 0.5 * theta;
+        1.0 / (theta * theta) - half.cos() / (half.sin() * 2.0 * theta)
+    }
+}
+
+/// (θ² + 2 cos θ − 2) / (2θ⁴), the second coefficient of Q(ρ, θ) (Barfoot & Furgale 2014, eq. 102).
+///
+/// ```
+/// use posecov::lie::series::q_coefficient_2 as c2;
+/// let t: f64 = 1.0;
+/// assert!((c2(t) - (t * t + 2.0 * t.cos() - 2.0) / 2.0).abs() < 1e-15);
+/// assert!((c2(0.0) - 1.0 / 24.0).abs() < 1e-16);
+/// ```
+pub fn q_coefficient_2(theta: f64) -> f64 {
+    if theta.abs() < SMALL_ANGLE {
+        let t2 = theta * theta;
+        1.0 / 24.0 - t2 / 720.0 + t2 * t2 / 40320.0 - t2 * t2 * t2 / 3_628_800.0
+    } else {
+        let t2 = theta * theta;
+        (t2 + 2.0 * theta.cos() - 2.0) / (2.0 * t2 * t2)
+    }
+}
+
+/// (2θ − 3 sin θ + θ cos θ) / (2θ⁵), the third coefficient of Q(ρ, θ) (Barfoot & Furgale 2014, eq. 102).
+///
+/// ```
+/// use posecov::lie::series::q_coefficient_3 as c3;
+/// let t: f64 = 1.0;
+/// assert!((c3(t) - (2.0 * t - 3.0 * t.sin() + t * t.cos()) / 2.0).abs() < 1e-15);
+/// assert!((c3(0.0) - 1.0 / 120.0).abs() < 1e-16);
+/// ```
+pub fn q_coefficient_3(theta: f64) -> f64 {
+    if theta.abs() < SMALL_ANGLE {
+        let t2 = theta * theta;
+        1.0 / 120.0 - t2 / 2520.0 + t2 * t2 / 120_960.0 - t2 * t2 * t2 / 9_979_200.0
+    } else {
+        let t2 = theta * theta;
+        (2.0 * theta - 3.0 * theta.sin() + theta * theta.cos()) / (2.0 * t2 * t2 * theta)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Both branches agree at the switch point, so no coefficient jumps there.
+    #[test]
+    fn branches_meet_at_the_threshold() {
+        let below = SMALL_ANGLE * (1.0 - 1e-12);
+        let above = SMALL_ANGLE * (1.0 + 1e-12);
+        for f in [
+            sinc,
+            one_minus_cos_by_theta2,
+            theta_minus_sin_by_theta3,
+            jinv_coefficient,
+            q_coefficient_2,
+            q_coefficient_3,
+        ] {
+            let (a, b) = (f(below), f(above));
+            assert!((a - b).abs() < 1e-9 * a.abs(), "{a} vs {b}");
+        }
+    }
+}

@@ -1,0 +1,95 @@
+//! Shared test helpers: seeded tangent samples in four regimes and central finite
+//! differences on the manifold. Used by every group suite.
+#![allow(dead_code)]
+
+use nalgebra::{SMatrix, SVector};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Where a tangent sample lives: the branches a closed form can take.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Regime {
+    /// τ = 0 exactly.
+    Identity,
+    /// ‖τ‖ ≈ 1e-8: the Taylor branches.
+    Tiny,
+    /// Uniform in a box: the closed forms.
+    Random,
+    /// Rotation angle π − 1e-6: the Log branch near π.
+    NearPi,
+}
+
+/// All four regimes.
+pub const REGIMES: [Regime; 4] = [
+    Regime::Identity,
+    Regime::Tiny,
+    Regime::Random,
+    Regime::NearPi,
+];
+
+/// Samples per regime (Identity gives one distinct sample, repeated).
+pub const SAMPLES: usize = 8;
+
+/// Finite-difference step for a regime: near π a step must not cross the cut at π.
+pub fn fd_step(regime: Regime) -> f64 {
+    match regime {
+        Regime::NearPi => 1e-8,
+        _ => 1e-5,
+    }
+}
+
+/// Seeded tangent samples for a regime. `rot` is the index range of the rotation part.
+pub fn tangents<const N: usize>(
+    regime: Regime,
+    rot: std::ops::Range<usize>,
+    seed: u64,
+) -> Vec<SVector<f64, N>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..SAMPLES)
+        .map(|_| {
+            let mut v = SVector::<f64, N>::from_fn(|_, _| rng.random_range(-1.0..1.0));
+            match regime {
+                Regime::Identity => v.fill(0.0),
+                Regime::Tiny => v *= 1e-8 / v.norm(),
+                Regime::Random => v *= 2.0,
+                Regime::NearPi => {
+                    let mut r = v.rows_range_mut(rot.clone());
+                    let n = r.norm();
+                    r *= (std::f64::consts::PI - 1e-6) / n;
+                }
+            }
+            v
+        })
+        .collect()
+}
+
+/// Central-difference Jacobian of g at 0: column i = (g(h eᵢ) − g(−h eᵢ)) / 2h.
+/// Callers build g as "perturb the input on the manifold, take the output's ⊖ against the
+/// unperturbed output", so this is the Jacobian with respect to right perturbations.
+pub fn numeric_jacobian<const I: usize, const O: usize>(
+    g: impl Fn(&SVector<f64, I>) -> SVector<f64, O>,
+    h: f64,
+) -> SMatrix<f64, O, I> {
+    let mut j = SMatrix::<f64, O, I>::zeros();
+    for i in 0..I {
+        let mut e = SVector::<f64, I>::zeros();
+        e[i] = h;
+        j.set_column(i, &((g(&e) - g(&-e)) / (2.0 * h)));
+    }
+    j
+}
+
+/// Asserts max |a − b| ≤ tol with a readable message.
+#[track_caller]
+pub fn assert_close<const R: usize, const C: usize>(
+    a: &SMatrix<f64, R, C>,
+    b: &SMatrix<f64, R, C>,
+    tol: f64,
+    what: &str,
+) {
+    let err = (a - b).amax();
+    assert!(
+        err <= tol,
+        "{what}: max abs error {err:.3e} > {tol:.1e}\n left: {a}\n right: {b}"
+    );
+}
