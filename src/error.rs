@@ -77,6 +77,20 @@ pub enum Error {
         /// Length given.
         got: usize,
     },
+    /// A matrix of the wrong shape (e.g. a joint covariance that is not 2N × 2N).
+    #[error("{what}: expected a {expected_rows} × {expected_cols} matrix, got {rows} × {cols}")]
+    WrongShape {
+        /// Which input.
+        what: &'static str,
+        /// Rows required.
+        expected_rows: usize,
+        /// Columns required.
+        expected_cols: usize,
+        /// Rows given.
+        rows: usize,
+        /// Columns given.
+        cols: usize,
+    },
     /// A covariance that is not symmetric within the tolerance.
     #[error(
         "{what}: not symmetric, entry ({row}, {col}) = {upper} but ({col}, {row}) = {lower} \

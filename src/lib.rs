@@ -11,7 +11,9 @@
 //! - [`lie`]: the groups SO(2), SO(3), SE(2), SE(3) with exp/log, adjoints and every Jacobian.
 //! - [`uncertain`]: poses with covariances (mean, Σ, side), validation, side conversion.
 //! - [`propagate`]: operations on uncertain poses, each method named in its result.
+//! - [`sample`]: seeded (parallel, thread-count independent) sampling; Lie mean, covariances, NEES.
 //! - [`convert`]: nalgebra and glam boundaries.
+//! - [`interop`]: uncertain poses in and out: ROS `PoseWithCovariance`, rotation-first orders, (x, y, θ) and Euler-angle covariances.
 //! - [`error`]: typed errors that name the offending input and value.
 //!
 //! # Conventions
@@ -57,9 +59,13 @@
 #![deny(missing_docs)]
 
 pub mod convert;
+pub mod draw;
 pub mod error;
+pub mod interop;
 pub mod lie;
 pub mod propagate;
+pub mod sample;
+pub mod scenario;
 pub mod scene;
 #[cfg(feature = "viewer")]
 pub mod sink;

@@ -29,11 +29,11 @@ use std::fmt::{Debug, Display};
 
 use nalgebra::{SMatrix, SVector};
 
-mod se2;
-mod se3;
+pub mod se2;
+pub mod se3;
 pub mod series;
-mod so2;
-mod so3;
+pub mod so2;
+pub mod so3;
 
 pub use se2::Se2;
 pub use se3::Se3;

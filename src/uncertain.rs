@@ -4,11 +4,12 @@
 //! Right / body (default): X = μ · Exp(ε); left / world: X = Exp(ε) · μ; ε ~ N(0, Σ).
 //! Σ_left = Ad_μ Σ_right Ad_μᵀ. See the [crate conventions](crate#conventions).
 
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::{DMatrix, Matrix2, Matrix3, SMatrix, SymmetricEigen, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 use crate::error::{Error, Result, check_finite};
-use crate::lie::{LieGroup, TangentMatrix};
+use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 
 /// Which side of the mean a covariance's perturbation multiplies.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -96,12 +97,37 @@ pub fn validate_covariance<const N: usize>(
     what: &'static str,
     cov: &TangentMatrix<N>,
 ) -> Result<TangentMatrix<N>> {
+    let sym = validate_covariance_dyn(what, &DMatrix::from_iterator(N, N, cov.iter().copied()))?;
+    Ok(TangentMatrix::<N>::from_iterator(sym.iter().copied()))
+}
+
+/// [`validate_covariance`] for a matrix whose size is known only at run time (a joint
+/// covariance of several poses): square, finite, symmetric within [`SYMMETRY_TOLERANCE`],
+/// positive semi-definite within [`PSD_TOLERANCE`]. Returns ½(Σ + Σᵀ).
+///
+/// ```
+/// use posecov::uncertain::validate_covariance_dyn;
+/// use nalgebra::DMatrix;
+/// assert!(validate_covariance_dyn("joint", &DMatrix::<f64>::identity(4, 4)).is_ok());
+/// assert!(validate_covariance_dyn("joint", &DMatrix::<f64>::identity(4, 3)).is_err()); // not square
+/// ```
+pub fn validate_covariance_dyn(what: &'static str, cov: &DMatrix<f64>) -> Result<DMatrix<f64>> {
+    let (n, cols) = cov.shape();
+    if n != cols {
+        return Err(Error::WrongShape {
+            what,
+            expected_rows: n.max(cols),
+            expected_cols: n.max(cols),
+            rows: n,
+            cols,
+        });
+    }
     check_finite(what, cov.transpose().iter().copied())?;
     let scale = cov.amax().max(1.0);
     let tolerance = SYMMETRY_TOLERANCE * scale;
     let mut worst = (0, 0, 0.0);
-    for row in 0..N {
-        for col in row + 1..N {
+    for row in 0..n {
+        for col in row + 1..n {
             let difference = (cov[(row, col)] - cov[(col, row)]).abs();
             if difference > worst.2 {
                 worst = (row, col, difference);
@@ -121,9 +147,10 @@ pub fn validate_covariance<const N: usize>(
         });
     }
     let sym = (cov + cov.transpose()) * 0.5;
-    // Dynamic storage: nalgebra's static-size eigensolver needs bounds a const-generic N lacks.
-    let eigenvalues =
-        SymmetricEigen::new(DMatrix::from_iterator(N, N, sym.iter().copied())).eigenvalues;
+    if n == 0 {
+        return Ok(sym);
+    }
+    let eigenvalues = SymmetricEigen::new(sym.clone()).eigenvalues;
     let min_eigenvalue = eigenvalues.min();
     let tolerance = PSD_TOLERANCE * eigenvalues.max().max(1.0);
     if min_eigenvalue < -tolerance {
@@ -276,5 +303,383 @@ impl<G: LieGroup<N>, const N: usize> UncertainPose<G, N> {
     /// ```
     pub fn cov_left(&self) -> TangentMatrix<N> {
         self.to_side(Side::Left).cov
+    }
+}
+
+// --------------------------------------------------------------------------------------------
+// Constructors from standard deviations, Mahalanobis distance.
+
+impl<G: LieGroup<N>, const N: usize> UncertainPose<G, N> {
+    /// A pose with independent tangent components: Σ = diag(σ₁², …, σ_N²), σ in the tangent
+    /// order of the [conventions](crate#conventions) (SE(3): σ_ρx, σ_ρy, σ_ρz, σ_θx, σ_θy,
+    /// σ_θz; SE(2): σ_ρx, σ_ρy, σ_θ), on `side`. Each σ must be finite and ≥ 0.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.2, 0.05], Side::Right).unwrap();
+    /// assert!((p.cov()[(1, 1)] - 0.04).abs() < 1e-15);
+    /// assert!(UncertainPose::try_from_std_devs(Se2::identity(), [0.1, -0.2, 0.05], Side::Right).is_err());
+    /// ```
+    pub fn try_from_std_devs(mean: G, std_devs: [f64; N], side: Side) -> Result<Self> {
+        check_finite("standard deviations", std_devs)?;
+        if let Some(&sigma) = std_devs.iter().find(|s| **s < 0.0) {
+            return Err(Error::OutOfRange {
+                what: "standard deviation",
+                value: sigma,
+                expected: "σ ≥ 0",
+            });
+        }
+        let variances = nalgebra::SVector::<f64, N>::from_iterator(std_devs.iter().map(|s| s * s));
+        Ok(Self::new_unchecked(
+            mean,
+            TangentMatrix::<N>::from_diagonal(&variances),
+            side,
+        ))
+    }
+
+    /// The tangent perturbation ε that takes the mean to `x` on this pose's side:
+    /// right ε = Log(μ⁻¹ x) (x = μ · Exp ε), left ε = Log(x μ⁻¹) (x = Exp ε · μ).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::uncertain::UncertainPose;
+    /// use nalgebra::Vector3;
+    /// let p = UncertainPose::certain(Se2::from_xy_theta(1.0, 0.0, 0.3));
+    /// let eps = Vector3::new(0.1, -0.2, 0.05);
+    /// assert!((p.perturbation_of(&p.mean().rplus(&eps)) - eps).norm() < 1e-14);
+    /// ```
+    pub fn perturbation_of(&self, x: &G) -> Tangent<N> {
+        match self.side {
+            Side::Right => x.rminus(&self.mean),
+            Side::Left => x.lminus(&self.mean),
+        }
+    }
+
+    /// Squared Mahalanobis distance of `x` from this distribution, d² = εᵀ Σ⁻¹ ε with ε from
+    /// [`perturbation_of`](Self::perturbation_of) (N degrees of freedom: compare with
+    /// [`chi2_radius`]`(p, N)²`). The value is the same on either side (Ad is linear).
+    /// Errors: [`Error::SingularCovariance`] when Σ is singular (see [`try_inverse_covariance`]).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// use nalgebra::Vector3;
+    /// let p = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.1, 0.1], Side::Right).unwrap();
+    /// let x = Se2::exp(&Vector3::new(0.2, 0.0, 0.0));
+    /// assert!((p.mahalanobis_squared(&x).unwrap() - 4.0).abs() < 1e-12);
+    /// assert!(UncertainPose::certain(Se2::identity()).mahalanobis_squared(&x).is_err());
+    /// ```
+    pub fn mahalanobis_squared(&self, x: &G) -> Result<f64> {
+        let info = try_inverse_covariance("pose covariance", &self.cov)?;
+        let eps = self.perturbation_of(x);
+        Ok((eps.transpose() * info * eps)[(0, 0)])
+    }
+
+    /// Mahalanobis distance d = √(εᵀ Σ⁻¹ ε), see [`mahalanobis_squared`](Self::mahalanobis_squared).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(So2::identity(), [0.1], Side::Right).unwrap();
+    /// assert!((p.mahalanobis(&So2::from_angle(-0.3)).unwrap() - 3.0).abs() < 1e-12);
+    /// ```
+    pub fn mahalanobis(&self, x: &G) -> Result<f64> {
+        self.mahalanobis_squared(x).map(f64::sqrt)
+    }
+}
+
+/// Below this ratio λ_min / λ_max a covariance counts as singular and is not inverted.
+pub const SINGULAR_TOLERANCE: f64 = 1e-12;
+
+/// The information matrix Σ⁻¹ of a covariance, through its eigen-decomposition
+/// Σ = V diag(λ) Vᵀ → Σ⁻¹ = V diag(1/λ) Vᵀ. Σ is validated first
+/// ([`validate_covariance`]); [`Error::SingularCovariance`] when λ_min ≤
+/// [`SINGULAR_TOLERANCE`] · λ_max (including Σ = 0).
+///
+/// ```
+/// use posecov::uncertain::try_inverse_covariance;
+/// use nalgebra::Matrix2;
+/// let info = try_inverse_covariance("Σ", &Matrix2::new(4.0, 0.0, 0.0, 0.25)).unwrap();
+/// assert!((info - Matrix2::new(0.25, 0.0, 0.0, 4.0)).norm() < 1e-14);
+/// assert!(try_inverse_covariance("Σ", &Matrix2::new(1.0, 1.0, 1.0, 1.0)).is_err());
+/// ```
+pub fn try_inverse_covariance<const N: usize>(
+    what: &'static str,
+    cov: &TangentMatrix<N>,
+) -> Result<TangentMatrix<N>> {
+    let sym = validate_covariance(what, cov)?;
+    let eigen = SymmetricEigen::new(DMatrix::from_iterator(N, N, sym.iter().copied()));
+    let (min_eigenvalue, max_eigenvalue) = (eigen.eigenvalues.min(), eigen.eigenvalues.max());
+    if max_eigenvalue <= 0.0 || min_eigenvalue <= SINGULAR_TOLERANCE * max_eigenvalue {
+        return Err(Error::SingularCovariance {
+            what,
+            min_eigenvalue,
+        });
+    }
+    let v = &eigen.eigenvectors;
+    let inverse_values = eigen.eigenvalues.map(|l| 1.0 / l);
+    let info = v * DMatrix::from_diagonal(&inverse_values) * v.transpose();
+    let info = TangentMatrix::<N>::from_iterator(info.iter().copied());
+    Ok((info + info.transpose()) * 0.5)
+}
+
+// --------------------------------------------------------------------------------------------
+// Confidence regions (CONVENTIONS §7): χ² with d degrees of freedom.
+
+fn chi_squared(dof: usize) -> Result<ChiSquared> {
+    if dof == 0 {
+        return Err(Error::OutOfRange {
+            what: "degrees of freedom d",
+            value: 0.0,
+            expected: "d ≥ 1",
+        });
+    }
+    ChiSquared::new(dof as f64).map_err(|_| Error::OutOfRange {
+        what: "degrees of freedom d",
+        value: dof as f64,
+        expected: "a finite d ≥ 1",
+    })
+}
+
+/// The Mahalanobis radius r of the p-probability region of a d-dimensional Gaussian:
+/// P(εᵀ Σ⁻¹ ε ≤ r²) = p, i.e. r = √(χ²_d quantile(p)) (CONVENTIONS §7). d = 3 for an SE(3)
+/// position marginal, 2 for SE(2), 6 / 3 for the full pose. Errors: p ∉ (0, 1), d = 0.
+///
+/// ```
+/// use posecov::uncertain::chi2_radius;
+/// assert!((chi2_radius(0.95, 3).unwrap() - 2.795).abs() < 1e-3);
+/// assert!((chi2_radius(0.95, 2).unwrap() - 2.448).abs() < 1e-3);
+/// assert!((chi2_radius(0.6827, 3).unwrap() - 1.878).abs() < 1e-3);
+/// assert!(chi2_radius(1.0, 3).is_err());
+/// ```
+pub fn chi2_radius(probability: f64, dof: usize) -> Result<f64> {
+    if !(probability > 0.0 && probability < 1.0) {
+        return Err(Error::OutOfRange {
+            what: "probability p",
+            value: probability,
+            expected: "0 < p < 1",
+        });
+    }
+    Ok(chi_squared(dof)?.inverse_cdf(probability).sqrt())
+}
+
+/// The probability inside Mahalanobis radius r of a d-dimensional Gaussian,
+/// P(εᵀ Σ⁻¹ ε ≤ r²) = F_χ²_d(r²): the inverse of [`chi2_radius`]. Errors: r < 0 or not
+/// finite, d = 0.
+///
+/// ```
+/// use posecov::uncertain::chi2_probability;
+/// assert!((chi2_probability(1.0, 1).unwrap() - 0.682689).abs() < 1e-6); // 1σ in 1-D
+/// assert!((chi2_probability(1.0, 3).unwrap() - 0.198748).abs() < 1e-6); // 1σ ellipsoid in 3-D
+/// ```
+pub fn chi2_probability(radius: f64, dof: usize) -> Result<f64> {
+    if !(radius.is_finite() && radius >= 0.0) {
+        return Err(Error::OutOfRange {
+            what: "Mahalanobis radius r",
+            value: radius,
+            expected: "a finite r ≥ 0",
+        });
+    }
+    Ok(chi_squared(dof)?.cdf(radius * radius))
+}
+
+/// The probability of the 1-D k-σ interval, P(|z| ≤ k) = erf(k/√2) = F_χ²_1(k²)
+/// (d = 1: 1σ → 68.27 %, 2σ → 95.45 %, 3σ → 99.73 %).
+///
+/// ```
+/// use posecov::uncertain::sigma_probability;
+/// assert!((sigma_probability(2.0).unwrap() - 0.954500).abs() < 1e-6);
+/// ```
+pub fn sigma_probability(k: f64) -> Result<f64> {
+    chi2_probability(k, 1)
+}
+
+/// The d-dimensional Mahalanobis radius holding the same probability as the 1-D k-σ interval:
+/// r = [`chi2_radius`]`(`[`sigma_probability`]`(k), d)`. E.g. "1σ" (68.27 %) in d = 3 is
+/// r = 1.878, not 1: drawing the r = 1 ellipsoid of a 3-D position holds only 19.9 %.
+///
+/// ```
+/// use posecov::uncertain::sigma_radius;
+/// assert!((sigma_radius(1.0, 3).unwrap() - 1.878).abs() < 1e-3);
+/// assert!((sigma_radius(2.0, 1).unwrap() - 2.0).abs() < 1e-9);
+/// ```
+pub fn sigma_radius(k: f64, dof: usize) -> Result<f64> {
+    chi2_radius(sigma_probability(k)?, dof)
+}
+
+// --------------------------------------------------------------------------------------------
+// Marginals (CONVENTIONS §7), first order in the position, exact in the rotation.
+
+/// R Σ Rᵀ.
+fn rotate_cov<const D: usize>(
+    r: &SMatrix<f64, D, D>,
+    cov: &SMatrix<f64, D, D>,
+) -> SMatrix<f64, D, D> {
+    let out = r * cov * r.transpose();
+    (out + out.transpose()) * 0.5
+}
+
+impl UncertainPose<Se3, 6> {
+    /// The mean position t (the body origin in the world frame).
+    ///
+    /// ```
+    /// use posecov::lie::Se3;
+    /// use posecov::uncertain::UncertainPose;
+    /// let p = UncertainPose::certain(Se3::from_xyz_rpy([1.0, 2.0, 3.0], [0.0; 3]));
+    /// assert_eq!(p.position().x, 1.0);
+    /// ```
+    pub fn position(&self) -> Vector3<f64> {
+        *self.mean.translation()
+    }
+
+    /// Position covariance in the **body** axes, first order: the ρρ block of the right-form
+    /// Σ (X = μ Exp([ρ; θ]) moves the position by R Jl(θ) ρ ≈ R ρ; Solà et al. 2018 eq. 172).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se3};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(Se3::identity(), [0.1, 0.2, 0.3, 0.0, 0.0, 0.0], Side::Right).unwrap();
+    /// assert!((p.position_cov_in_body()[(2, 2)] - 0.09).abs() < 1e-15);
+    /// ```
+    pub fn position_cov_in_body(&self) -> Matrix3<f64> {
+        self.cov_right().fixed_view::<3, 3>(0, 0).into_owned()
+    }
+
+    /// Position covariance in the **world** axes, first order: R Σ_ρρ Rᵀ from the right form
+    /// (CONVENTIONS §7). Note: this is *not* the ρρ block of the left form unless t = 0 — a
+    /// left perturbation moves the position by ρ + θ × t.
+    ///
+    /// ```
+    /// use posecov::lie::Se3;
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let yaw90 = Se3::from_xyz_rpy([5.0, 0.0, 0.0], [0.0, 0.0, std::f64::consts::FRAC_PI_2]);
+    /// let p = UncertainPose::try_from_std_devs(yaw90, [0.1, 0.0, 0.0, 0.0, 0.0, 0.0], Side::Right).unwrap();
+    /// // body x is world y
+    /// assert!((p.position_cov_in_world()[(1, 1)] - 0.01).abs() < 1e-15);
+    /// ```
+    pub fn position_cov_in_world(&self) -> Matrix3<f64> {
+        rotate_cov(
+            &self.mean.rotation().to_matrix(),
+            &self.position_cov_in_body(),
+        )
+    }
+
+    /// Rotation covariance in the body frame: the θθ block of the right-form Σ (exact: the
+    /// rotation of μ Exp([ρ; θ]) is R Exp(θ)).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se3};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(Se3::identity(), [0.0, 0.0, 0.0, 0.1, 0.0, 0.0], Side::Right).unwrap();
+    /// assert!((p.rotation_cov_in_body()[(0, 0)] - 0.01).abs() < 1e-15);
+    /// ```
+    pub fn rotation_cov_in_body(&self) -> Matrix3<f64> {
+        self.cov_right().fixed_view::<3, 3>(3, 3).into_owned()
+    }
+
+    /// Rotation covariance in the world frame: R Σ_θθ Rᵀ (exact: R Exp(θ) = Exp(R θ) R), equal
+    /// to the θθ block of the left form.
+    ///
+    /// ```
+    /// use posecov::lie::Se3;
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let x = Se3::from_xyz_rpy([1.0, 2.0, 3.0], [0.1, 0.2, 0.3]);
+    /// let p = UncertainPose::try_from_std_devs(x, [0.1, 0.2, 0.3, 0.01, 0.02, 0.03], Side::Right).unwrap();
+    /// let left = p.cov_left();
+    /// assert!((p.rotation_cov_in_world() - left.fixed_view::<3, 3>(3, 3)).norm() < 1e-15);
+    /// ```
+    pub fn rotation_cov_in_world(&self) -> Matrix3<f64> {
+        rotate_cov(
+            &self.mean.rotation().to_matrix(),
+            &self.rotation_cov_in_body(),
+        )
+    }
+
+    /// The rotation marginal as an uncertain SO(3) element (right side, Σ = Σ_θθ; exact).
+    ///
+    /// ```
+    /// use posecov::lie::Se3;
+    /// use posecov::uncertain::UncertainPose;
+    /// let p = UncertainPose::certain(Se3::from_xyz_rpy([1.0, 0.0, 0.0], [0.0, 0.0, 0.5]));
+    /// assert!((p.rotation_marginal().mean().to_rpy()[2] - 0.5).abs() < 1e-15);
+    /// ```
+    pub fn rotation_marginal(&self) -> UncertainPose<So3, 3> {
+        UncertainPose::new_unchecked(
+            *self.mean.rotation(),
+            self.rotation_cov_in_body(),
+            Side::Right,
+        )
+    }
+}
+
+impl UncertainPose<Se2, 3> {
+    /// The mean position (x, y).
+    ///
+    /// ```
+    /// use posecov::lie::Se2;
+    /// use posecov::uncertain::UncertainPose;
+    /// assert_eq!(UncertainPose::certain(Se2::from_xy_theta(1.0, 2.0, 0.0)).position().y, 2.0);
+    /// ```
+    pub fn position(&self) -> Vector2<f64> {
+        *self.mean.translation()
+    }
+
+    /// Position covariance in the **body** axes, first order: the ρρ block of the right-form Σ
+    /// (μ Exp([ρ; θ]) moves the position by R V(θ) ρ ≈ R ρ; Solà et al. 2018 eq. 156).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.2, 0.3], Side::Right).unwrap();
+    /// assert!((p.position_cov_in_body()[(1, 1)] - 0.04).abs() < 1e-15);
+    /// ```
+    pub fn position_cov_in_body(&self) -> Matrix2<f64> {
+        self.cov_right().fixed_view::<2, 2>(0, 0).into_owned()
+    }
+
+    /// Position covariance in the **world** axes, first order: R Σ_ρρ Rᵀ from the right form
+    /// (CONVENTIONS §7; the left form's ρρ block differs unless t = 0).
+    ///
+    /// ```
+    /// use posecov::lie::Se2;
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let x = Se2::from_xy_theta(3.0, 0.0, std::f64::consts::FRAC_PI_2);
+    /// let p = UncertainPose::try_from_std_devs(x, [0.1, 0.0, 0.0], Side::Right).unwrap();
+    /// assert!((p.position_cov_in_world()[(1, 1)] - 0.01).abs() < 1e-15);
+    /// ```
+    pub fn position_cov_in_world(&self) -> Matrix2<f64> {
+        rotate_cov(
+            &self.mean.rotation().to_matrix(),
+            &self.position_cov_in_body(),
+        )
+    }
+
+    /// Heading variance σ_θ² (the same in body and world frames: SO(2) is commutative; exact).
+    ///
+    /// ```
+    /// use posecov::lie::Se2;
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(Se2::from_xy_theta(1.0, 2.0, 0.3), [0.1, 0.1, 0.2], Side::Left).unwrap();
+    /// assert!((p.heading_variance() - 0.04).abs() < 1e-15);
+    /// ```
+    pub fn heading_variance(&self) -> f64 {
+        self.cov[(2, 2)]
+    }
+
+    /// The rotation marginal as an uncertain SO(2) element (right side, Σ = σ_θ²; exact).
+    ///
+    /// ```
+    /// use posecov::lie::Se2;
+    /// use posecov::uncertain::UncertainPose;
+    /// let p = UncertainPose::certain(Se2::from_xy_theta(0.0, 0.0, 0.4));
+    /// assert!((p.rotation_marginal().mean().angle() - 0.4).abs() < 1e-15);
+    /// ```
+    pub fn rotation_marginal(&self) -> UncertainPose<So2, 1> {
+        UncertainPose::new_unchecked(
+            *self.mean.rotation(),
+            nalgebra::Matrix1::new(self.heading_variance()),
+            Side::Right,
+        )
     }
 }

@@ -70,6 +70,7 @@ fn nalgebra_and_glam_round_trip() {
 }
 
 #[test]
+#[allow(clippy::approx_constant)] // 0.7071 is deliberately a rounded 1/√2
 fn quaternions_euler_axis_angle_round_trip() {
     let r = So3::from_rpy(0.3, -0.2, 2.5);
     let back = So3::try_from_quaternion_xyzw(r.to_quaternion_xyzw()).unwrap();

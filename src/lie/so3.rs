@@ -11,6 +11,29 @@
 //! Closed forms from Solà et al. 2018 (arXiv:1812.01537) §B and Barfoot 2017 §7.1; with
 //! A(θ) = (1 − cos θ)/θ², B(θ) = (θ − sin θ)/θ³, C(θ) = 1/θ² − cot(θ/2)/(2θ)
 //! (see [`series`](crate::lie::series) for their small-angle branches).
+//!
+//! # Why the exponential map
+//! Integrating a constant body rate ω by n Euler steps R ← R (I + ω̂ dt) leaves SO(3): every
+//! step stretches the directions orthogonal to ω by √(1 + |ω|² dt²), so RᵀR drifts from I.
+//! Stepping with Exp, R ← R · Exp(ω dt), stays on the group to round-off and lands exactly on
+//! Exp(n ω dt).
+//!
+//! ```
+//! use posecov::lie::{LieGroup, So3};
+//! use nalgebra::{Matrix3, Vector3};
+//! let (omega, dt, n) = (Vector3::new(0.3, -0.2, 1.0), 0.01, 1000);
+//! let mut r_euler = Matrix3::identity();
+//! let mut r_exp = So3::identity();
+//! for _ in 0..n {
+//!     r_euler *= Matrix3::identity() + So3::hat(&(omega * dt));
+//!     r_exp = r_exp.rplus(&(omega * dt));
+//! }
+//! let drift = |r: &Matrix3<f64>| (r.transpose() * r - Matrix3::identity()).amax();
+//! // (1 + 1.13e-4)^1000 ≈ 1.12: RᵀR is 12 % off the identity after 10 s.
+//! assert!(drift(&r_euler) > 0.1);
+//! assert!(drift(&r_exp.to_matrix()) < 1e-12);
+//! assert!(r_exp.is_approx(&So3::exp(&(omega * dt * n as f64)), 1e-12));
+//! ```
 
 use std::fmt;
 

@@ -5,6 +5,15 @@
 //! data (for the JSON report and the viewer), with the relative Frobenius error against
 //! Monte Carlo where Monte Carlo ran.
 
+pub mod diff_drive;
+pub mod first_order;
+pub mod fourth_order;
+pub mod fusion;
+pub mod monte_carlo;
+pub mod odometry;
+pub mod sigma_point;
+pub mod vector_space;
+
 use serde::{Deserialize, Serialize};
 
 use crate::lie::{LieGroup, TangentMatrix};

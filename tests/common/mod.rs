@@ -93,3 +93,39 @@ pub fn assert_close<const R: usize, const C: usize>(
         "{what}: max abs error {err:.3e} > {tol:.1e}\n left: {a}\n right: {b}"
     );
 }
+
+/// A seeded random symmetric positive-definite matrix A Aᵀ · scale + 1e-3 · scale · I
+/// (entries of A uniform in [−1, 1]): well conditioned, with correlations.
+pub fn random_spd<const N: usize>(seed: u64, scale: f64) -> SMatrix<f64, N, N> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let a = SMatrix::<f64, N, N>::from_fn(|_, _| rng.random_range(-1.0..1.0));
+    (a * a.transpose() + SMatrix::<f64, N, N>::identity() * 1e-3) * scale
+}
+
+/// `n` seeded draws of N(0, Σ) as L z with L Lᵀ = Σ (Cholesky) and z standard normal.
+/// Panics if Σ is not positive definite (test inputs only).
+pub fn gaussian_draws<const N: usize>(
+    cov: &SMatrix<f64, N, N>,
+    n: usize,
+    seed: u64,
+) -> Vec<SVector<f64, N>> {
+    use rand_distr::StandardNormal;
+    let l = cov
+        .cholesky()
+        .expect("test covariance must be positive definite")
+        .l();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| l * SVector::<f64, N>::from_fn(|_, _| rng.sample::<f64, _>(StandardNormal)))
+        .collect()
+}
+
+/// Sample covariance about zero, (1/n) Σ εεᵀ (the perturbations are already taken about the
+/// propagated mean).
+pub fn uncentred_cov<const N: usize>(samples: &[SVector<f64, N>]) -> SMatrix<f64, N, N> {
+    let mut cov = SMatrix::<f64, N, N>::zeros();
+    for e in samples {
+        cov += e * e.transpose();
+    }
+    cov / samples.len() as f64
+}

@@ -1,0 +1,698 @@
+//! Sampling uncertain poses and the statistics of sample sets (CONVENTIONS §8).
+//!
+//! # Drawing
+//! A [`Sampler`] holds μ, a square root L of Σ (L Lᵀ = Σ) and the side; a draw is
+//! z ~ N(0, I), ε = L z, then X = μ · Exp(ε) (right / body) or X = Exp(ε) · μ (left / world).
+//! L is the Cholesky factor when Σ is positive definite, else the eigen-based square root
+//! L = V diag(√max(λ, 0)) (for PSD-singular Σ such as a pose with no z / roll / pitch noise).
+//!
+//! # Seeding scheme (identical results whatever the thread count)
+//! Parallel draws split the output into fixed chunks of [`CHUNK_SIZE`] samples. Chunk `c` of
+//! the random *family* `f` (one family per independent source of randomness of an operation,
+//! e.g. the initial pose and each odometry step) draws from
+//! `ChaCha8Rng::seed_from_u64(seed + f · 0x9E37_79B9_7F4A_7C15)` with `set_stream(c)`:
+//! [`chunk_rng`]. Which thread runs a chunk never changes what the chunk draws, and sums
+//! over samples are formed per chunk and then added in chunk order, so every result is
+//! bit-identical for a given seed on 1 or 64 threads.
+//!
+//! # Statistics
+//! - [`lie_mean`]: μ ← μ · Exp(mean Log(μ⁻¹ Xᵢ)) (right; left: μ ← Exp(mean Log(Xᵢ μ⁻¹)) · μ)
+//!   until ‖step‖ < [`LIE_MEAN_TOLERANCE`], at most [`LIE_MEAN_MAX_ITERATIONS`] iterations; on
+//!   no convergence a [`MeanError::NotConverged`] carrying the last estimate.
+//! - [`centred_covariance`]: 1/(N−1) Σ ξᵢ ξᵢᵀ about the sample Lie mean (ROB 530).
+//! - [`uncentred_covariance`]: 1/N Σ ξᵢ ξᵢᵀ about a given mean, E[ξξᵀ] (Barfoot & Furgale
+//!   2014, §IV experiments).
+//! - [`nees`]: normalised estimation error squared of samples against a claimed covariance.
+//!
+//! ```
+//! use posecov::lie::{LieGroup, Se2};
+//! use posecov::sample::{Sampler, sample_statistics};
+//! use posecov::uncertain::{Side, UncertainPose};
+//! let pose = UncertainPose::try_from_std_devs(Se2::from_xy_theta(1.0, 2.0, 0.3), [0.1, 0.05, 0.02], Side::Right).unwrap();
+//! let samples = Sampler::new(&pose).unwrap().draw_par(20_000, 7);
+//! let stats = sample_statistics(&samples, Side::Right).unwrap();
+//! assert!(stats.mean.is_approx(pose.mean(), 0.01));
+//! assert!((stats.cov[(0, 0)] / 0.01 - 1.0).abs() < 0.05);
+//! ```
+
+use std::fmt::{Debug, Display};
+
+use nalgebra::{Cholesky, DMatrix, SymmetricEigen};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+use rayon::prelude::*;
+
+use crate::error::{Error, Result, check_finite};
+use crate::lie::{LieGroup, Tangent, TangentMatrix};
+use crate::uncertain::{Side, UncertainPose, try_inverse_covariance};
+
+/// Samples per parallel chunk: the unit of work and of random streams (see the
+/// [seeding scheme](self#seeding-scheme-identical-results-whatever-the-thread-count)).
+pub const CHUNK_SIZE: usize = 1024;
+
+/// The Lie mean stops when the norm of its last tangent update is below this (CONVENTIONS §8).
+pub const LIE_MEAN_TOLERANCE: f64 = 1e-10;
+
+/// The Lie mean gives up after this many iterations (CONVENTIONS §8).
+pub const LIE_MEAN_MAX_ITERATIONS: usize = 100;
+
+/// Golden-ratio increment that separates the seeds of random families.
+const FAMILY_INCREMENT: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// The random generator of chunk `chunk` of random family `family`:
+/// `ChaCha8Rng::seed_from_u64(seed + family · 0x9E37_79B9_7F4A_7C15)` with `set_stream(chunk)`
+/// (wrapping arithmetic). Independent of threads by construction.
+///
+/// ```
+/// use posecov::sample::chunk_rng;
+/// use rand::Rng;
+/// let a: u64 = chunk_rng(1, 0, 3).random();
+/// let b: u64 = chunk_rng(1, 0, 3).random();
+/// let c: u64 = chunk_rng(1, 0, 4).random();
+/// assert_eq!(a, b);
+/// assert_ne!(a, c);
+/// ```
+pub fn chunk_rng(seed: u64, family: u64, chunk: u64) -> ChaCha8Rng {
+    let mut rng =
+        ChaCha8Rng::seed_from_u64(seed.wrapping_add(family.wrapping_mul(FAMILY_INCREMENT)));
+    rng.set_stream(chunk);
+    rng
+}
+
+/// Fills `out` in parallel, chunk by chunk: chunk `c` calls `fill(rng, chunk)` with
+/// [`chunk_rng`]`(seed, family, c)`. The per-sample work inside `fill` should not allocate.
+///
+/// ```
+/// use posecov::sample::fill_par;
+/// use rand::Rng;
+/// let mut v = vec![0.0; 3000];
+/// fill_par(&mut v, 5, 0, |rng, chunk| chunk.iter_mut().for_each(|x| *x = rng.random::<f64>()));
+/// assert!(v.iter().all(|x| (0.0..1.0).contains(x)));
+/// ```
+pub fn fill_par<T, F>(out: &mut [T], seed: u64, family: u64, fill: F)
+where
+    T: Send,
+    F: Fn(&mut ChaCha8Rng, &mut [T]) + Sync,
+{
+    out.par_chunks_mut(CHUNK_SIZE)
+        .enumerate()
+        .for_each(|(c, chunk)| fill(&mut chunk_rng(seed, family, c as u64), chunk));
+}
+
+/// A standard normal vector z ~ N(0, I) in ℝᴺ.
+///
+/// ```
+/// use posecov::sample::standard_normal;
+/// let z = standard_normal::<3, _>(&mut posecov::sample::chunk_rng(0, 0, 0));
+/// assert!(z.iter().all(|v| v.is_finite()));
+/// ```
+pub fn standard_normal<const N: usize, R: Rng + ?Sized>(rng: &mut R) -> Tangent<N> {
+    Tangent::<N>::from_fn(|_, _| rng.sample(StandardNormal))
+}
+
+/// A square root L of a covariance, L Lᵀ = Σ: the lower Cholesky factor when Σ is positive
+/// definite, else V diag(√max(λ, 0)) from the eigen-decomposition Σ = V diag(λ) Vᵀ (PSD-singular
+/// Σ, e.g. zero rows). Errors: [`Error::NonFinite`] for NaN / ±∞.
+///
+/// ```
+/// use posecov::sample::covariance_square_root;
+/// use nalgebra::Matrix3;
+/// let cov = Matrix3::from_diagonal(&nalgebra::Vector3::new(0.0, 4.0, 0.0)); // singular
+/// let l = covariance_square_root(&cov).unwrap();
+/// assert!((l * l.transpose() - cov).norm() < 1e-14);
+/// ```
+pub fn covariance_square_root<const N: usize>(
+    cov: &TangentMatrix<N>,
+) -> Result<TangentMatrix<N>> {
+    check_finite("covariance", cov.transpose().iter().copied())?;
+    let sym = (cov + cov.transpose()) * 0.5;
+    if let Some(chol) = Cholesky::new(sym) {
+        return Ok(chol.l());
+    }
+    // Dynamic storage: the static-size eigensolver needs bounds a const-generic N lacks.
+    let eigen = SymmetricEigen::new(DMatrix::from_iterator(N, N, sym.iter().copied()));
+    let roots = eigen.eigenvalues.map(|l| l.max(0.0).sqrt());
+    let root = &eigen.eigenvectors * DMatrix::from_diagonal(&roots);
+    Ok(TangentMatrix::<N>::from_iterator(root.iter().copied()))
+}
+
+/// The tangent ξ of `x` about `mean` on `side`: right ξ = Log(μ⁻¹ x), left ξ = Log(x μ⁻¹).
+///
+/// ```
+/// use posecov::lie::{LieGroup, So2};
+/// use posecov::sample::tangent_about;
+/// use posecov::uncertain::Side;
+/// let xi = tangent_about(&So2::from_angle(0.5), &So2::from_angle(0.2), Side::Right);
+/// assert!((xi[0] - 0.3).abs() < 1e-15);
+/// ```
+pub fn tangent_about<G: LieGroup<N>, const N: usize>(x: &G, mean: &G, side: Side) -> Tangent<N> {
+    match side {
+        Side::Right => x.rminus(mean),
+        Side::Left => x.lminus(mean),
+    }
+}
+
+/// Moves `mean` by the tangent `step` on `side`: right μ · Exp(step), left Exp(step) · μ.
+///
+/// ```
+/// use posecov::lie::{LieGroup, So2};
+/// use posecov::sample::retract;
+/// use posecov::uncertain::Side;
+/// assert!((retract(&So2::from_angle(0.2), &nalgebra::Vector1::new(0.3), Side::Left).angle() - 0.5).abs() < 1e-15);
+/// ```
+pub fn retract<G: LieGroup<N>, const N: usize>(mean: &G, step: &Tangent<N>, side: Side) -> G {
+    match side {
+        Side::Right => mean.rplus(step),
+        Side::Left => mean.lplus(step),
+    }
+}
+
+// --------------------------------------------------------------------------------------------
+// Drawing.
+
+/// Draws poses from an [`UncertainPose`]: X = μ · Exp(L z) (right) or Exp(L z) · μ (left),
+/// z ~ N(0, I), L Lᵀ = Σ ([`covariance_square_root`]).
+///
+/// ```
+/// use posecov::lie::{LieGroup, Se3};
+/// use posecov::sample::Sampler;
+/// use posecov::uncertain::UncertainPose;
+/// use rand::SeedableRng;
+/// let sampler = Sampler::new(&UncertainPose::certain(Se3::identity())).unwrap();
+/// let x = sampler.draw(&mut rand_chacha::ChaCha8Rng::seed_from_u64(1));
+/// assert_eq!(x, Se3::identity().compose(&Se3::exp(&nalgebra::Vector6::zeros())));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampler<G: LieGroup<N>, const N: usize> {
+    mean: G,
+    factor: TangentMatrix<N>,
+    side: Side,
+}
+
+impl<G: LieGroup<N>, const N: usize> Sampler<G, N> {
+    /// A sampler for `pose`. Errors: a non-finite covariance.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So3};
+    /// use posecov::sample::Sampler;
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(So3::identity(), [0.1, 0.2, 0.3], Side::Left).unwrap();
+    /// let s = Sampler::new(&p).unwrap();
+    /// assert!((s.factor()[(2, 2)] - 0.3).abs() < 1e-15);
+    /// ```
+    pub fn new(pose: &UncertainPose<G, N>) -> Result<Self> {
+        Ok(Self {
+            mean: *pose.mean(),
+            factor: covariance_square_root(pose.cov())?,
+            side: pose.side(),
+        })
+    }
+
+    /// The square root L (L Lᵀ = Σ) the sampler uses.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::sample::Sampler;
+    /// use posecov::uncertain::UncertainPose;
+    /// let s = Sampler::new(&UncertainPose::certain(So2::identity())).unwrap();
+    /// assert_eq!(s.factor()[(0, 0)], 0.0);
+    /// ```
+    pub fn factor(&self) -> &TangentMatrix<N> {
+        &self.factor
+    }
+
+    /// One tangent perturbation ε = L z, z ~ N(0, I).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::sample::{Sampler, chunk_rng};
+    /// use posecov::uncertain::UncertainPose;
+    /// let s = Sampler::new(&UncertainPose::certain(So2::identity())).unwrap();
+    /// assert_eq!(s.draw_tangent(&mut chunk_rng(0, 0, 0))[0], 0.0);
+    /// ```
+    pub fn draw_tangent<R: Rng + ?Sized>(&self, rng: &mut R) -> Tangent<N> {
+        self.factor * standard_normal::<N, R>(rng)
+    }
+
+    /// The pose at perturbation ε: μ · Exp(ε) (right) or Exp(ε) · μ (left).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::sample::Sampler;
+    /// use posecov::uncertain::UncertainPose;
+    /// let s = Sampler::new(&UncertainPose::certain(So2::from_angle(0.1))).unwrap();
+    /// assert!((s.perturb(&nalgebra::Vector1::new(0.2)).angle() - 0.3).abs() < 1e-15);
+    /// ```
+    pub fn perturb(&self, eps: &Tangent<N>) -> G {
+        retract(&self.mean, eps, self.side)
+    }
+
+    /// One pose drawn with the caller's generator.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::sample::{Sampler, chunk_rng};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.1, 0.1], Side::Right).unwrap();
+    /// let x = Sampler::new(&p).unwrap().draw(&mut chunk_rng(3, 0, 0));
+    /// assert!(x.rminus(&Se2::identity()).norm() < 1.0);
+    /// ```
+    pub fn draw<R: Rng + ?Sized>(&self, rng: &mut R) -> G {
+        self.perturb(&self.draw_tangent(rng))
+    }
+
+    /// `n` poses drawn sequentially with the caller's generator.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So3};
+    /// use posecov::sample::{Sampler, chunk_rng};
+    /// use posecov::uncertain::UncertainPose;
+    /// let s = Sampler::new(&UncertainPose::certain(So3::identity())).unwrap();
+    /// assert_eq!(s.draw_many(&mut chunk_rng(0, 0, 0), 5).len(), 5);
+    /// ```
+    pub fn draw_many<R: Rng + ?Sized>(&self, rng: &mut R, n: usize) -> Vec<G> {
+        (0..n).map(|_| self.draw(rng)).collect()
+    }
+
+    /// `n` poses drawn in parallel (rayon), identical for a given `seed` whatever the thread
+    /// count: random family 0 of the [seeding scheme](self#seeding-scheme-identical-results-whatever-the-thread-count).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::sample::Sampler;
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.1, 0.1], Side::Right).unwrap();
+    /// let s = Sampler::new(&p).unwrap();
+    /// assert_eq!(s.draw_par(3000, 42), s.draw_par(3000, 42));
+    /// ```
+    pub fn draw_par(&self, n: usize, seed: u64) -> Vec<G> {
+        let mut out = vec![self.mean; n];
+        self.fill_par(&mut out, seed, 0);
+        out
+    }
+
+    /// Overwrites `out` with draws in parallel from random family `family` (see
+    /// [`draw_par`](Self::draw_par)); no allocation per sample.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::sample::Sampler;
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let p = UncertainPose::try_from_std_devs(So2::identity(), [0.1], Side::Right).unwrap();
+    /// let mut out = vec![So2::identity(); 10];
+    /// Sampler::new(&p).unwrap().fill_par(&mut out, 1, 0);
+    /// assert!(out.iter().any(|x| x.angle() != 0.0));
+    /// ```
+    pub fn fill_par(&self, out: &mut [G], seed: u64, family: u64) {
+        fill_par(out, seed, family, |rng, chunk| {
+            chunk.iter_mut().for_each(|x| *x = self.draw(rng));
+        });
+    }
+}
+
+// --------------------------------------------------------------------------------------------
+// Statistics.
+
+/// Why a Lie mean failed. Generic over the group so that a non-converged iteration hands back
+/// its last estimate as a typed value; converts into [`crate::Error`] (the estimate then
+/// travels formatted in [`Error::NotConverged`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MeanError<G: Debug + Display> {
+    /// The input was invalid (e.g. [`Error::TooFewSamples`], mismatched weights).
+    #[error(transparent)]
+    Invalid(#[from] Error),
+    /// The iteration did not reach [`LIE_MEAN_TOLERANCE`] within [`LIE_MEAN_MAX_ITERATIONS`].
+    #[error(
+        "Lie mean: no convergence after {iterations} iterations (last step {last_step:.3e} > {tolerance:.1e}); \
+         last estimate {last_estimate}"
+    )]
+    NotConverged {
+        /// Where the iteration stopped.
+        last_estimate: G,
+        /// Iterations run.
+        iterations: usize,
+        /// Norm of the last tangent update.
+        last_step: f64,
+        /// The threshold it was held to.
+        tolerance: f64,
+    },
+}
+
+impl<G: Debug + Display> From<MeanError<G>> for Error {
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::sample::MeanError;
+    /// let e: posecov::Error = MeanError::NotConverged { last_estimate: So2::identity(), iterations: 100, last_step: 1.0, tolerance: 1e-10 }.into();
+    /// assert!(matches!(e, posecov::Error::NotConverged { iterations: 100, .. }));
+    /// ```
+    fn from(e: MeanError<G>) -> Self {
+        match e {
+            MeanError::Invalid(e) => e,
+            MeanError::NotConverged {
+                last_estimate,
+                iterations,
+                last_step,
+                tolerance,
+            } => Error::NotConverged {
+                what: "Lie mean",
+                iterations,
+                last_step,
+                tolerance,
+                last_estimate: last_estimate.to_string(),
+            },
+        }
+    }
+}
+
+/// A converged Lie mean with its iteration count and final step norm.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LieMean<G> {
+    /// The mean μ.
+    pub mean: G,
+    /// Iterations run (1 when the initial guess already satisfied the tolerance).
+    pub iterations: usize,
+    /// Norm of the last tangent update (< [`LIE_MEAN_TOLERANCE`]).
+    pub last_step: f64,
+}
+
+fn check_count(what: &'static str, got: usize, needed: usize) -> Result<()> {
+    if got < needed {
+        return Err(Error::TooFewSamples { what, needed, got });
+    }
+    Ok(())
+}
+
+/// Σᵢ wᵢ ξᵢ of the tangents about `mean`, in chunks added in chunk order (deterministic).
+fn weighted_tangent_sum<G: LieGroup<N>, const N: usize>(
+    points: &[G],
+    weights: Option<&[f64]>,
+    mean: &G,
+    side: Side,
+) -> Tangent<N> {
+    let chunk_sums: Vec<Tangent<N>> = points
+        .par_chunks(CHUNK_SIZE)
+        .enumerate()
+        .map(|(c, chunk)| {
+            chunk.iter().enumerate().fold(Tangent::<N>::zeros(), |acc, (i, x)| {
+                let w = weights.map_or(1.0, |w| w[c * CHUNK_SIZE + i]);
+                acc + tangent_about(x, mean, side) * w
+            })
+        })
+        .collect();
+    chunk_sums.iter().sum()
+}
+
+/// The Lie (Fréchet / Karcher) mean of weighted points from the initial guess `initial`:
+/// μ ← μ · Exp(Σ wᵢ Log(μ⁻¹ Xᵢ) / Σ wᵢ) (right), μ ← Exp(Σ wᵢ Log(Xᵢ μ⁻¹) / Σ wᵢ) · μ (left),
+/// until ‖step‖ < [`LIE_MEAN_TOLERANCE`] (CONVENTIONS §8; unscented weights may be negative
+/// as long as their sum is not 0). `weights = None` means equal weights.
+///
+/// Errors: [`Error::TooFewSamples`] for no points, [`Error::WrongLength`] for a weight vector
+/// of the wrong length, [`Error::OutOfRange`] for a zero or non-finite weight sum,
+/// [`MeanError::NotConverged`] (with the last estimate) after [`LIE_MEAN_MAX_ITERATIONS`].
+///
+/// ```
+/// use posecov::lie::{LieGroup, So2};
+/// use posecov::sample::weighted_lie_mean;
+/// use posecov::uncertain::Side;
+/// let pts = [So2::from_angle(0.1), So2::from_angle(0.4)];
+/// let m = weighted_lie_mean(&pts, Some(&[2.0, 1.0]), &pts[0], Side::Right).unwrap();
+/// assert!((m.mean.angle() - 0.2).abs() < 1e-12);
+/// ```
+pub fn weighted_lie_mean<G: LieGroup<N>, const N: usize>(
+    points: &[G],
+    weights: Option<&[f64]>,
+    initial: &G,
+    side: Side,
+) -> Result<LieMean<G>, MeanError<G>> {
+    check_count("Lie mean", points.len(), 1)?;
+    let total = match weights {
+        None => points.len() as f64,
+        Some(w) if w.len() != points.len() => {
+            return Err(Error::WrongLength {
+                what: "Lie mean weights",
+                expected: points.len(),
+                got: w.len(),
+            }
+            .into());
+        }
+        Some(w) => w.iter().sum(),
+    };
+    if !(total.is_finite() && total != 0.0) {
+        return Err(Error::OutOfRange {
+            what: "sum of Lie mean weights",
+            value: total,
+            expected: "a finite, non-zero sum",
+        }
+        .into());
+    }
+    let mut mean = *initial;
+    let mut last_step = f64::INFINITY;
+    for iterations in 1..=LIE_MEAN_MAX_ITERATIONS {
+        let step = weighted_tangent_sum(points, weights, &mean, side) / total;
+        last_step = step.norm();
+        if !last_step.is_finite() {
+            break;
+        }
+        mean = retract(&mean, &step, side);
+        if last_step < LIE_MEAN_TOLERANCE {
+            return Ok(LieMean {
+                mean,
+                iterations,
+                last_step,
+            });
+        }
+    }
+    Err(MeanError::NotConverged {
+        last_estimate: mean,
+        iterations: LIE_MEAN_MAX_ITERATIONS,
+        last_step,
+        tolerance: LIE_MEAN_TOLERANCE,
+    })
+}
+
+/// The iterative Lie mean of samples (CONVENTIONS §8), starting from the first sample; see
+/// [`weighted_lie_mean`] for the iteration, the errors and the left-side form.
+///
+/// ```
+/// use posecov::lie::{LieGroup, Se2};
+/// use posecov::sample::{MeanError, lie_mean};
+/// use posecov::uncertain::Side;
+/// let pts = [Se2::from_xy_theta(0.0, 0.0, 0.2), Se2::from_xy_theta(0.0, 0.0, -0.2)];
+/// assert!(lie_mean(&pts, Side::Right).unwrap().mean.theta().abs() < 1e-12);
+/// assert!(matches!(lie_mean::<Se2, 3>(&[], Side::Right), Err(MeanError::Invalid(_))));
+/// ```
+pub fn lie_mean<G: LieGroup<N>, const N: usize>(
+    samples: &[G],
+    side: Side,
+) -> Result<LieMean<G>, MeanError<G>> {
+    let first = samples
+        .first()
+        .ok_or(Error::TooFewSamples {
+            what: "Lie mean",
+            needed: 1,
+            got: 0,
+        })?;
+    weighted_lie_mean(samples, None, first, side)
+}
+
+/// Σᵢ wᵢ ξᵢ ξᵢᵀ of the tangents about `mean`, in chunks added in chunk order (deterministic).
+fn weighted_outer_sum<G: LieGroup<N>, const N: usize>(
+    points: &[G],
+    weights: Option<&[f64]>,
+    mean: &G,
+    side: Side,
+) -> TangentMatrix<N> {
+    let chunk_sums: Vec<TangentMatrix<N>> = points
+        .par_chunks(CHUNK_SIZE)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut acc = TangentMatrix::<N>::zeros();
+            for (i, x) in chunk.iter().enumerate() {
+                let w = weights.map_or(1.0, |w| w[c * CHUNK_SIZE + i]);
+                let xi = tangent_about(x, mean, side);
+                acc.ger(w, &xi, &xi, 1.0);
+            }
+            acc
+        })
+        .collect();
+    let sum: TangentMatrix<N> = chunk_sums.iter().sum();
+    (sum + sum.transpose()) * 0.5
+}
+
+/// Weighted second moment Σᵢ wᵢ ξᵢ ξᵢᵀ about `mean` on `side` (ξ from [`tangent_about`]); the
+/// unscented transform's covariance with its weights W⁽ᶜ⁾ (Julier & Uhlmann 2004, eq. 12).
+/// Errors: [`Error::WrongLength`] when the lengths differ, [`Error::TooFewSamples`] for none.
+///
+/// ```
+/// use posecov::lie::{LieGroup, So2};
+/// use posecov::sample::weighted_covariance;
+/// use posecov::uncertain::Side;
+/// let pts = [So2::from_angle(0.1), So2::from_angle(-0.1)];
+/// let c = weighted_covariance(&pts, &[0.5, 0.5], &So2::identity(), Side::Right).unwrap();
+/// assert!((c[(0, 0)] - 0.01).abs() < 1e-15);
+/// ```
+pub fn weighted_covariance<G: LieGroup<N>, const N: usize>(
+    points: &[G],
+    weights: &[f64],
+    mean: &G,
+    side: Side,
+) -> Result<TangentMatrix<N>> {
+    check_count("weighted covariance", points.len(), 1)?;
+    if weights.len() != points.len() {
+        return Err(Error::WrongLength {
+            what: "covariance weights",
+            expected: points.len(),
+            got: weights.len(),
+        });
+    }
+    Ok(weighted_outer_sum(points, Some(weights), mean, side))
+}
+
+/// The uncentred covariance E[ξξᵀ] ≈ 1/N Σ ξᵢ ξᵢᵀ of samples about a *given* mean (e.g. the
+/// propagated nominal pose), as in Barfoot & Furgale 2014's Monte Carlo comparisons (§IV-A,
+/// Fig. 2). Right: ξ = Log(μ⁻¹ X); left: ξ = Log(X μ⁻¹). Errors: [`Error::TooFewSamples`] for
+/// an empty set.
+///
+/// ```
+/// use posecov::lie::{LieGroup, So2};
+/// use posecov::sample::uncentred_covariance;
+/// use posecov::uncertain::Side;
+/// let pts = [So2::from_angle(0.3), So2::from_angle(0.1)];
+/// let c = uncentred_covariance(&pts, &So2::identity(), Side::Right).unwrap();
+/// assert!((c[(0, 0)] - 0.05).abs() < 1e-15); // (0.09 + 0.01) / 2, not about the mean 0.2
+/// ```
+pub fn uncentred_covariance<G: LieGroup<N>, const N: usize>(
+    samples: &[G],
+    about: &G,
+    side: Side,
+) -> Result<TangentMatrix<N>> {
+    check_count("uncentred covariance", samples.len(), 1)?;
+    Ok(weighted_outer_sum(samples, None, about, side) / samples.len() as f64)
+}
+
+/// The centred sample covariance 1/(N−1) Σ ξᵢ ξᵢᵀ about the sample's own Lie mean `mean`
+/// (ROB 530; pass the result of [`lie_mean`]). Right: ξ = Log(μ⁻¹ X); left: ξ = Log(X μ⁻¹).
+/// At the Lie mean Σ ξᵢ = 0, so this is the unbiased covariance of the ξᵢ. Errors:
+/// [`Error::TooFewSamples`] for fewer than 2 samples.
+///
+/// ```
+/// use posecov::lie::{LieGroup, So2};
+/// use posecov::sample::centred_covariance;
+/// use posecov::uncertain::Side;
+/// let pts = [So2::from_angle(0.3), So2::from_angle(0.1)];
+/// let c = centred_covariance(&pts, &So2::from_angle(0.2), Side::Right).unwrap();
+/// assert!((c[(0, 0)] - 0.02).abs() < 1e-15); // (0.01 + 0.01) / (2 − 1)
+/// ```
+pub fn centred_covariance<G: LieGroup<N>, const N: usize>(
+    samples: &[G],
+    mean: &G,
+    side: Side,
+) -> Result<TangentMatrix<N>> {
+    check_count("centred covariance", samples.len(), 2)?;
+    Ok(weighted_outer_sum(samples, None, mean, side) / (samples.len() - 1) as f64)
+}
+
+/// Sample statistics: the Lie mean and the centred 1/(N−1) covariance about it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleStatistics<G: LieGroup<N>, const N: usize> {
+    /// The iterative Lie mean.
+    pub mean: G,
+    /// The centred covariance about it, on `side`.
+    pub cov: TangentMatrix<N>,
+    /// The side of the tangents (and of the mean iteration).
+    pub side: Side,
+    /// Number of samples.
+    pub count: usize,
+    /// Lie mean iterations.
+    pub iterations: usize,
+}
+
+impl<G: LieGroup<N>, const N: usize> SampleStatistics<G, N> {
+    /// As an uncertain pose (μ, Σ, side).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::sample::sample_statistics;
+    /// use posecov::uncertain::Side;
+    /// let s = sample_statistics(&[So2::from_angle(0.1), So2::from_angle(0.3)], Side::Right).unwrap();
+    /// assert!((s.to_pose().cov()[(0, 0)] - 0.02).abs() < 1e-15);
+    /// ```
+    pub fn to_pose(&self) -> UncertainPose<G, N> {
+        UncertainPose::new_unchecked(self.mean, self.cov, self.side)
+    }
+}
+
+/// The Lie mean ([`lie_mean`]) and centred covariance ([`centred_covariance`]) of samples,
+/// on `side` (CONVENTIONS §8). Errors: [`Error::TooFewSamples`] below 2 samples,
+/// [`MeanError::NotConverged`].
+///
+/// ```
+/// use posecov::lie::{LieGroup, So3};
+/// use posecov::sample::sample_statistics;
+/// use posecov::uncertain::Side;
+/// assert!(sample_statistics(&[So3::identity()], Side::Left).is_err()); // one sample
+/// ```
+pub fn sample_statistics<G: LieGroup<N>, const N: usize>(
+    samples: &[G],
+    side: Side,
+) -> Result<SampleStatistics<G, N>, MeanError<G>> {
+    check_count("sample statistics", samples.len(), 2)?;
+    let mean = lie_mean(samples, side)?;
+    Ok(SampleStatistics {
+        mean: mean.mean,
+        cov: centred_covariance(samples, &mean.mean, side)?,
+        side,
+        count: samples.len(),
+        iterations: mean.iterations,
+    })
+}
+
+/// Normalised estimation error squared of samples against a claimed distribution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Nees {
+    /// εᵢᵀ Σ⁻¹ εᵢ per sample.
+    pub values: Vec<f64>,
+    /// Their average; ≈ `dof` when the claimed Σ is consistent with the samples.
+    pub mean: f64,
+    /// Degrees of freedom N of the group.
+    pub dof: usize,
+}
+
+/// NEES of each sample against `claimed` (Bar-Shalom, Li & Kirubarajan 2001, §5.4.2):
+/// NEESᵢ = εᵢᵀ Σ⁻¹ εᵢ with εᵢ = Log(μ⁻¹ Xᵢ) (right) or Log(Xᵢ μ⁻¹) (left). For a consistent Σ
+/// the mean NEES is ≈ N (χ²_N), with standard error √(2N / count). Errors:
+/// [`Error::TooFewSamples`] for none, [`Error::SingularCovariance`] when Σ is singular.
+///
+/// ```
+/// use posecov::lie::{LieGroup, Se2};
+/// use posecov::sample::{Sampler, nees};
+/// use posecov::uncertain::{Side, UncertainPose};
+/// let p = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.2, 0.05], Side::Right).unwrap();
+/// let samples = Sampler::new(&p).unwrap().draw_par(20_000, 3);
+/// let n = nees(&samples, &p).unwrap();
+/// assert!((n.mean - 3.0).abs() < 5.0 * (6.0f64 / 20_000.0).sqrt());
+/// ```
+pub fn nees<G: LieGroup<N>, const N: usize>(
+    samples: &[G],
+    claimed: &UncertainPose<G, N>,
+) -> Result<Nees> {
+    check_count("NEES", samples.len(), 1)?;
+    let info = try_inverse_covariance("claimed covariance", claimed.cov())?;
+    let (mean, side) = (claimed.mean(), claimed.side());
+    let values: Vec<f64> = samples
+        .par_iter()
+        .map(|x| {
+            let eps = tangent_about(x, mean, side);
+            eps.dot(&(info * eps))
+        })
+        .collect();
+    // Sequential sum: deterministic whatever the thread count.
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    Ok(Nees {
+        values,
+        mean,
+        dof: N,
+    })
+}

@@ -1,0 +1,287 @@
+//! The scenario file format: serde structures that mirror the TOML one to one.
+//!
+//! Every table rejects unknown keys (serde `deny_unknown_fields`, which lists the valid ones).
+//! Values whose meaning is checked after parsing (covariances, quaternions, names) keep their
+//! byte span, so errors can point at `file:line:column`.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::uncertain::{Method, Side};
+
+/// A whole scenario file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioFile {
+    /// The `[scenario]` header.
+    pub scenario: Header,
+    /// Named poses: inputs, fixed transforms (no `cov`), or uncertain estimates.
+    #[serde(default, rename = "pose")]
+    pub poses: Vec<PoseSpec>,
+    /// Operations, evaluated in file order; each writes a new named pose.
+    #[serde(default, rename = "operation")]
+    pub operations: Vec<OperationSpec>,
+    /// What to draw.
+    #[serde(default)]
+    pub draw: DrawSpec,
+}
+
+/// The Lie group every pose of a scenario lives in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GroupName {
+    /// Planar rotations.
+    So2,
+    /// Planar poses, tangent [x, y, θ].
+    Se2,
+    /// 3D rotations, tangent θ ∈ ℝ³.
+    So3,
+    /// 3D poses, tangent [ρ; θ].
+    Se3,
+}
+
+impl GroupName {
+    /// Degrees of freedom: 1, 3, 3, 6.
+    ///
+    /// ```
+    /// use posecov::scenario::schema::GroupName;
+    /// assert_eq!(GroupName::Se3.dof(), 6);
+    /// ```
+    pub fn dof(self) -> usize {
+        match self {
+            GroupName::So2 => 1,
+            GroupName::Se2 | GroupName::So3 => 3,
+            GroupName::Se3 => 6,
+        }
+    }
+}
+
+/// `[scenario]`: what this scenario is and how to evaluate it.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Header {
+    /// One-line title (also the `posecov list` description).
+    pub title: String,
+    /// Markdown shown in the viewer's text panel: what the picture teaches.
+    #[serde(default)]
+    pub description: String,
+    /// Where the example comes from (lecture, paper, figure).
+    #[serde(default)]
+    pub source: String,
+    /// The group of every pose.
+    pub group: GroupName,
+    /// Seed of every random draw (CLI `--seed` overrides).
+    #[serde(default)]
+    pub seed: Option<u64>,
+    /// Monte Carlo sample count (CLI `--samples` overrides).
+    #[serde(default)]
+    pub samples: Option<Spanned<u64>>,
+    /// Confidence of drawn regions as a probability in (0, 1) (CLI `--confidence` overrides).
+    #[serde(default)]
+    pub confidence: Option<Spanned<f64>>,
+    /// Methods to compare, e.g. `["first_order", "monte_carlo"]`.
+    #[serde(default)]
+    pub methods: Vec<Method>,
+}
+
+/// `[[pose]]`: a named pose, deterministic (no `cov`) or uncertain.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseSpec {
+    /// Its name, e.g. `world_from_body` (used by operations and as the entity path).
+    pub name: Spanned<String>,
+    /// The mean.
+    pub mean: Spanned<MeanSpec>,
+    /// The covariance; absent for a known transform.
+    #[serde(default)]
+    pub cov: Option<Spanned<CovSpec>>,
+    /// Draw this pose. Default: uncertain poses always; a known transform `a_from_b` only when
+    /// `a` is the scenario's root frame (the parent of its first uncertain pose), so relative
+    /// mounts such as `robot_from_camera` are not drawn as if they were world poses.
+    #[serde(default)]
+    pub draw: Option<bool>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// A mean, given in exactly one way (translation and rotation may be combined).
+///
+/// - SE(2): `xy_theta = [x, y, θ]` (θ in radians) or `xy_theta_deg`.
+/// - SO(2): `angle` or `angle_deg`.
+/// - SO(3)/SE(3): rotation from `quaternion_xyzw`, `rpy` (radians) or `rpy_deg`
+///   (R = Rz(yaw) Ry(pitch) Rx(roll)), or `axis_angle = [x, y, z, angle]`; SE(3) adds `xyz`.
+/// - Any group: `matrix` (rotation or homogeneous, row-major rows) or `tangent`
+///   (μ = Exp(τ), in the conventions' order).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeanSpec {
+    /// SE(2) position and heading (radians).
+    pub xy_theta: Option<[f64; 3]>,
+    /// SE(2) position and heading (degrees).
+    pub xy_theta_deg: Option<[f64; 3]>,
+    /// SO(2) angle (radians).
+    pub angle: Option<f64>,
+    /// SO(2) angle (degrees).
+    pub angle_deg: Option<f64>,
+    /// SE(3) position.
+    pub xyz: Option<[f64; 3]>,
+    /// Rotation as a unit quaternion, ROS order (x, y, z, w).
+    pub quaternion_xyzw: Option<[f64; 4]>,
+    /// Rotation as roll, pitch, yaw (radians).
+    pub rpy: Option<[f64; 3]>,
+    /// Rotation as roll, pitch, yaw (degrees).
+    pub rpy_deg: Option<[f64; 3]>,
+    /// Rotation as a unit axis and an angle in radians: [x, y, z, angle].
+    pub axis_angle: Option<[f64; 4]>,
+    /// The group element as a matrix, row-major rows.
+    pub matrix: Option<Vec<Vec<f64>>>,
+    /// The group element as Exp(tangent).
+    pub tangent: Option<Vec<f64>>,
+}
+
+/// Order of the numbers in a covariance given as a matrix.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Order {
+    /// posecov's order: [ρ; θ] (ROS, Solà, Barfoot & Furgale).
+    #[default]
+    TranslationFirst,
+    /// [θ; ρ] (GTSAM Pose3, sophus-rs, Lynch & Park, EEME E6911).
+    RotationFirst,
+}
+
+/// A covariance, given in exactly one way.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CovSpec {
+    /// Per-axis standard deviations (Σ = diag(σ²)), in the conventions' order.
+    pub std: Option<Vec<f64>>,
+    /// Per-axis standard deviations with the rotational ones in degrees.
+    pub std_deg: Option<Vec<f64>>,
+    /// Full matrix, row-major rows.
+    pub matrix: Option<Vec<Vec<f64>>>,
+    /// ROS `PoseWithCovariance.covariance`: 36 numbers, row-major, (x, y, z, rotX, rotY, rotZ),
+    /// position error in the parent frame's axes, rotation error local (SE(3) only).
+    pub ros: Option<Vec<f64>>,
+    /// Which side the perturbation is on (default `right`: X = μ · Exp(ε)).
+    #[serde(default)]
+    pub side: Side,
+    /// Order of `matrix` / `std` entries (default `translation_first`).
+    #[serde(default)]
+    pub order: Order,
+}
+
+/// `[[operation]]`: one step of what the robot does. `kind` selects which other keys apply;
+/// the evaluator rejects keys that do not belong to the kind.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OperationSpec {
+    /// One of the [`OPERATION_KINDS`].
+    pub kind: Spanned<String>,
+    /// Name of the pose this operation creates.
+    pub output: Spanned<String>,
+    /// The single input (inverse, change of frame, odometry start, point_through_pose).
+    pub input: Option<Spanned<String>>,
+    /// Left operand (compose, between).
+    pub lhs: Option<Spanned<String>>,
+    /// Right operand (compose, between).
+    pub rhs: Option<Spanned<String>>,
+    /// A known transform (change of frame: `world_from_map` on the left, `body_from_camera` on the right).
+    pub by: Option<Spanned<String>>,
+    /// Several inputs (fuse).
+    pub inputs: Option<Vec<Spanned<String>>>,
+    /// Cross-covariance Σ_XY between `lhs` and `rhs` (correlated compose/between).
+    pub cross_cov: Option<Spanned<Vec<Vec<f64>>>>,
+    /// Per-step control inputs (odometry): one tangent per step, or one repeated `steps` times.
+    pub controls: Option<Spanned<Vec<Vec<f64>>>>,
+    /// Number of steps (odometry with a single control, compound).
+    pub steps: Option<Spanned<u64>>,
+    /// Process noise per step (odometry, compound).
+    pub noise: Option<Spanned<CovSpec>>,
+    /// Odometry model: `"increment"` X·U·Exp(w) (NA 568) or `"exp"` X·Exp(u + w).
+    pub model: Option<Spanned<String>>,
+    /// Point coordinates in the input pose's frame (point_through_pose).
+    pub point: Option<Spanned<Vec<f64>>>,
+    /// Point covariance in the input pose's frame (point_through_pose).
+    pub point_cov: Option<Spanned<Vec<Vec<f64>>>>,
+    /// Differential drive: wheel radius r (m).
+    pub wheel_radius: Option<Spanned<f64>>,
+    /// Differential drive: wheelbase l (m).
+    pub wheelbase: Option<Spanned<f64>>,
+    /// Differential drive: duration T (s).
+    pub duration: Option<Spanned<f64>>,
+    /// Differential drive: wheel noise intensity D.
+    pub diffusion: Option<Spanned<f64>>,
+    /// Differential drive: forward speed v (m/s).
+    pub speed: Option<Spanned<f64>>,
+    /// Differential drive: turn rate α̇ (rad/s), 0 for straight.
+    pub turn_rate: Option<Spanned<f64>>,
+    /// Time step (s) of sampled integration (differential drive, Euler vs Exp).
+    pub dt: Option<Spanned<f64>>,
+    /// Body angular rate ω (rad/s) for `euler_vs_exp`.
+    pub rate: Option<Spanned<Vec<f64>>>,
+}
+
+/// Every operation kind the evaluator knows.
+pub const OPERATION_KINDS: &[&str] = &[
+    "inverse",
+    "change_frame_left",
+    "change_frame_right",
+    "compose",
+    "between",
+    "compose_correlated",
+    "between_correlated",
+    "odometry",
+    "compound",
+    "diff_drive",
+    "point_through_pose",
+    "fuse",
+    "euler_vs_exp",
+];
+
+/// `[draw]`: what the viewer shows (all default to true).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DrawSpec {
+    /// Mean frames as axis triads.
+    #[serde(default = "yes")]
+    pub axes: bool,
+    /// Monte Carlo sample positions.
+    #[serde(default = "yes")]
+    pub clouds: bool,
+    /// Small axis triads on a subsample of the samples.
+    #[serde(default = "yes")]
+    pub sample_axes: bool,
+    /// Position covariance ellipsoids (first-order, world frame).
+    #[serde(default = "yes")]
+    pub ellipsoids: bool,
+    /// Exp-mapped "banana" surfaces of each method's tangent ellipsoid.
+    #[serde(default = "yes")]
+    pub bananas: bool,
+    /// Orientation uncertainty: axis-tip sprays and their Exp-mapped ellipses.
+    #[serde(default = "yes")]
+    pub orientation: bool,
+    /// Nominal and sampled trajectories.
+    #[serde(default = "yes")]
+    pub trajectories: bool,
+    /// Length of the mean frames' axes (m); default from the scene size.
+    #[serde(default)]
+    pub axis_length: Option<f64>,
+}
+
+impl Default for DrawSpec {
+    fn default() -> Self {
+        Self {
+            axes: true,
+            clouds: true,
+            sample_axes: true,
+            ellipsoids: true,
+            bananas: true,
+            orientation: true,
+            trajectories: true,
+            axis_length: None,
+        }
+    }
+}

@@ -1,0 +1,361 @@
+//! A plain-data scene: what to draw, where, and when — the last stage before a sink.
+//!
+//! The data path is *scenario → evaluation → [`Scene`] → sink*. A scene knows nothing about
+//! Rerun: it is a list of [`SceneItem`]s (frames, triad batches, point clouds, ellipsoids,
+//! surfaces, line strips, arrows, text) plus [`ScalarSeries`] for plots, each item placed on
+//! an entity path and either static or at an integer `step` of the propagation timeline.
+//! [`crate::sink`] turns it into Rerun archetypes; tests can inspect it directly.
+//!
+//! # Conventions at this boundary
+//! - Numbers are `f64` here; the sink converts to `f32` (Rerun speaks glam/f32). A value
+//!   that is not finite, or not finite once converted to `f32`, is rejected by
+//!   [`Scene::validate`] — NaN never reaches the viewer.
+//! - Positions are in the `world` frame, right-handed, z up.
+//! - Quaternions are **`[x, y, z, w]`** ([`QuatXyzw`]), unit norm (±[`QUAT_NORM_TOLERANCE`]).
+//!   From nalgebra: `let q: QuatXyzw = unit_quaternion.coords.into();` (nalgebra stores
+//!   `[i, j, k, w]`).
+//! - Entity paths: 3-D geometry lives under [`WORLD`], scalar series under [`PLOTS`]; the
+//!   scenario description is drawn at [`DESCRIPTION`]. Suggested layout:
+//!   `world/<pose>/<method>/<what>` (e.g. `world/T_MC/first_order/ellipsoid`), so each pose ×
+//!   method can be toggled in the viewer.
+//!
+//! # Example
+//! ```
+//! use posecov::scene::{Color, ItemKind, PointCloud, Scene, SceneItem, Timing};
+//!
+//! let mut scene = Scene::new("demo", "A single point.");
+//! scene.push(SceneItem::new(
+//!     "world/p/monte_carlo/cloud",
+//!     Timing::Static,
+//!     ItemKind::Points(PointCloud {
+//!         positions: vec![[0.0, 0.0, 1.0]],
+//!         color: Color::rgb(200, 200, 200),
+//!         radius: 0.01,
+//!     }),
+//! ));
+//! assert!(scene.validate().is_ok());
+//! ```
+
+mod demo;
+mod mesh;
+mod palette;
+mod validate;
+
+pub use demo::{DEMO_SAMPLES, demo_scene, demo_scene_with};
+pub use mesh::unit_sphere_mesh;
+pub use palette::Method;
+
+/// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
+pub type Vec3 = [f64; 3];
+
+/// A unit quaternion in **`[x, y, z, w]`** order (glam / ROS order, not nalgebra's `new(w, …)`).
+pub type QuatXyzw = [f64; 4];
+
+/// The identity rotation, `[x, y, z, w] = [0, 0, 0, 1]`.
+pub const QUAT_IDENTITY: QuatXyzw = [0.0, 0.0, 0.0, 1.0];
+
+/// How far from 1 a quaternion's norm may be before [`Scene::validate`] rejects it.
+pub const QUAT_NORM_TOLERANCE: f64 = 1e-3;
+
+/// Root entity of all 3-D geometry (the 3-D view of the default layout shows this subtree).
+pub const WORLD: &str = "world";
+
+/// Root entity of all scalar series (the plot of the default layout shows this subtree).
+pub const PLOTS: &str = "plots";
+
+/// Entity of the scenario's markdown description (the text panel of the default layout).
+pub const DESCRIPTION: &str = "description";
+
+/// An sRGB colour with unmultiplied alpha, `[r, g, b, a]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Color(pub [u8; 4]);
+
+impl Color {
+    /// An opaque colour.
+    ///
+    /// ```
+    /// assert_eq!(posecov::scene::Color::rgb(1, 2, 3).0, [1, 2, 3, 255]);
+    /// ```
+    pub const fn rgb(r: u8, g: u8, b: u8) -> Self {
+        Self([r, g, b, 255])
+    }
+
+    /// The same colour with alpha `a` (0 = transparent, 255 = opaque).
+    ///
+    /// ```
+    /// let c = posecov::scene::Color::rgb(1, 2, 3).with_alpha(128);
+    /// assert_eq!(c.0, [1, 2, 3, 128]);
+    /// ```
+    pub const fn with_alpha(self, a: u8) -> Self {
+        let [r, g, b, _] = self.0;
+        Self([r, g, b, a])
+    }
+}
+
+/// When an item is shown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Timing {
+    /// Always, on every timeline (fixed context: frames, descriptions, nominal paths).
+    Static,
+    /// From this value of the `step` sequence timeline on (until the same entity is logged
+    /// at a later step).
+    Step(i64),
+}
+
+/// How an ellipsoid is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FillMode {
+    /// Filled surface, no lines. Hides what is inside: use a low alpha.
+    Solid,
+    /// Three principal cross-section ellipses (light; clouds stay visible).
+    MajorWireframe,
+    /// A see-through wireframe mesh.
+    DenseWireframe,
+    /// A transparent fill with the principal ellipses on top.
+    TransparentFillMajorWireframe,
+}
+
+/// A coordinate frame drawn as an RGB (x, y, z) axis triad.
+///
+/// The sink logs it as a transform of its own entity, so nothing else may be placed
+/// *under* a frame's entity path ([`Scene::validate`] checks this).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Origin of the frame in the world.
+    pub translation: Vec3,
+    /// Orientation `world_from_frame`, `[x, y, z, w]`.
+    pub rotation: QuatXyzw,
+    /// Length of each axis, metres.
+    pub axis_length: f64,
+    /// Text drawn at the origin (e.g. `"T_MC"`), if any.
+    pub label: Option<String>,
+}
+
+/// Many small RGB axis triads on one entity (e.g. a subsample of Monte-Carlo poses).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Triads {
+    /// Origins, one per triad.
+    pub translations: Vec<Vec3>,
+    /// Orientations `world_from_sample`, `[x, y, z, w]`, one per triad.
+    pub rotations: Vec<QuatXyzw>,
+    /// Length of each axis, metres.
+    pub axis_length: f64,
+    /// Line radius, metres (a few percent of `axis_length` reads well).
+    pub line_radius: f64,
+}
+
+/// A point cloud in one colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointCloud {
+    /// Point positions.
+    pub positions: Vec<Vec3>,
+    /// Colour of every point.
+    pub color: Color,
+    /// Radius of every point, metres.
+    pub radius: f64,
+}
+
+/// One ellipsoid: `{ centre + R · diag(half_sizes) · u : ‖u‖ = 1 }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ellipsoid {
+    /// Centre in the world.
+    pub center: Vec3,
+    /// Semi-axis lengths along the rotated x, y, z axes (k·√λᵢ for a covariance).
+    pub half_sizes: Vec3,
+    /// Rotation `world_from_principal`, `[x, y, z, w]` (columns = eigenvectors).
+    pub rotation: QuatXyzw,
+}
+
+/// A batch of ellipsoids sharing colour and style (e.g. one per pose along a path).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ellipsoids {
+    /// The ellipsoids.
+    pub shapes: Vec<Ellipsoid>,
+    /// Colour (alpha matters for [`FillMode::Solid`] and the transparent fill).
+    pub color: Color,
+    /// Drawing style; always sent explicitly (Rerun's default changed in 0.31).
+    pub fill: FillMode,
+    /// Radius of wireframe lines, metres.
+    pub line_radius: f64,
+    /// Label shown at each ellipsoid, if any (e.g. `"95 %"`).
+    pub label: Option<String>,
+}
+
+/// A triangle mesh (e.g. the Exp-image "banana" of a tangent-space ellipsoid).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surface {
+    /// Vertex positions.
+    pub vertices: Vec<Vec3>,
+    /// Triangles as indices into `vertices`, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+    /// Unit vertex normals (same length as `vertices`), or empty to let the viewer compute.
+    pub normals: Vec<Vec3>,
+    /// Colour; alpha < 255 draws a translucent surface (no order-independent transparency:
+    /// keep surfaces few and light).
+    pub color: Color,
+}
+
+/// Polylines in one colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LineStrips {
+    /// Each strip is a polyline through its points.
+    pub strips: Vec<Vec<Vec3>>,
+    /// Colour of every strip.
+    pub color: Color,
+    /// Line radius, metres.
+    pub radius: f64,
+}
+
+/// Arrows `origin → origin + vector` in one colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Arrows {
+    /// Tails.
+    pub origins: Vec<Vec3>,
+    /// Tail-to-head vectors, one per origin.
+    pub vectors: Vec<Vec3>,
+    /// Colour of every arrow.
+    pub color: Color,
+    /// Shaft radius, metres.
+    pub radius: f64,
+}
+
+/// What an item draws.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ItemKind {
+    /// A coordinate frame (axis triad).
+    Frame(Frame),
+    /// A batch of small axis triads.
+    Triads(Triads),
+    /// A point cloud.
+    Points(PointCloud),
+    /// A batch of ellipsoids.
+    Ellipsoids(Ellipsoids),
+    /// A triangle mesh.
+    Surface(Surface),
+    /// Polylines.
+    LineStrips(LineStrips),
+    /// Arrows.
+    Arrows(Arrows),
+    /// A markdown document (shown in a text view, not in 3-D).
+    Text(String),
+}
+
+/// One drawable thing at one entity path and one time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneItem {
+    /// Entity path, `/`-separated; segments use `[A-Za-z0-9_.-]`.
+    pub path: String,
+    /// Static, or at a `step`.
+    pub timing: Timing,
+    /// What to draw.
+    pub kind: ItemKind,
+}
+
+impl SceneItem {
+    /// An item at `path`.
+    ///
+    /// ```
+    /// use posecov::scene::{ItemKind, SceneItem, Timing};
+    /// let item = SceneItem::new("description/extra", Timing::Step(3), ItemKind::Text("hi".into()));
+    /// assert_eq!(item.timing, Timing::Step(3));
+    /// ```
+    pub fn new(path: impl Into<String>, timing: Timing, kind: ItemKind) -> Self {
+        Self {
+            path: path.into(),
+            timing,
+            kind,
+        }
+    }
+}
+
+/// A named scalar time series (one line in the plot), e.g. the trace of a method's covariance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScalarSeries {
+    /// Entity path under [`PLOTS`], e.g. `plots/trace/first_order`.
+    pub path: String,
+    /// Legend name, e.g. `"first order"`.
+    pub name: String,
+    /// Line colour (use the method's [`Method::color`]).
+    pub color: Color,
+    /// Line width in UI points.
+    pub width: f64,
+    /// `(step, value)` samples.
+    pub points: Vec<(i64, f64)>,
+}
+
+/// Everything one scenario draws.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Scene {
+    /// Short title (also the recording name).
+    pub title: String,
+    /// Markdown shown in the text panel: what is drawn, conventions, formulas, measured errors.
+    pub description_markdown: String,
+    /// Drawables, logged in order (static ones first, then by step; stable within a step).
+    pub items: Vec<SceneItem>,
+    /// Plot lines.
+    pub series: Vec<ScalarSeries>,
+}
+
+impl Scene {
+    /// An empty scene with a title and a description.
+    ///
+    /// ```
+    /// let scene = posecov::scene::Scene::new("t", "**d**");
+    /// assert!(scene.items.is_empty());
+    /// ```
+    pub fn new(title: impl Into<String>, description_markdown: impl Into<String>) -> Self {
+        Self {
+            title: title.into(),
+            description_markdown: description_markdown.into(),
+            items: Vec::new(),
+            series: Vec::new(),
+        }
+    }
+
+    /// Appends an item.
+    pub fn push(&mut self, item: SceneItem) {
+        self.items.push(item);
+    }
+
+    /// The distinct steps used by items and series, ascending (empty for a static scene).
+    ///
+    /// ```
+    /// use posecov::scene::{ItemKind, Scene, SceneItem, Timing};
+    /// let mut scene = Scene::new("t", "");
+    /// for k in [3, 1, 3] {
+    ///     scene.push(SceneItem::new("description/k", Timing::Step(k), ItemKind::Text(String::new())));
+    /// }
+    /// assert_eq!(scene.steps(), vec![1, 3]);
+    /// ```
+    pub fn steps(&self) -> Vec<i64> {
+        let mut steps: Vec<i64> = self
+            .items
+            .iter()
+            .filter_map(|item| match item.timing {
+                Timing::Static => None,
+                Timing::Step(k) => Some(k),
+            })
+            .chain(
+                self.series
+                    .iter()
+                    .flat_map(|s| s.points.iter().map(|p| p.0)),
+            )
+            .collect();
+        steps.sort_unstable();
+        steps.dedup();
+        steps
+    }
+
+    /// Items in logging order: static items first, then ascending step; insertion order is
+    /// kept within each group (so the output is deterministic).
+    pub fn items_in_log_order(&self) -> Vec<&SceneItem> {
+        let mut items: Vec<&SceneItem> = self.items.iter().collect();
+        items.sort_by_key(|item| match item.timing {
+            Timing::Static => (0, 0),
+            Timing::Step(k) => (1, k),
+        });
+        items
+    }
+}
+
+pub use validate::SceneError;

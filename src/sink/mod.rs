@@ -1,0 +1,141 @@
+//! Sinks: where a [`Scene`](crate::scene::Scene) goes. Only this module knows Rerun.
+//!
+//! - [`rerun`]: scene → Rerun 0.36 archetypes (batched, one entity per item) and the default
+//!   layout ([`default_blueprint`]).
+//! - [`stream`]: opening a [`Sink`] (viewer, file, stdout, web viewer, memory) with
+//!   deterministic content, and finishing it cleanly ([`SinkGuard::finish`]).
+//! - [`viewer`]: finding a native `rerun` 0.36 viewer and rendering PNGs with it.
+//!
+//! # Deterministic content
+//! For a given scene, every run writes the same *content*: the recording id is derived from
+//! the scenario name and seed ([`RecordingIds::for_scenario`]), no wall-clock time is logged,
+//! recording properties (start time) are not sent, and every item becomes exactly one chunk
+//! sent in a fixed order (so chunking cannot depend on timing). Row and chunk ids and the
+//! blueprint's ids still differ between runs — compare with `rerun rrd compare`, or decode
+//! and compare the chunks as `tests/sink.rs` does.
+//!
+//! # Example
+//! ```
+//! use posecov::scene::demo_scene;
+//! use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
+//! let bytes = scene_to_rrd_bytes(&demo_scene(1), &RecordingIds::for_scenario("demo", 1))?;
+//! assert!(bytes.len() > 1000);
+//! # Ok::<(), posecov::sink::SinkError>(())
+//! ```
+
+pub mod rerun;
+pub mod stream;
+pub mod viewer;
+
+use std::path::PathBuf;
+
+pub use self::rerun::{
+    LogOutcome, STEP_TIMELINE, default_blueprint, log_scene, log_scene_cancellable,
+};
+pub use self::stream::{SinkGuard, open_stream, scene_to_rrd_bytes};
+pub use self::viewer::{NativeViewer, find_native_viewer, render_png};
+
+/// Application id of every posecov recording (the viewer groups recordings by it).
+pub const APPLICATION_ID: &str = "posecov";
+
+/// Where a recording goes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Sink {
+    /// Write an .rrd file. Written to a temporary file next to it and renamed when complete.
+    Save(PathBuf),
+    /// Write .rrd bytes to stdout (for `| rerun -`).
+    Stdout,
+    /// Spawn a native `rerun` viewer from `PATH` (or `$POSECOV_RERUN`) and stream to it.
+    Spawn,
+    /// Stream to a running viewer or server, e.g. `rerun+http://127.0.0.1:9876/proxy`.
+    Connect(String),
+    /// Host a gRPC server and the embedded web viewer on 127.0.0.1.
+    Serve {
+        /// HTTP port of the web viewer (0 = any free port).
+        web_port: u16,
+        /// Port of the gRPC server the web viewer connects to.
+        grpc_port: u16,
+        /// Open the viewer URL in the default browser.
+        open_browser: bool,
+    },
+    /// Keep everything in memory (tests); read it with [`SinkGuard::take_bytes`].
+    Memory,
+}
+
+/// Identity of a recording: stable across runs so that two runs can be compared.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RecordingIds {
+    /// Recording id, fixed for a scenario and seed (the application id is always
+    /// [`APPLICATION_ID`]).
+    pub recording_id: String,
+}
+
+impl RecordingIds {
+    /// Ids for `scenario` run with `seed`: `posecov/<scenario>/seed-<seed>`.
+    ///
+    /// ```
+    /// let ids = posecov::sink::RecordingIds::for_scenario("se2_odometry", 7);
+    /// assert_eq!(ids.recording_id, "posecov/se2_odometry/seed-7");
+    /// ```
+    pub fn for_scenario(scenario: &str, seed: u64) -> Self {
+        Self {
+            recording_id: format!("{APPLICATION_ID}/{scenario}/seed-{seed}"),
+        }
+    }
+}
+
+/// What can go wrong on the way to a viewer or file.
+#[derive(Debug, thiserror::Error)]
+pub enum SinkError {
+    /// The scene failed [`Scene::validate`](crate::scene::Scene::validate).
+    #[error("invalid scene: {0}")]
+    Scene(#[from] crate::scene::SceneError),
+    /// The Rerun SDK refused (bad URL, spawn failure, serialization).
+    #[error("rerun: {0}")]
+    Rerun(#[from] ::rerun::RecordingStreamError),
+    /// A chunk could not be built (a bug: validation should have caught it).
+    #[error("building a rerun chunk for {path}: {message}")]
+    Chunk {
+        /// Entity path.
+        path: String,
+        /// The SDK's message.
+        message: String,
+    },
+    /// Flushing to the sink failed or timed out.
+    #[error("flushing the recording: {0}")]
+    Flush(String),
+    /// A file operation failed.
+    #[error("{action} {path}: {source}")]
+    Io {
+        /// What was being done ("creating", "renaming to", …).
+        action: &'static str,
+        /// Which file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The web viewer could not be served.
+    #[error("serving the web viewer: {0}")]
+    WebViewer(String),
+    /// No native viewer of the right version was found.
+    #[error(
+        "no rerun 0.36 viewer found{found}; install one with `pip install rerun-sdk==0.36.3` \
+         (or point $POSECOV_RERUN at a rerun 0.36 binary)"
+    )]
+    NoViewer {
+        /// What was found instead, e.g. " (PATH has rerun 0.24.1)", or empty.
+        found: String,
+    },
+    /// The headless viewer did not produce a screenshot.
+    #[error("rendering {png} with {viewer} failed ({status}): {stderr}")]
+    Screenshot {
+        /// Output file.
+        png: PathBuf,
+        /// Viewer binary.
+        viewer: PathBuf,
+        /// Exit status.
+        status: String,
+        /// The tail of its stderr.
+        stderr: String,
+    },
+}

@@ -1,0 +1,334 @@
+//! Scene → Rerun 0.36 archetypes, and the default layout.
+//!
+//! One item becomes one chunk on its own entity path (so each pose × method toggles on its
+//! own), with all its instances batched in one row: a cloud is one `Points3D`, a path of
+//! ellipsoids one `Ellipsoids3D`, a set of triads one `LineStrips3D`. This is also the only
+//! place where `f64` becomes `f32`.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use ::rerun as rr;
+use rr::AsComponents;
+use rr::blueprint::components::PanelState;
+use rr::blueprint::{
+    Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView, TextDocumentView,
+    TimePanel, TimeSeriesView, Vertical,
+};
+use rr::log::{Chunk, RowId};
+
+use super::SinkError;
+use crate::scene::{
+    self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, QuatXyzw,
+    ScalarSeries, Scene, SceneItem, Surface, Timing, Triads, Vec3,
+};
+
+/// Name of the sequence timeline that [`Timing::Step`] items are logged on.
+pub const STEP_TIMELINE: &str = "step";
+
+/// Whether [`log_scene_cancellable`] logged everything.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LogOutcome {
+    /// Every item and series was logged.
+    Complete,
+    /// The cancel flag was raised; everything before `next_step` (and all static items) was
+    /// logged, nothing from `next_step` on.
+    Cancelled {
+        /// First step that was *not* logged (`None`: cancelled among the static items).
+        next_step: Option<i64>,
+    },
+}
+
+/// Logs a validated scene to `rec` (see [`log_scene_cancellable`]).
+///
+/// # Errors
+/// [`SinkError::Scene`] if the scene is invalid (nothing is logged then), or an SDK error.
+pub fn log_scene(rec: &rr::RecordingStream, scene: &Scene) -> Result<(), SinkError> {
+    log_scene_cancellable(rec, scene, &AtomicBool::new(false)).map(|_| ())
+}
+
+/// Logs `scene` to `rec`: validates it first (so NaN never reaches the viewer), then the
+/// world's view coordinates (right-handed, z up) and the description (static), every static
+/// item, then the items of each step in ascending order, then the plot series. `cancel` is
+/// checked before every item: when it is raised, logging stops at a step boundary-or-item and
+/// the outcome says where (what was logged stays a consistent prefix).
+///
+/// # Errors
+/// [`SinkError::Scene`] if the scene is invalid (nothing is logged then), or an SDK error.
+pub fn log_scene_cancellable(
+    rec: &rr::RecordingStream,
+    scene: &Scene,
+    cancel: &AtomicBool,
+) -> Result<LogOutcome, SinkError> {
+    scene.validate()?;
+    rec.set_log_time_enabled(false);
+    rec.set_log_tick_enabled(false);
+    // The recording's name, sent like `send_recording_name` but as a chunk in sequence.
+    let name = rr::RecordingInfo::update_fields().with_name(scene.title.as_str());
+    send(rec, rr::EntityPath::properties(), Timing::Static, &[&name])?;
+    send(
+        rec,
+        scene::WORLD,
+        Timing::Static,
+        &[&rr::ViewCoordinates::RIGHT_HAND_Z_UP()],
+    )?;
+    send(
+        rec,
+        scene::DESCRIPTION,
+        Timing::Static,
+        &[&rr::TextDocument::from_markdown(
+            scene.description_markdown.as_str(),
+        )],
+    )?;
+    for item in scene.items_in_log_order() {
+        if cancel.load(Ordering::Relaxed) {
+            let next_step = match item.timing {
+                Timing::Static => None,
+                Timing::Step(k) => Some(k),
+            };
+            return Ok(LogOutcome::Cancelled { next_step });
+        }
+        log_item(rec, item)?;
+    }
+    for series in &scene.series {
+        log_series(rec, series)?;
+    }
+    Ok(LogOutcome::Complete)
+}
+
+/// The default layout: the 3-D view of `world` on the left (two thirds), the description
+/// above the plots of `plots` on the right; time panel collapsed to the essentials.
+///
+/// ```
+/// let _blueprint = posecov::sink::default_blueprint();
+/// ```
+pub fn default_blueprint() -> Blueprint {
+    let view3d = Spatial3DView::new("3D").with_origin(scene::WORLD);
+    let text = TextDocumentView::new("Description").with_origin(scene::DESCRIPTION);
+    let plots = TimeSeriesView::new("Per step").with_origin(scene::PLOTS);
+    let right = Vertical::new([text.into(), plots.into()]).with_row_shares([3.0, 2.0]);
+    Blueprint::new(Horizontal::new([view3d.into(), right.into()]).with_column_shares([2.0, 1.0]))
+        .with_auto_views(false)
+        .with_blueprint_panel(BlueprintPanel::from_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::from_state(PanelState::Collapsed))
+        .with_time_panel(
+            TimePanel::new()
+                .with_state(PanelState::Collapsed)
+                .with_timeline(STEP_TIMELINE),
+        )
+}
+
+/// Sends one row with all `parts` as one chunk: no log time, no batcher, fixed order.
+fn send(
+    rec: &rr::RecordingStream,
+    path: impl Into<rr::EntityPath>,
+    timing: Timing,
+    parts: &[&dyn AsComponents],
+) -> Result<(), SinkError> {
+    let timepoint = match timing {
+        Timing::Static => rr::TimePoint::default(),
+        Timing::Step(k) => {
+            rr::TimePoint::default().with(rr::Timeline::new_sequence(STEP_TIMELINE), k)
+        }
+    };
+    let path = path.into();
+    let batches = parts.iter().flat_map(|p| p.as_serialized_batches());
+    let chunk = Chunk::builder(path.clone())
+        .with_serialized_batches(RowId::new(), timepoint, batches)
+        .build()
+        .map_err(|err| SinkError::Chunk {
+            path: path.to_string(),
+            message: err.to_string(),
+        })?;
+    rec.send_chunk(chunk);
+    Ok(())
+}
+
+fn log_item(rec: &rr::RecordingStream, item: &SceneItem) -> Result<(), SinkError> {
+    let (path, at) = (item.path.as_str(), item.timing);
+    match &item.kind {
+        ItemKind::Frame(frame) => log_frame(rec, path, at, frame),
+        ItemKind::Triads(triads) => send(rec, path, at, &[&triad_strips(triads)]),
+        ItemKind::Points(cloud) => send(rec, path, at, &[&points(cloud)]),
+        ItemKind::Ellipsoids(e) => send(rec, path, at, &[&ellipsoids(e)]),
+        ItemKind::Surface(surface) => send(rec, path, at, &[&mesh(surface)]),
+        ItemKind::LineStrips(strips) => send(rec, path, at, &[&line_strips(strips)]),
+        ItemKind::Arrows(arrows) => send(rec, path, at, &[&arrows3d(arrows)]),
+        ItemKind::Text(markdown) => send(
+            rec,
+            path,
+            at,
+            &[&rr::TextDocument::from_markdown(markdown.as_str())],
+        ),
+    }
+}
+
+/// A frame is a transform of its own entity plus its axes; the label is a tiny point at the
+/// frame's origin (in the frame's coordinates, hence `[0, 0, 0]`).
+fn log_frame(
+    rec: &rr::RecordingStream,
+    path: &str,
+    at: Timing,
+    frame: &Frame,
+) -> Result<(), SinkError> {
+    let transform =
+        rr::Transform3D::from_translation_rotation(v3(&frame.translation), quat(&frame.rotation));
+    let axes = rr::TransformAxes3D::new(f(frame.axis_length));
+    match &frame.label {
+        None => send(rec, path, at, &[&transform, &axes]),
+        Some(label) => {
+            let marker = rr::Points3D::new([[0.0f32; 3]])
+                .with_radii([f(0.04 * frame.axis_length)])
+                .with_colors([color(Color::rgb(128, 128, 128))])
+                .with_labels([label.as_str()])
+                .with_show_labels(true);
+            send(rec, path, at, &[&transform, &axes, &marker])
+        }
+    }
+}
+
+/// N triads as 3N two-point strips coloured x red, y green, z blue.
+fn triad_strips(triads: &Triads) -> rr::LineStrips3D {
+    const AXIS_COLORS: [Color; 3] = [
+        Color::rgb(230, 60, 60),
+        Color::rgb(60, 200, 60),
+        Color::rgb(70, 110, 255),
+    ];
+    let mut strips = Vec::with_capacity(3 * triads.translations.len());
+    let mut colors = Vec::with_capacity(strips.capacity());
+    for (t, q) in triads.translations.iter().zip(&triads.rotations) {
+        for (axis, c) in AXIS_COLORS.iter().enumerate() {
+            let mut unit = [0.0; 3];
+            unit[axis] = triads.axis_length;
+            let tip = rotate(q, unit);
+            strips.push([v3(t), v3(&[t[0] + tip[0], t[1] + tip[1], t[2] + tip[2]])]);
+            colors.push(color(*c));
+        }
+    }
+    rr::LineStrips3D::new(strips)
+        .with_colors(colors)
+        .with_radii([f(triads.line_radius)])
+}
+
+fn points(cloud: &PointCloud) -> rr::Points3D {
+    rr::Points3D::new(cloud.positions.iter().map(v3))
+        .with_colors([color(cloud.color)])
+        .with_radii([f(cloud.radius)])
+}
+
+fn ellipsoids(e: &Ellipsoids) -> rr::Ellipsoids3D {
+    let fill = match e.fill {
+        FillMode::Solid => rr::FillMode::Solid,
+        FillMode::MajorWireframe => rr::FillMode::MajorWireframe,
+        FillMode::DenseWireframe => rr::FillMode::DenseWireframe,
+        FillMode::TransparentFillMajorWireframe => rr::FillMode::TransparentFillMajorWireframe,
+    };
+    let archetype = rr::Ellipsoids3D::from_centers_and_half_sizes(
+        e.shapes.iter().map(|s| v3(&s.center)),
+        e.shapes.iter().map(|s| v3(&s.half_sizes)),
+    )
+    .with_quaternions(e.shapes.iter().map(|s| quat(&s.rotation)))
+    .with_colors([color(e.color)])
+    .with_fill_mode(fill)
+    .with_line_radii([f(e.line_radius)]);
+    match &e.label {
+        Some(label) => archetype.with_labels([label.as_str()]),
+        None => archetype,
+    }
+}
+
+fn mesh(surface: &Surface) -> rr::Mesh3D {
+    let archetype = rr::Mesh3D::new(surface.vertices.iter().map(v3))
+        .with_triangle_indices(
+            surface
+                .triangles
+                .iter()
+                .map(|t| rr::TriangleIndices::from(*t)),
+        )
+        .with_albedo_factor(color(surface.color).0);
+    if surface.normals.is_empty() {
+        archetype
+    } else {
+        archetype.with_vertex_normals(surface.normals.iter().map(v3))
+    }
+}
+
+fn line_strips(strips: &LineStrips) -> rr::LineStrips3D {
+    rr::LineStrips3D::new(
+        strips
+            .strips
+            .iter()
+            .map(|s| s.iter().map(v3).collect::<Vec<_>>()),
+    )
+    .with_colors([color(strips.color)])
+    .with_radii([f(strips.radius)])
+}
+
+fn arrows3d(arrows: &Arrows) -> rr::Arrows3D {
+    rr::Arrows3D::from_vectors(arrows.vectors.iter().map(v3))
+        .with_origins(arrows.origins.iter().map(v3))
+        .with_colors([color(arrows.color)])
+        .with_radii([f(arrows.radius)])
+}
+
+/// Series style (static, once) and all samples in one column chunk.
+fn log_series(rec: &rr::RecordingStream, series: &ScalarSeries) -> Result<(), SinkError> {
+    let style = rr::SeriesLines::new()
+        .with_names([series.name.as_str()])
+        .with_colors([color(series.color)])
+        .with_widths([f(series.width)]);
+    send(rec, series.path.as_str(), Timing::Static, &[&style])?;
+    if series.points.is_empty() {
+        return Ok(());
+    }
+    let steps = rr::TimeColumn::new_sequence(STEP_TIMELINE, series.points.iter().map(|p| p.0));
+    let values = rr::Scalars::new(series.points.iter().map(|p| p.1))
+        .columns_of_unit_batches()
+        .map_err(rr::RecordingStreamError::from)?;
+    rec.send_columns(series.path.as_str(), [steps], values)?;
+    Ok(())
+}
+
+/// `f64 → f32` at the rendering boundary (validated values fit).
+fn f(x: f64) -> f32 {
+    x as f32
+}
+
+fn v3(v: &Vec3) -> [f32; 3] {
+    v.map(f)
+}
+
+fn quat(q: &QuatXyzw) -> rr::Quaternion {
+    rr::Quaternion::from_xyzw(q.map(f))
+}
+
+fn color(c: Color) -> rr::Color {
+    let [r, g, b, a] = c.0;
+    rr::Color::from_unmultiplied_rgba(r, g, b, a)
+}
+
+/// Rotates `v` by the unit quaternion `q` = `[x, y, z, w]`: v + 2w(u×v) + 2u×(u×v).
+fn rotate(q: &QuatXyzw, v: Vec3) -> Vec3 {
+    let (u, w) = ([q[0], q[1], q[2]], q[3]);
+    let cross = |a: Vec3, b: Vec3| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let uv = cross(u, v);
+    let uuv = cross(u, uv);
+    [0, 1, 2].map(|i| v[i] + 2.0 * (w * uv[i] + uuv[i]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotate_matches_a_quarter_turn_about_z() {
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        let r = rotate(&[0.0, 0.0, s, s], [1.0, 0.0, 0.0]);
+        assert!((r[0]).abs() < 1e-12 && (r[1] - 1.0).abs() < 1e-12 && r[2].abs() < 1e-12);
+    }
+}
