@@ -23,8 +23,8 @@ use crate::lie::{LieGroup, Se3, Tangent, TangentMatrix};
 use crate::scenario::SpecGroup;
 use crate::scenario::model::{AnyEvaluation, Evaluation, Node, Role};
 use crate::scene::{
-    self, Arrows, Color, Ellipsoid, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, ScalarSeries, Scene,
-    SceneItem, Surface, Timing, Triads, Vec3,
+    self, Arrows, Color, Ellipsoid, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud,
+    ScalarSeries, Scene, SceneItem, Surface, Timing, Triads, Vec3,
 };
 use crate::uncertain::{Method, Side, UncertainPose};
 
@@ -37,13 +37,30 @@ const MAX_PARTICLE_STEPS: u64 = 20;
 /// How many Monte Carlo particles get a small axis triad.
 const TRIAD_SUBSAMPLE: usize = 60;
 
+/// Evaluates a scenario and builds its scene: the whole pure data path in one call.
+///
+/// ```
+/// use posecov::scenario::{Scenario, eval::EvalOptions};
+/// let s = Scenario::load_any("camera_on_robot").unwrap();
+/// let options = EvalOptions { samples: Some(50), ..Default::default() };
+/// assert!(posecov::draw::scene_of(&s, &options).unwrap().validate().is_ok());
+/// ```
+pub fn scene_of(
+    scenario: &crate::scenario::Scenario,
+    options: &crate::scenario::eval::EvalOptions,
+) -> Result<Scene, crate::scenario::ScenarioError> {
+    Ok(build_scene(&crate::scenario::eval::evaluate(
+        scenario, options,
+    )?))
+}
+
 /// Builds the scene of an evaluated scenario.
 ///
 /// ```
 /// use posecov::scenario::{Scenario, eval::{evaluate, EvalOptions}};
 /// let s = Scenario::parse("[scenario]\ntitle='t'\ngroup='se2'\nmethods=['first_order']\n[[pose]]\nname='a'\nmean={xy_theta=[1,2,0]}\ncov={std=[0.1,0.1,0.3]}\n", "t.toml").unwrap();
 /// let scene = posecov::draw::build_scene(&evaluate(&s, &EvalOptions::default()).unwrap());
-/// assert!(scene.items.iter().any(|i| i.path == "world/a/first_order/banana"));
+/// assert!(scene.items.iter().any(|i| i.path == "world/a/given/banana"));
 /// assert!(scene.validate().is_ok());
 /// ```
 pub fn build_scene(evaluation: &AnyEvaluation) -> Scene {
@@ -52,50 +69,6 @@ pub fn build_scene(evaluation: &AnyEvaluation) -> Scene {
         AnyEvaluation::Se2(e) => build(e),
         AnyEvaluation::So3(e) => build(e),
         AnyEvaluation::Se3(e) => build(e),
-    }
-}
-
-/// The entity-path segment of a method: its serde name (`first_order`, `monte_carlo`, …).
-///
-/// ```
-/// assert_eq!(posecov::draw::method_segment(posecov::uncertain::Method::MonteCarlo), "monte_carlo");
-/// ```
-pub fn method_segment(method: Method) -> String {
-    serde_json::to_value(method)
-        .ok()
-        .and_then(|v| v.as_str().map(str::to_owned))
-        .unwrap_or_else(|| format!("{method:?}"))
-}
-
-/// The colour of a method (Okabe–Ito palette, shared with plots and legends).
-///
-/// ```
-/// use posecov::{draw::method_color, uncertain::Method};
-/// assert_ne!(method_color(Method::FirstOrder), method_color(Method::MonteCarlo));
-/// ```
-pub fn method_color(method: Method) -> Color {
-    palette_method(method).color()
-}
-
-/// The colour's name, for the text panel.
-///
-/// ```
-/// use posecov::{draw::method_color_name, uncertain::Method};
-/// assert_eq!(method_color_name(Method::MonteCarlo), "grey");
-/// ```
-pub fn method_color_name(method: Method) -> &'static str {
-    palette_method(method).color_name()
-}
-
-fn palette_method(method: Method) -> scene::Method {
-    match method {
-        Method::FirstOrder | Method::Exact | Method::ClosedForm => scene::Method::FirstOrder,
-        Method::SecondOrder | Method::NumericIntegral => scene::Method::SecondOrder,
-        Method::FourthOrder => scene::Method::FourthOrder,
-        Method::SigmaPoints => scene::Method::SigmaPoints,
-        Method::MonteCarlo => scene::Method::MonteCarlo,
-        Method::VectorSpace => scene::Method::VectorSpace,
-        Method::LectureNoJr => scene::Method::LectureFaithful,
     }
 }
 
@@ -128,7 +101,9 @@ fn principal_axes<const N: usize>(cov: &TangentMatrix<N>) -> (Vec<f64>, Vec<Tang
 
 /// The first-order world-frame position covariance of an uncertain pose (SE(2): 3×3 with a
 /// zero z row). From the right form: t(μ Exp(ε)) ≈ t + R ρ, so Σ_p = R Σ_ρρ Rᵀ.
-fn position_cov_world<G: SpecGroup<N>, const N: usize>(pose: &UncertainPose<G, N>) -> Option<Matrix3<f64>> {
+fn position_cov_world<G: SpecGroup<N>, const N: usize>(
+    pose: &UncertainPose<G, N>,
+) -> Option<Matrix3<f64>> {
     let rot = G::rotation_range();
     if rot.start == 0 {
         return None; // a rotation group has no position
@@ -153,7 +128,11 @@ fn ellipsoid_of(center: &Vector3<f64>, cov: &Matrix3<f64>, radius: f64) -> Ellip
     if axes.determinant() < 0.0 {
         axes.set_column(2, &(-axes.column(2)));
     }
-    let half: Vec<f64> = eig.eigenvalues.iter().map(|l| radius * l.max(0.0).sqrt()).collect();
+    let half: Vec<f64> = eig
+        .eigenvalues
+        .iter()
+        .map(|l| radius * l.max(0.0).sqrt())
+        .collect();
     let floor = half.iter().copied().fold(0.0, f64::max) * 0.01;
     let rotation = nalgebra::UnitQuaternion::from_matrix(&axes);
     Ellipsoid {
@@ -187,7 +166,11 @@ impl Painter {
 fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
     let rotation_group = G::rotation_range().start == 0;
     let extent = scene_extent(e);
-    let axis_length = e.meta.draw.axis_length.unwrap_or(if rotation_group { 1.0 } else { (0.12 * extent).clamp(0.05, 2.0) });
+    let axis_length = e.meta.draw.axis_length.unwrap_or(if rotation_group {
+        1.0
+    } else {
+        (0.12 * extent).clamp(0.05, 2.0)
+    });
     let last_step = e.nodes.iter().filter_map(|n| n.step).max().unwrap_or(0);
     let mut p = Painter {
         scene: Scene::new(e.meta.title.clone(), description(e)),
@@ -201,12 +184,20 @@ fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
     }
     if e.meta.draw.trajectories {
         for path in &e.paths {
-            let strip: Vec<Vec3> = path.poses.iter().map(|x| v3(x.to_se3().translation())).collect();
-            let color = path.method.map_or(Color::rgb(255, 255, 255), method_color);
+            let strip: Vec<Vec3> = path
+                .poses
+                .iter()
+                .map(|x| v3(x.to_se3().translation()))
+                .collect();
+            let color = path.method.map_or(scene::NOMINAL, Method::color);
             p.push(
                 format!("world/{}", path.name),
                 None,
-                ItemKind::LineStrips(LineStrips { strips: vec![strip], color, radius: 0.004 * extent.max(0.25) }),
+                ItemKind::LineStrips(LineStrips {
+                    strips: vec![strip],
+                    color,
+                    radius: 0.004 * extent.max(0.25),
+                }),
             );
         }
     }
@@ -215,11 +206,11 @@ fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
             let cov = Matrix3::from_fn(|r, c| cov[r][c]);
             let shape = ellipsoid_of(&Vector3::from(*mean), &cov, chi2_radius(p.confidence, 3));
             p.push(
-                format!("world/{}/{}/ellipsoid", point.name, method_segment(*method)),
+                format!("world/{}/{}/ellipsoid", point.name, Method::slug(*method)),
                 None,
                 ItemKind::Ellipsoids(Ellipsoids {
                     shapes: vec![shape],
-                    color: method_color(*method),
+                    color: Method::color(*method),
                     fill: FillMode::MajorWireframe,
                     line_radius: 0.003,
                     label: None,
@@ -230,18 +221,36 @@ fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
             p.push(
                 format!("world/{}/monte_carlo/cloud", point.name),
                 None,
-                ItemKind::Points(PointCloud { positions: particles.clone(), color: cloud_color(), radius: 0.01 }),
+                ItemKind::Points(PointCloud {
+                    positions: particles.clone(),
+                    color: cloud_color(),
+                    radius: 0.01,
+                }),
             );
         }
     }
-    for frame in &e.matrix_frames {
-        let colors = [Color::rgb(255, 90, 90), Color::rgb(90, 220, 90), Color::rgb(100, 140, 255)];
+    let drawn: Vec<_> = e
+        .matrix_frames
+        .iter()
+        .filter(|f| p.particles_at(f.step))
+        .collect();
+    for frame in drawn {
+        let colors = [
+            Color::rgb(255, 90, 90),
+            Color::rgb(90, 220, 90),
+            Color::rgb(100, 140, 255),
+        ];
         for (k, color) in colors.iter().enumerate() {
             let c = frame.columns.column(k);
             p.push(
                 format!("world/{}/axis_{}", frame.name, ["x", "y", "z"][k]),
                 frame.step,
-                ItemKind::Arrows(Arrows { origins: vec![frame.origin], vectors: vec![[c[0], c[1], c[2]]], color: *color, radius: 0.01 }),
+                ItemKind::Arrows(Arrows {
+                    origins: vec![frame.origin],
+                    vectors: vec![[c[0], c[1], c[2]]],
+                    color: *color,
+                    radius: 0.01,
+                }),
             );
         }
     }
@@ -250,8 +259,8 @@ fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
         let n = by_quantity.len();
         let plot = *by_quantity.entry(&s.quantity).or_insert(n);
         let (segment, color) = match s.method {
-            Some(m) => (method_segment(m), method_color(m)),
-            None => (slug(&s.label), Color::rgb(255, 255, 255)),
+            Some(m) => (m.slug().to_owned(), m.color()),
+            None => (slug(&s.label), scene::NOMINAL),
         };
         p.scene.series.push(ScalarSeries {
             path: format!("{}/{plot}_{}/{segment}", scene::PLOTS, slug(&s.quantity)),
@@ -265,13 +274,19 @@ fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
 }
 
 fn cloud_color() -> Color {
-    method_color(Method::MonteCarlo).with_alpha(150)
+    Method::color(Method::MonteCarlo).with_alpha(150)
 }
 
 fn slug(s: &str) -> String {
     let mut out: String = s
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
         .collect();
     while out.contains("__") {
         out = out.replace("__", "_");
@@ -286,17 +301,29 @@ fn scene_extent<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> f64 {
         .nodes
         .iter()
         .map(|n| *n.nominal.to_se3().translation())
-        .chain(e.paths.iter().flat_map(|p| p.poses.iter().map(|x| *x.to_se3().translation())))
+        .chain(
+            e.paths
+                .iter()
+                .flat_map(|p| p.poses.iter().map(|x| *x.to_se3().translation())),
+        )
         .collect();
     if points.is_empty() {
         return 1.0;
     }
     let centroid = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
-    let extent = points.iter().map(|p| (p - centroid).norm()).fold(0.0, f64::max);
+    let extent = points
+        .iter()
+        .map(|p| (p - centroid).norm())
+        .fold(0.0, f64::max);
     if extent > 0.0 { extent } else { 1.0 }
 }
 
-fn draw_node<G: SpecGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>, rotation_group: bool, e: &Evaluation<G, N>) {
+fn draw_node<G: SpecGroup<N>, const N: usize>(
+    p: &mut Painter,
+    node: &Node<G, N>,
+    rotation_group: bool,
+    e: &Evaluation<G, N>,
+) {
     let draw = &e.meta.draw;
     let pose3 = node.nominal.to_se3();
     if draw.axes {
@@ -315,6 +342,11 @@ fn draw_node<G: SpecGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>
     if node.role == Role::Fixed {
         return;
     }
+    if !p.particles_at(node.step) && node.step != Some(0) {
+        // Between drawn steps only the (light) frame and ellipsoids are logged.
+        draw_ellipsoids_only(p, node, rotation_group, draw);
+        return;
+    }
     let primary = primary_method(node);
     for estimate in &node.estimates {
         let pose = estimate.result.pose;
@@ -323,37 +355,59 @@ fn draw_node<G: SpecGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>
             continue; // the cloud itself shows Monte Carlo
         }
         let is_primary = Some(method) == primary;
-        let base = format!("world/{}/{}", node.name, method_segment(method));
-        let color = method_color(method);
+        // An input's own Gaussian is "given", not computed by a method.
+        let segment = if node.role == Role::Input && method == Method::Exact {
+            "given"
+        } else {
+            method.slug()
+        };
+        let base = format!("world/{}/{segment}", node.name);
+        let color = Method::color(method);
         // The Cartesian ellipsoid: the primary method's (to contrast with its banana) and the
         // vector-space baseline's (a Gaussian in (x, y, θ) is exactly that ellipse).
         let ellipsoid = is_primary || method == Method::VectorSpace;
-        if !rotation_group && draw.ellipsoids && ellipsoid {
-            if let Some(cov) = position_cov_world(&pose) {
-                let d = if G::rotation_range().start == 2 { 2 } else { 3 };
-                let shape = ellipsoid_of(pose.mean().to_se3().translation(), &cov, chi2_radius(p.confidence, d));
-                p.push(
-                    format!("{base}/ellipsoid"),
-                    node.step,
-                    ItemKind::Ellipsoids(Ellipsoids {
-                        shapes: vec![shape],
-                        color,
-                        fill: FillMode::MajorWireframe,
-                        line_radius: 0.002 * p.axis_length / 0.15,
-                        label: None,
-                    }),
-                );
-            }
+        if !rotation_group
+            && draw.ellipsoids
+            && ellipsoid
+            && let Some(cov) = position_cov_world(&pose)
+        {
+            let d = if G::rotation_range().start == 2 { 2 } else { 3 };
+            let shape = ellipsoid_of(
+                pose.mean().to_se3().translation(),
+                &cov,
+                chi2_radius(p.confidence, d),
+            );
+            p.push(
+                format!("{base}/ellipsoid"),
+                node.step,
+                ItemKind::Ellipsoids(Ellipsoids {
+                    shapes: vec![shape],
+                    color,
+                    fill: FillMode::MajorWireframe,
+                    line_radius: 0.002 * p.axis_length / 0.15,
+                    label: None,
+                }),
+            );
         }
         if draw.bananas && !rotation_group && method != Method::VectorSpace {
             let point_of = |x: &G| *x.to_se3().translation();
             if is_primary {
                 banana(p, &base, node.step, &pose, color, point_of);
             } else {
-                outlines(p, &format!("{base}/banana_outline"), node.step, &pose, color, point_of);
+                outlines(
+                    p,
+                    &format!("{base}/banana_outline"),
+                    node.step,
+                    &pose,
+                    color,
+                    point_of,
+                );
             }
         }
-        if draw.orientation && (rotation_group || (N == 6 && is_primary)) && method != Method::VectorSpace {
+        if draw.orientation
+            && (rotation_group || (N == 6 && is_primary))
+            && method != Method::VectorSpace
+        {
             for (k, axis) in ["axis_x", "axis_y", "axis_z"].iter().enumerate() {
                 let len = p.axis_length;
                 let path = format!("{base}/{axis}");
@@ -364,8 +418,49 @@ fn draw_node<G: SpecGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>
             }
         }
     }
-    if let Some(particles) = node.particles.as_ref().filter(|_| p.particles_at(node.step)) {
+    if let Some(particles) = node
+        .particles
+        .as_ref()
+        .filter(|_| p.particles_at(node.step))
+    {
         draw_particles(p, node, particles, rotation_group, draw);
+    }
+}
+
+/// On steps between the drawn ones: the primary method's Cartesian ellipsoid only, so the
+/// step slider still shows the growth without logging a surface per step.
+fn draw_ellipsoids_only<G: SpecGroup<N>, const N: usize>(
+    p: &mut Painter,
+    node: &Node<G, N>,
+    rotation_group: bool,
+    draw: &crate::scenario::schema::DrawSpec,
+) {
+    let Some(primary) = primary_method(node) else {
+        return;
+    };
+    if rotation_group || !draw.ellipsoids {
+        return;
+    }
+    for e in node.estimates.iter().filter(|e| e.result.method == primary) {
+        if let Some(cov) = position_cov_world(&e.result.pose) {
+            let d = if G::rotation_range().start == 2 { 2 } else { 3 };
+            let shape = ellipsoid_of(
+                e.result.pose.mean().to_se3().translation(),
+                &cov,
+                chi2_radius(p.confidence, d),
+            );
+            p.push(
+                format!("world/{}/{}/ellipsoid", node.name, primary.slug()),
+                node.step,
+                ItemKind::Ellipsoids(Ellipsoids {
+                    shapes: vec![shape],
+                    color: primary.color(),
+                    fill: FillMode::MajorWireframe,
+                    line_radius: 0.002 * p.axis_length / 0.15,
+                    label: None,
+                }),
+            );
+        }
     }
 }
 
@@ -393,9 +488,22 @@ fn banana<G: SpecGroup<N>, const N: usize>(
         .iter()
         .map(|u| v3(&point_of(&frame.apply(pose, [u[0], u[1], u[2]]))))
         .collect();
-    let surface = Surface { vertices, triangles, normals: Vec::new(), color: color.with_alpha(70) }.with_computed_normals();
+    let surface = Surface {
+        vertices,
+        triangles,
+        normals: Vec::new(),
+        color: color.with_alpha(70),
+    }
+    .with_computed_normals();
     p.push(format!("{base}/banana"), step, ItemKind::Surface(surface));
-    outlines(p, &format!("{base}/banana_outline"), step, pose, color, point_of);
+    outlines(
+        p,
+        &format!("{base}/banana_outline"),
+        step,
+        pose,
+        color,
+        point_of,
+    );
 }
 
 /// Images of the three principal great circles of the tangent ellipsoid.
@@ -425,7 +533,11 @@ fn outlines<G: SpecGroup<N>, const N: usize>(
     p.push(
         path.to_owned(),
         step,
-        ItemKind::LineStrips(LineStrips { strips, color, radius: 0.0015 * p.axis_length / 0.15 }),
+        ItemKind::LineStrips(LineStrips {
+            strips,
+            color,
+            radius: 0.0015 * p.axis_length / 0.15,
+        }),
     );
 }
 
@@ -434,14 +546,19 @@ struct PrincipalFrame<const N: usize> {
     columns: [Tangent<N>; 3],
 }
 
-fn principal_frame<G: SpecGroup<N>, const N: usize>(pose: &UncertainPose<G, N>, confidence: f64) -> PrincipalFrame<N> {
+fn principal_frame<G: SpecGroup<N>, const N: usize>(
+    pose: &UncertainPose<G, N>,
+    confidence: f64,
+) -> PrincipalFrame<N> {
     let (values, vectors) = principal_axes(pose.cov());
     let r = chi2_radius(confidence, N);
     let column = |i: usize| match (values.get(i), vectors.get(i)) {
         (Some(l), Some(v)) => v * (r * l.sqrt()),
         _ => Tangent::<N>::zeros(),
     };
-    PrincipalFrame { columns: [column(0), column(1), column(2)] }
+    PrincipalFrame {
+        columns: [column(0), column(1), column(2)],
+    }
 }
 
 impl<const N: usize> PrincipalFrame<N> {
@@ -484,7 +601,10 @@ fn draw_particles<G: SpecGroup<N>, const N: usize>(
             node.step,
             ItemKind::Arrows(Arrows {
                 origins: subsample.iter().map(|x| v3(x.translation())).collect(),
-                vectors: subsample.iter().map(|x| v3(&x.rotation().act(&(Vector3::x() * 0.35 * p.axis_length)))).collect(),
+                vectors: subsample
+                    .iter()
+                    .map(|x| v3(&x.rotation().act(&(Vector3::x() * 0.35 * p.axis_length))))
+                    .collect(),
                 color: Color::rgb(255, 120, 120).with_alpha(200),
                 radius: 0.0015 * p.axis_length / 0.15,
             }),
@@ -497,18 +617,28 @@ fn draw_particles<G: SpecGroup<N>, const N: usize>(
             node.step,
             ItemKind::Triads(Triads {
                 translations: subsample.iter().map(|x| v3(x.translation())).collect(),
-                rotations: subsample.iter().map(|x| x.rotation().to_quaternion_xyzw()).collect(),
+                rotations: subsample
+                    .iter()
+                    .map(|x| x.rotation().to_quaternion_xyzw())
+                    .collect(),
                 axis_length: 0.35 * p.axis_length,
                 line_radius: 0.0015 * p.axis_length / 0.15,
             }),
         );
     }
     if draw.orientation && (rotation_group || N == 6) {
-        let axis_colors = [Color::rgb(255, 90, 90), Color::rgb(90, 220, 90), Color::rgb(100, 140, 255)];
+        let axis_colors = [
+            Color::rgb(255, 90, 90),
+            Color::rgb(90, 220, 90),
+            Color::rgb(100, 140, 255),
+        ];
         for (k, name) in ["spray_x", "spray_y", "spray_z"].iter().enumerate() {
             let tips = poses
                 .iter()
-                .map(|x| v3(&(x.translation() + x.rotation().act(&(Vector3::ith(k, 1.0) * p.axis_length)))))
+                .map(|x| {
+                    v3(&(x.translation()
+                        + x.rotation().act(&(Vector3::ith(k, 1.0) * p.axis_length))))
+                })
                 .collect();
             p.push(
                 format!("{base}/{name}"),
@@ -545,20 +675,47 @@ fn description<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> String 
     if !m.methods.is_empty() {
         let _ = writeln!(s, "| method | colour |\n|---|---|");
         for method in &m.methods {
-            let _ = writeln!(s, "| {} | {} |", method.label(), method_color_name(*method));
+            let _ = writeln!(
+                s,
+                "| {} | {} |",
+                method.label(),
+                Method::color_name(*method)
+            );
         }
-        let _ = writeln!(s, "| Monte Carlo samples | grey cloud ({} samples, seed {}) |\n", m.samples, m.seed);
+        let _ = writeln!(
+            s,
+            "| Monte Carlo samples | grey cloud ({} samples, seed {}) |\n",
+            m.samples, m.seed
+        );
     }
     let finals = final_nodes(e);
-    let with_errors: Vec<_> = finals.iter().filter(|n| n.estimates.iter().any(|x| x.error_vs_monte_carlo.is_some())).collect();
+    let with_errors: Vec<_> = finals
+        .iter()
+        .filter(|n| n.estimates.iter().any(|x| x.error_vs_monte_carlo.is_some()))
+        .collect();
     if !with_errors.is_empty() {
-        let _ = writeln!(s, "**Error against Monte Carlo** (‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F, right side):\n");
+        let _ = writeln!(
+            s,
+            "**Error against Monte Carlo** (‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F, right side):\n"
+        );
         let _ = writeln!(s, "| pose | method | error |\n|---|---|---|");
         for node in with_errors {
-            let label = node.step.map_or(node.name.clone(), |k| format!("{} (step {k})", node.name));
-            for est in node.estimates.iter().filter(|x| x.result.method != Method::MonteCarlo) {
-                let Some(err) = est.error_vs_monte_carlo else { continue };
-                let method = if node.role == Role::Input { "given Σ (sampling noise floor)" } else { est.result.method.label() };
+            let label = node
+                .step
+                .map_or(node.name.clone(), |k| format!("{} (step {k})", node.name));
+            for est in node
+                .estimates
+                .iter()
+                .filter(|x| x.result.method != Method::MonteCarlo)
+            {
+                let Some(err) = est.error_vs_monte_carlo else {
+                    continue;
+                };
+                let method = if node.role == Role::Input {
+                    "given Σ (sampling noise floor)"
+                } else {
+                    est.result.method.label()
+                };
                 let _ = writeln!(s, "| {label} | {method} | {:.1} % |", 100.0 * err);
             }
         }

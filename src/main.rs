@@ -4,6 +4,8 @@
 //! scene. With no sink flag, a native `rerun` 0.36 viewer is spawned if one is on `PATH`,
 //! otherwise the web viewer embedded in this binary is served on 127.0.0.1.
 
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -12,13 +14,21 @@ use std::time::Duration;
 
 use anyhow::{Context as _, bail};
 use clap::{Args, Parser, Subcommand};
-use posecov::scene::{DEMO_SAMPLES, Scene, demo_scene_with};
+use indicatif::{ProgressBar, ProgressStyle};
+use posecov::draw::build_scene;
+use posecov::scenario::Scenario;
+use posecov::scenario::bundled::BUNDLED;
+use posecov::scenario::eval::{EvalOptions, evaluate};
+use posecov::scenario::model::AnyEvaluation;
+use posecov::scene::Scene;
 use posecov::sink::{
     self, LogOutcome, RecordingIds, Sink, SinkGuard, find_native_viewer, open_stream, render_png,
 };
 
 /// Exit code after Ctrl-C (128 + SIGINT), as shells expect.
 const EXIT_INTERRUPTED: u8 = 130;
+/// How often `--watch` looks at the file's modification time.
+const WATCH_POLL: Duration = Duration::from_millis(300);
 /// Environment variable bounding how long `--serve` serves (seconds), e.g. for CI.
 const SERVE_SECONDS_ENV: &str = "POSECOV_SERVE_SECONDS";
 
@@ -62,17 +72,16 @@ enum Command {
 /// Which scenario, evaluated how.
 #[derive(Clone, Debug, Args)]
 struct ScenarioArgs {
-    /// A bundled scenario name (see `posecov list`) or a scenario TOML file; `demo` is the
-    /// built-in demo.
+    /// A bundled scenario name (see `posecov list`) or a scenario TOML file.
     // `Option` only so that `posecov <COMMAND>` parses; clap requires it otherwise.
     #[arg(required = true)]
     scenario: Option<String>,
-    /// Seed of every random draw (same seed, same recording content).
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
+    /// Seed of every random draw (default: the scenario's; same seed, same recording content).
+    #[arg(long)]
+    seed: Option<u64>,
     /// Monte-Carlo samples (default: the scenario's).
     #[arg(long)]
-    samples: Option<usize>,
+    samples: Option<u64>,
     /// Probability inside drawn regions, strictly between 0 and 1 (default: the scenario's).
     #[arg(long, value_parser = parse_probability)]
     confidence: Option<f64>,
@@ -113,7 +122,7 @@ struct SinkArgs {
     /// Write an .rrd file (headless); same seed, same content.
     #[arg(long, value_name = "FILE.rrd")]
     save: Option<PathBuf>,
-    /// Write .rrd bytes to stdout, e.g. `posecov demo --stdout | rerun -`.
+    /// Write .rrd bytes to stdout, e.g. `posecov camera_on_robot --stdout | rerun -`.
     #[arg(long)]
     stdout: bool,
 }
@@ -163,19 +172,51 @@ impl ScenarioArgs {
     fn scenario(&self) -> &str {
         self.scenario.as_deref().unwrap_or_default()
     }
-}
 
-/// The seam where scenario evaluation plugs in: scenario arguments → scene.
-fn scene_for(args: &ScenarioArgs) -> anyhow::Result<Scene> {
-    match args.scenario() {
-        "demo" => Ok(demo_scene_with(
-            args.seed,
-            args.samples.unwrap_or(DEMO_SAMPLES),
-            args.confidence.unwrap_or(0.95),
-        )?),
-        other => {
-            bail!("scenario {other:?}: scenario files are not implemented yet (try `posecov demo`)")
+    fn options(&self, cancel: Option<Arc<AtomicBool>>) -> EvalOptions {
+        EvalOptions {
+            seed: self.seed,
+            samples: self.samples,
+            confidence: self.confidence,
+            cancel,
         }
+    }
+
+    /// Loads (bundled name or file) and evaluates the scenario, with a spinner when it takes
+    /// more than a moment.
+    fn evaluate(&self, cancel: Option<Arc<AtomicBool>>) -> anyhow::Result<AnyEvaluation> {
+        let scenario = Scenario::load_any(self.scenario())?;
+        let spinner =
+            ProgressBar::new_spinner().with_message(format!("evaluating {}", self.scenario()));
+        spinner.set_style(
+            ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        // The spinner draws only on a terminal (indicatif hides it otherwise) and only after
+        // 0.3 s, so quick scenarios print nothing.
+        let done = AtomicBool::new(false);
+        let ticking = std::thread::scope(|scope| {
+            let ticker = scope.spawn(|| {
+                let start = std::time::Instant::now();
+                while !done.load(Ordering::Relaxed) {
+                    if start.elapsed() > Duration::from_millis(300) {
+                        spinner.tick();
+                    }
+                    std::thread::sleep(Duration::from_millis(80));
+                }
+            });
+            let result = evaluate(&scenario, &self.options(cancel));
+            done.store(true, Ordering::Relaxed);
+            let _ = ticker.join();
+            result
+        });
+        spinner.finish_and_clear();
+        Ok(ticking?)
+    }
+
+    /// The seed in effect (for the recording id): the flag, else the scenario's.
+    fn seed_of(&self, evaluation: &AnyEvaluation) -> u64 {
+        self.seed.unwrap_or(evaluation.meta().seed)
     }
 }
 
@@ -184,6 +225,92 @@ fn scenario_name(scenario: &str) -> String {
     Path::new(scenario)
         .file_stem()
         .map_or_else(|| scenario.to_owned(), |s| s.to_string_lossy().into_owned())
+}
+
+/// `posecov list`: every bundled scenario with its title.
+fn list() -> anyhow::Result<ExitCode> {
+    let width = BUNDLED.iter().map(|b| b.name.len()).max().unwrap_or(0);
+    let mut out = String::new();
+    for b in BUNDLED {
+        let scenario = Scenario::parse(b.text, b.name)?;
+        let _ = writeln!(out, "{:width$}  {}", b.name, scenario.file.scenario.title);
+    }
+    emit(&out)
+}
+
+/// `posecov report`: every mean, covariance, method and error, as JSON or as text.
+fn report(args: &ScenarioArgs, json: bool) -> anyhow::Result<ExitCode> {
+    let evaluation = args.evaluate(None)?;
+    let records = evaluation.records();
+    let meta = evaluation.meta();
+    if json {
+        let notes = match &evaluation {
+            AnyEvaluation::So2(e) => &e.notes,
+            AnyEvaluation::Se2(e) => &e.notes,
+            AnyEvaluation::So3(e) => &e.notes,
+            AnyEvaluation::Se3(e) => &e.notes,
+        };
+        let out = serde_json::json!({ "scenario": args.scenario(), "meta": meta, "results": records, "notes": notes });
+        return emit(&(serde_json::to_string_pretty(&out)? + "\n"));
+    }
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{} — {} (seed {}, {} samples, {:.1} % regions)",
+        args.scenario(),
+        meta.title,
+        meta.seed,
+        meta.samples,
+        100.0 * meta.confidence
+    );
+    for r in &records {
+        let error = r.relative_error_vs_monte_carlo.map_or(String::new(), |e| {
+            format!(", vs Monte Carlo {:.2} %", 100.0 * e)
+        });
+        let _ = writeln!(
+            out,
+            "\n{} [{}] {} ({:?} side{error})",
+            r.label,
+            r.group,
+            r.method.label(),
+            r.side
+        );
+        let tangent: Vec<String> = r.mean_tangent.iter().map(|v| format!("{v:.6}")).collect();
+        let _ = writeln!(out, "  mean Log(μ) = [{}]", tangent.join(", "));
+        let _ = writeln!(out, "  covariance:");
+        for row in &r.covariance {
+            let row: Vec<String> = row.iter().map(|v| format!("{v:>12.6}")).collect();
+            let _ = writeln!(out, "   {}", row.join(" "));
+        }
+    }
+    emit(&out)
+}
+
+/// Writes to stdout; a closed pipe (`posecov report … | head`) is not an error.
+fn emit(text: &str) -> anyhow::Result<ExitCode> {
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e).context("writing to stdout"),
+        _ => Ok(ExitCode::SUCCESS),
+    }
+}
+
+/// `posecov check`: parse and evaluate (with few samples) without drawing.
+fn check(args: &ScenarioArgs) -> anyhow::Result<ExitCode> {
+    let quick = ScenarioArgs {
+        samples: Some(args.samples.unwrap_or(32).min(32)),
+        ..args.clone()
+    };
+    let evaluation = quick.evaluate(None)?;
+    let scene = build_scene(&evaluation);
+    scene.validate().context("the scene is not drawable")?;
+    println!(
+        "{}: ok ({} results, {} drawn items, {} steps)",
+        args.scenario(),
+        evaluation.records().len(),
+        scene.items.len(),
+        scene.steps().len()
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 fn main() -> ExitCode {
@@ -199,55 +326,133 @@ fn main() -> ExitCode {
 fn try_main() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
-        Some(Command::List) => {
-            println!("demo    built-in demo: a drifting robot, Monte Carlo vs first order");
-            Ok(ExitCode::SUCCESS)
-        }
-        Some(Command::Report { .. }) => {
-            bail!("`posecov report` is not implemented yet (it needs scenario evaluation)")
-        }
-        Some(Command::Check { scenario }) => {
-            let scene = scene_for(&scenario)?;
-            scene.validate().context("the scene is not drawable")?;
-            println!(
-                "{}: ok ({} items, {} steps)",
-                scenario.scenario(),
-                scene.items.len(),
-                scene.steps().len()
-            );
-            Ok(ExitCode::SUCCESS)
-        }
+        Some(Command::List) => list(),
+        Some(Command::Report { scenario, json }) => report(&scenario, json),
+        Some(Command::Check { scenario }) => check(&scenario),
         None => view(&cli.view),
     }
 }
 
 fn view(args: &ViewArgs) -> anyhow::Result<ExitCode> {
-    if args.watch {
-        bail!("--watch is not implemented yet (it needs scenario files)");
-    }
-    let scene = scene_for(&args.scenario)?;
-    scene.validate().context("the scene is not drawable")?;
     let cancel = install_ctrl_c()?;
-    let ids =
-        RecordingIds::for_scenario(&scenario_name(args.scenario.scenario()), args.scenario.seed);
+    if args.watch {
+        return watch(args, &cancel);
+    }
+    let evaluation = args.scenario.evaluate(Some(Arc::clone(&cancel)))?;
+    let scene = build_scene(&evaluation);
+    scene.validate().context("the scene is not drawable")?;
+    let ids = RecordingIds::for_scenario(
+        &scenario_name(args.scenario.scenario()),
+        args.scenario.seed_of(&evaluation),
+    );
     if let Some(png) = &args.png {
         return render(args, &scene, &ids, png, &cancel);
     }
     let sink = choose_sink(&args.sink, &args.serve)?;
-    let (rec, guard) = open_stream(&sink, &ids).context("opening the recording")?;
+    let (rec, guard) = open_stream(&sink, &ids, &scene).context("opening the recording")?;
     if let Some(url) = guard.viewer_url() {
         println!("Web viewer: {url}");
     }
     let outcome = run(&rec, &scene, &cancel)?;
     if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
-        let limit = serve_limit(&args.serve)?;
-        match limit {
-            Some(l) => eprintln!("Serving for {} s (Ctrl-C stops).", l.as_secs()),
-            None => eprintln!("Serving until Ctrl-C."),
-        }
-        guard.serve_until(&cancel, limit);
+        serve(&args.serve, &guard, &cancel)?;
     }
     finish(guard, rec, &sink, outcome)
+}
+
+fn serve(args: &ServeArgs, guard: &SinkGuard, cancel: &AtomicBool) -> anyhow::Result<()> {
+    let limit = serve_limit(args)?;
+    match limit {
+        Some(l) => eprintln!("Serving for {} s (Ctrl-C stops).", l.as_secs()),
+        None => eprintln!("Serving until Ctrl-C."),
+    }
+    guard.serve_until(cancel, limit);
+    Ok(())
+}
+
+/// `--watch`: evaluate, stream, and again whenever the file changes. Each generation is a new
+/// recording (id suffix `/gen-N`) sent to the same viewer, so nothing stale survives an edit;
+/// errors in the file are printed and the previous picture stays up.
+fn watch(args: &ViewArgs, cancel: &AtomicBool) -> anyhow::Result<ExitCode> {
+    let path = PathBuf::from(args.scenario.scenario());
+    if !path.is_file() {
+        bail!(
+            "--watch needs a scenario file to watch; {:?} is not one (copy a bundled scenario from assets/scenarios/)",
+            path
+        );
+    }
+    if args.sink.stdout || args.png.is_some() {
+        bail!(
+            "--watch streams to a viewer or rewrites a --save file; it does not combine with --stdout or --png"
+        );
+    }
+    let first_sink = choose_sink(&args.sink, &args.serve)?;
+    // Later generations connect to the viewer the first one reached.
+    let next_sink = match &first_sink {
+        Sink::Spawn => Sink::Connect(rerun::DEFAULT_CONNECT_URL.to_owned()),
+        Sink::Serve { grpc_port, .. } => {
+            Sink::Connect(format!("rerun+http://127.0.0.1:{grpc_port}/proxy"))
+        }
+        other => other.clone(),
+    };
+    let mut keep_alive: Option<(rerun::RecordingStream, SinkGuard)> = None;
+    let mut generation = 0u64;
+    let mut last_seen = None;
+    while !cancel.load(Ordering::Relaxed) {
+        let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
+        if modified != last_seen {
+            last_seen = modified;
+            match args
+                .scenario
+                .evaluate(None)
+                .map(|e| (build_scene(&e), args.scenario.seed_of(&e)))
+            {
+                Err(err) => eprintln!(
+                    "error: {err:#}\n(waiting for the next change of {})",
+                    path.display()
+                ),
+                Ok((scene, seed)) => {
+                    let mut ids =
+                        RecordingIds::for_scenario(&scenario_name(args.scenario.scenario()), seed);
+                    ids.recording_id = format!("{}/gen-{generation}", ids.recording_id);
+                    let sink = if generation == 0 {
+                        &first_sink
+                    } else {
+                        &next_sink
+                    };
+                    let (rec, guard) =
+                        open_stream(sink, &ids, &scene).context("opening the recording")?;
+                    if let Some(url) = guard.viewer_url() {
+                        println!("Web viewer: {url}");
+                    }
+                    run(&rec, &scene, cancel)?;
+                    if matches!(sink, Sink::Serve { .. }) {
+                        // The served viewer lives as long as this first stream's guard.
+                        rec.flush_blocking()
+                            .map_err(|e| anyhow::anyhow!("flushing: {e}"))?;
+                        keep_alive = Some((rec, guard));
+                    } else {
+                        guard.finish(rec).context("finishing the recording")?;
+                        if let Sink::Save(file) = sink {
+                            eprintln!("Wrote {}", file.display());
+                        }
+                    }
+                    eprintln!(
+                        "[{generation}] streamed {} ({} items); watching {} for changes (Ctrl-C stops)",
+                        path.display(),
+                        scene.items.len(),
+                        path.display()
+                    );
+                    generation += 1;
+                }
+            }
+        }
+        std::thread::sleep(WATCH_POLL);
+    }
+    if let Some((rec, guard)) = keep_alive {
+        guard.finish(rec).context("finishing the recording")?;
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Logs the scene; reports how far it got if Ctrl-C interrupted it.
@@ -343,7 +548,7 @@ fn render(
         ),
     };
     let sink = Sink::Save(rrd.clone());
-    let (rec, guard) = open_stream(&sink, ids).context("opening the recording")?;
+    let (rec, guard) = open_stream(&sink, ids, scene).context("opening the recording")?;
     let outcome = run(&rec, scene, cancel)?;
     guard.finish(rec).context("finishing the recording")?;
     if outcome != LogOutcome::Complete {

@@ -20,7 +20,7 @@
 //!   until ‖step‖ < [`LIE_MEAN_TOLERANCE`], at most [`LIE_MEAN_MAX_ITERATIONS`] iterations; on
 //!   no convergence a [`MeanError::NotConverged`] carrying the last estimate.
 //! - [`centred_covariance`]: 1/(N−1) Σ ξᵢ ξᵢᵀ about the sample Lie mean (ROB 530).
-//! - [`uncentred_covariance`]: 1/N Σ ξᵢ ξᵢᵀ about a given mean, E[ξξᵀ] (Barfoot & Furgale
+//! - [`uncentred_covariance`]: 1/N Σ ξᵢ ξᵢᵀ about a given mean, E\[ξξᵀ\] (Barfoot & Furgale
 //!   2014, §IV experiments).
 //! - [`nees`]: normalised estimation error squared of samples against a claimed covariance.
 //!
@@ -122,9 +122,7 @@ pub fn standard_normal<const N: usize, R: Rng + ?Sized>(rng: &mut R) -> Tangent<
 /// let l = covariance_square_root(&cov).unwrap();
 /// assert!((l * l.transpose() - cov).norm() < 1e-14);
 /// ```
-pub fn covariance_square_root<const N: usize>(
-    cov: &TangentMatrix<N>,
-) -> Result<TangentMatrix<N>> {
+pub fn covariance_square_root<const N: usize>(cov: &TangentMatrix<N>) -> Result<TangentMatrix<N>> {
     check_finite("covariance", cov.transpose().iter().copied())?;
     let sym = (cov + cov.transpose()) * 0.5;
     if let Some(chol) = Cholesky::new(sym) {
@@ -394,10 +392,13 @@ fn weighted_tangent_sum<G: LieGroup<N>, const N: usize>(
         .par_chunks(CHUNK_SIZE)
         .enumerate()
         .map(|(c, chunk)| {
-            chunk.iter().enumerate().fold(Tangent::<N>::zeros(), |acc, (i, x)| {
-                let w = weights.map_or(1.0, |w| w[c * CHUNK_SIZE + i]);
-                acc + tangent_about(x, mean, side) * w
-            })
+            chunk
+                .iter()
+                .enumerate()
+                .fold(Tangent::<N>::zeros(), |acc, (i, x)| {
+                    let w = weights.map_or(1.0, |w| w[c * CHUNK_SIZE + i]);
+                    acc + tangent_about(x, mean, side) * w
+                })
         })
         .collect();
     chunk_sums.iter().sum()
@@ -487,13 +488,11 @@ pub fn lie_mean<G: LieGroup<N>, const N: usize>(
     samples: &[G],
     side: Side,
 ) -> Result<LieMean<G>, MeanError<G>> {
-    let first = samples
-        .first()
-        .ok_or(Error::TooFewSamples {
-            what: "Lie mean",
-            needed: 1,
-            got: 0,
-        })?;
+    let first = samples.first().ok_or(Error::TooFewSamples {
+        what: "Lie mean",
+        needed: 1,
+        got: 0,
+    })?;
     weighted_lie_mean(samples, None, first, side)
 }
 
@@ -550,7 +549,7 @@ pub fn weighted_covariance<G: LieGroup<N>, const N: usize>(
     Ok(weighted_outer_sum(points, Some(weights), mean, side))
 }
 
-/// The uncentred covariance E[ξξᵀ] ≈ 1/N Σ ξᵢ ξᵢᵀ of samples about a *given* mean (e.g. the
+/// The uncentred covariance E\[ξξᵀ\] ≈ 1/N Σ ξᵢ ξᵢᵀ of samples about a *given* mean (e.g. the
 /// propagated nominal pose), as in Barfoot & Furgale 2014's Monte Carlo comparisons (§IV-A,
 /// Fig. 2). Right: ξ = Log(μ⁻¹ X); left: ξ = Log(X μ⁻¹). Errors: [`Error::TooFewSamples`] for
 /// an empty set.

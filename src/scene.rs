@@ -36,14 +36,12 @@
 //! assert!(scene.validate().is_ok());
 //! ```
 
-mod demo;
 mod mesh;
 mod palette;
 mod validate;
 
-pub use demo::{DEMO_SAMPLES, demo_scene, demo_scene_with};
 pub use mesh::unit_sphere_mesh;
-pub use palette::Method;
+pub use palette::NOMINAL;
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
 pub type Vec3 = [f64; 3];
@@ -275,7 +273,7 @@ pub struct ScalarSeries {
     pub path: String,
     /// Legend name, e.g. `"first order"`.
     pub name: String,
-    /// Line colour (use the method's [`Method::color`]).
+    /// Line colour (use the method's [`Method::color`](crate::uncertain::Method::color)).
     pub color: Color,
     /// Line width in UI points.
     pub width: f64,

@@ -22,18 +22,38 @@ fn r4_inputs() -> Vec<Vector6<f64>> {
     let w2 = [0.0, 0.1, 0.2, 0.3];
     let w3 = [0.0, 0.7 / 3.0, 1.4 / 3.0, 0.7];
     (0..4)
-        .map(|k| Vector6::new(v1[k], 1.5 * v1[k], 0.05 * (0.6 * v1[k]).exp() - 0.05, w1[k], w2[k], w3[k]))
+        .map(|k| {
+            Vector6::new(
+                v1[k],
+                1.5 * v1[k],
+                0.05 * (0.6 * v1[k]).exp() - 0.05,
+                w1[k],
+                w2[k],
+                w3[k],
+            )
+        })
         .collect()
 }
 
 fn r4_noise() -> Matrix6<f64> {
-    Matrix6::from_diagonal(&Vector6::new(0.01f64.powi(2), 0.01f64.powi(2), 0.05f64.powi(2), 0.05f64.powi(2), 0.05f64.powi(2), 0.2f64.powi(2)))
+    Matrix6::from_diagonal(&Vector6::new(
+        0.01f64.powi(2),
+        0.01f64.powi(2),
+        0.05f64.powi(2),
+        0.05f64.powi(2),
+        0.05f64.powi(2),
+        0.2f64.powi(2),
+    ))
 }
 
 #[track_caller]
 fn assert_diagonal(cov: &Matrix6<f64>, expected: [f64; 6], tol: f64, what: &str) {
     for (i, e) in expected.iter().enumerate() {
-        assert!((cov[(i, i)] - e).abs() <= tol, "{what}: Σ[{i},{i}] = {:.6} vs {e}", cov[(i, i)]);
+        assert!(
+            (cov[(i, i)] - e).abs() <= tol,
+            "{what}: Σ[{i},{i}] = {:.6} vs {e}",
+            cov[(i, i)]
+        );
     }
 }
 
@@ -41,40 +61,90 @@ fn assert_diagonal(cov: &Matrix6<f64>, expected: [f64; 6], tol: f64, what: &str)
 fn r4_jr_corrected_matches_monte_carlo_and_the_lecture_form_is_low() {
     let start = UncertainPose::certain(Se3::identity());
     let (inputs, noise) = (r4_inputs(), r4_noise());
-    let with_jr = propagate_tangent_inputs(&start, &inputs, &noise, InputNoise::RightJacobian).unwrap();
-    let lecture = propagate_tangent_inputs(&start, &inputs, &noise, InputNoise::LectureNoJr).unwrap();
+    let with_jr =
+        propagate_tangent_inputs(&start, &inputs, &noise, InputNoise::RightJacobian).unwrap();
+    let lecture =
+        propagate_tangent_inputs(&start, &inputs, &noise, InputNoise::LectureNoJr).unwrap();
     let mc = odometry_tangent_inputs(&start, &inputs, &noise, &MonteCarlo::new(N, 530)).unwrap();
     assert_eq!((with_jr.len(), mc.len()), (5, 5));
 
     // Nominal positions (6 digits).
-    let positions = [[0.0, 0.0, 0.0], [1.096498, 2.125939, 0.176471], [1.870219, 6.635629, 1.507789], [0.460708, 11.663701, 6.289424]];
+    let positions = [
+        [0.0, 0.0, 0.0],
+        [1.096498, 2.125939, 0.176471],
+        [1.870219, 6.635629, 1.507789],
+        [0.460708, 11.663701, 6.289424],
+    ];
     for (k, p) in positions.iter().enumerate() {
         let got = mc[k + 1].nominal.translation();
-        assert!((got - Vector3::from(*p)).amax() < 5e-6, "nominal position {k}: {got}");
-        assert!(mc[k + 1].nominal.is_approx(with_jr[k + 1].pose.mean(), 1e-12));
+        assert!(
+            (got - Vector3::from(*p)).amax() < 5e-6,
+            "nominal position {k}: {got}"
+        );
+        assert!(
+            mc[k + 1]
+                .nominal
+                .is_approx(with_jr[k + 1].pose.mean(), 1e-12)
+        );
     }
 
-    let (jr4, lecture4, mc4) = (with_jr[4].pose.cov(), lecture[4].pose.cov(), mc[4].propagated.pose.cov());
-    let diag = |m: &Matrix6<f64>| (0..6).map(|i| format!("{:.6}", m[(i, i)])).collect::<Vec<_>>().join(", ");
-    println!("step 4 lecture: {}\nstep 4 Jr:      {}\nstep 4 MC:      {}", diag(lecture4), diag(jr4), diag(mc4));
-    assert_diagonal(lecture4, [0.852095, 4.488039, 7.399204, 0.012156, 0.070807, 0.097036], 5e-6, "lecture");
-    assert_diagonal(jr4, [0.867324, 5.207498, 9.044747, 0.012427, 0.081679, 0.083749], 5e-6, "Jr");
+    let (jr4, lecture4, mc4) = (
+        with_jr[4].pose.cov(),
+        lecture[4].pose.cov(),
+        mc[4].propagated.pose.cov(),
+    );
+    let diag = |m: &Matrix6<f64>| {
+        (0..6)
+            .map(|i| format!("{:.6}", m[(i, i)]))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    println!(
+        "step 4 lecture: {}\nstep 4 Jr:      {}\nstep 4 MC:      {}",
+        diag(lecture4),
+        diag(jr4),
+        diag(mc4)
+    );
+    assert_diagonal(
+        lecture4,
+        [0.852095, 4.488039, 7.399204, 0.012156, 0.070807, 0.097036],
+        5e-6,
+        "lecture",
+    );
+    assert_diagonal(
+        jr4,
+        [0.867324, 5.207498, 9.044747, 0.012427, 0.081679, 0.083749],
+        5e-6,
+        "Jr",
+    );
     // The MC reference diagonal holds to its sampling error: ≈ 4 · √(2/N) relative.
     let mc_reference = [0.915425, 5.172235, 9.099046, 0.012896, 0.081615, 0.083353];
     for (i, e) in mc_reference.iter().enumerate() {
-        assert!((mc4[(i, i)] / e - 1.0).abs() < 4.0 * (2.0 / N as f64).sqrt() * 2.0, "MC Σ[{i},{i}]");
+        assert!(
+            (mc4[(i, i)] / e - 1.0).abs() < 4.0 * (2.0 / N as f64).sqrt() * 2.0,
+            "MC Σ[{i},{i}]"
+        );
     }
 
     for k in 1..=4 {
         let e_jr = relative_frobenius_error(with_jr[k].pose.cov(), mc[k].propagated.pose.cov());
-        let e_lecture = relative_frobenius_error(lecture[k].pose.cov(), mc[k].propagated.pose.cov());
+        let e_lecture =
+            relative_frobenius_error(lecture[k].pose.cov(), mc[k].propagated.pose.cov());
         let lecture_ratio = lecture[k].pose.cov().norm() / mc[k].propagated.pose.cov().norm();
-        println!("step {k}: Jr vs MC {:.2} %, lecture vs MC {:.2} % (norm ratio {lecture_ratio:.3}), Lie mean offset {:.2e}", 100.0 * e_jr, 100.0 * e_lecture, mc[k].propagated.pose.mean().rminus(&mc[k].nominal).norm());
+        println!(
+            "step {k}: Jr vs MC {:.2} %, lecture vs MC {:.2} % (norm ratio {lecture_ratio:.3}), Lie mean offset {:.2e}",
+            100.0 * e_jr,
+            100.0 * e_lecture,
+            mc[k].propagated.pose.mean().rminus(&mc[k].nominal).norm()
+        );
         assert!(e_jr < 0.02, "step {k}: Jr-corrected {e_jr} vs MC");
         assert_eq!(mc[k].propagated.method, Method::MonteCarlo);
     }
     let e_lecture = relative_frobenius_error(lecture4, mc4);
-    assert!((0.15..=0.25).contains(&e_lecture), "lecture form {e_lecture} should be 15–25 % off");
+    assert!(
+        (0.15..=0.25).contains(&e_lecture),
+        "lecture form {e_lecture} should be 15–25 % off"
+    );
     assert!(lecture4.norm() < mc4.norm(), "the lecture form is low");
 }
 
@@ -83,24 +153,48 @@ fn r4_jr_corrected_matches_monte_carlo_and_the_lecture_form_is_low() {
 /// the nominal pose.
 #[test]
 fn r2_increments_monte_carlo_matches_first_order() {
-    let u2 = [0.043333, 0.062110, 0.089025, 0.127602, 0.182895, 0.262149, 0.375746];
-    let u3 = [0.072096, 0.031054, 0.044150, 0.062248, 0.086330, 0.116042, 0.147573];
-    let increments: Vec<Se2> = (0..7).map(|k| Se2::from_xy_theta(0.6, u2[k], u3[k])).collect();
-    let noise = Matrix3::from_diagonal(&Vector3::new(0.03f64.powi(2), 0.03f64.powi(2), 0.1f64.powi(2)));
+    let u2 = [
+        0.043333, 0.062110, 0.089025, 0.127602, 0.182895, 0.262149, 0.375746,
+    ];
+    let u3 = [
+        0.072096, 0.031054, 0.044150, 0.062248, 0.086330, 0.116042, 0.147573,
+    ];
+    let increments: Vec<Se2> = (0..7)
+        .map(|k| Se2::from_xy_theta(0.6, u2[k], u3[k]))
+        .collect();
+    let noise = Matrix3::from_diagonal(&Vector3::new(
+        0.03f64.powi(2),
+        0.03f64.powi(2),
+        0.1f64.powi(2),
+    ));
     let start = UncertainPose::certain(Se2::identity());
     let first = propagate_increments(&start, &increments, &noise).unwrap();
     let mc = odometry_increments(&start, &increments, &noise, &MonteCarlo::new(N, 568)).unwrap();
     for k in 1..=7 {
         let e = relative_frobenius_error(first[k].pose.cov(), mc[k].propagated.pose.cov());
-        let offset = mc[k].propagated.pose.mean().rminus(first[k].pose.mean()).norm();
-        println!("R2 step {k}: first order vs MC {:.2} %, Lie mean offset {offset:.2e}", 100.0 * e);
+        let offset = mc[k]
+            .propagated
+            .pose
+            .mean()
+            .rminus(first[k].pose.mean())
+            .norm();
+        println!(
+            "R2 step {k}: first order vs MC {:.2} %, Lie mean offset {offset:.2e}",
+            100.0 * e
+        );
         assert!(e < 0.015, "step {k}: {e}");
         assert!(offset < 6e-3, "step {k}: Lie mean offset {offset}");
     }
     // The left-side Monte Carlo agrees with the left-form recursion too.
     let left_start = UncertainPose::new_unchecked(Se2::identity(), Matrix3::zeros(), Side::Left);
     let first_left = propagate_increments(&left_start, &increments, &noise).unwrap();
-    let mc_left = odometry_increments(&start, &increments, &noise, &MonteCarlo::new(N, 568).with_side(Side::Left)).unwrap();
+    let mc_left = odometry_increments(
+        &start,
+        &increments,
+        &noise,
+        &MonteCarlo::new(N, 568).with_side(Side::Left),
+    )
+    .unwrap();
     let e = relative_frobenius_error(first_left[7].pose.cov(), mc_left[7].propagated.pose.cov());
     assert!(e < 0.015, "left form, step 7: {e}");
 }
@@ -110,11 +204,21 @@ fn monte_carlo_rejects_bad_settings() {
     let start = UncertainPose::certain(Se3::identity());
     let u = [Vector6::zeros()];
     let noise = r4_noise();
-    assert!(matches!(odometry_tangent_inputs(&start, &u, &noise, &MonteCarlo::new(1, 0)), Err(posecov::Error::OutOfRange { .. })));
+    assert!(matches!(
+        odometry_tangent_inputs(&start, &u, &noise, &MonteCarlo::new(1, 0)),
+        Err(posecov::Error::OutOfRange { .. })
+    ));
     let mut bad = noise;
     bad[(0, 1)] = 1.0;
-    assert!(matches!(odometry_tangent_inputs(&start, &u, &bad, &MonteCarlo::new(10, 0)), Err(posecov::Error::NotSymmetric { .. })));
+    assert!(matches!(
+        odometry_tangent_inputs(&start, &u, &bad, &MonteCarlo::new(10, 0)),
+        Err(posecov::Error::NotSymmetric { .. })
+    ));
     let empty: [UncertainPose<Se3, 6>; 0] = [];
-    let result = posecov::propagate::monte_carlo::map(&empty, |_: &[Se3]| Se3::identity(), &MonteCarlo::new(10, 0));
+    let result = posecov::propagate::monte_carlo::map(
+        &empty,
+        |_: &[Se3]| Se3::identity(),
+        &MonteCarlo::new(10, 0),
+    );
     assert!(matches!(result, Err(posecov::Error::TooFewSamples { .. })));
 }

@@ -9,46 +9,34 @@ use std::process::{Command, Stdio};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use posecov::scene::{Color, ItemKind, PointCloud, Scene, SceneItem, Timing, demo_scene_with};
+use posecov::scenario::Scenario;
+use posecov::scenario::eval::EvalOptions;
+use posecov::scene::{Color, ItemKind, PointCloud, Scene, SceneItem, Timing};
 use posecov::sink::{
     LogOutcome, RecordingIds, Sink, SinkError, log_scene_cancellable, open_stream,
     scene_to_rrd_bytes,
 };
-use rerun::external::re_log_encoding::DecoderApp;
-use rerun::log::{Chunk, LogMsg};
+mod rrd;
+
+use rrd::{assert_same_content, recording_chunks, rerun_cli};
 
 const BIN: &str = env!("CARGO_BIN_EXE_posecov");
 
+/// The scenario the CLI tests run (small, fast, with a cloud, a banana and an ellipse).
+const SCENARIO: &str = "camera_on_robot";
+
 fn ids(seed: u64) -> RecordingIds {
-    RecordingIds::for_scenario("demo", seed)
+    RecordingIds::for_scenario(SCENARIO, seed)
 }
 
 fn small_demo(seed: u64) -> Scene {
-    demo_scene_with(seed, 60, 0.95).expect("valid confidence")
-}
-
-/// The recording's (not the blueprint's) chunks, in stream order.
-fn recording_chunks(bytes: &[u8]) -> Vec<Chunk> {
-    let decoder = DecoderApp::decode_eager(std::io::Cursor::new(bytes)).expect("an .rrd stream");
-    decoder
-        .map(|msg| msg.expect("decodable message"))
-        .filter_map(|msg| match msg {
-            LogMsg::ArrowMsg(store, arrow) if store.kind() == rerun::StoreKind::Recording => {
-                Some(Chunk::from_arrow_msg(&arrow).expect("a chunk"))
-            }
-            _ => None,
-        })
-        .collect()
-}
-
-fn assert_same_content(a: &[u8], b: &[u8]) {
-    let (a, b) = (recording_chunks(a), recording_chunks(b));
-    assert_eq!(a.len(), b.len(), "number of chunks");
-    for (x, y) in a.iter().zip(&b) {
-        if let Err(err) = Chunk::ensure_similar(x, y) {
-            panic!("{} differs: {err:#}", x.entity_path());
-        }
-    }
+    let scenario = Scenario::load_any(SCENARIO).expect("bundled");
+    let options = EvalOptions {
+        seed: Some(seed),
+        samples: Some(60),
+        ..Default::default()
+    };
+    posecov::draw::scene_of(&scenario, &options).expect("evaluates")
 }
 
 fn scratch_dir(name: &str) -> PathBuf {
@@ -56,18 +44,6 @@ fn scratch_dir(name: &str) -> PathBuf {
     std::fs::remove_dir_all(&dir).ok();
     std::fs::create_dir_all(&dir).expect("create scratch dir");
     dir
-}
-
-fn rerun_cli() -> Option<PathBuf> {
-    let cli = PathBuf::from("/work/shared/scripts/rerun-cli");
-    let ok = cli.is_file()
-        && Command::new(&cli)
-            .arg("--version")
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success());
-    ok.then_some(cli)
 }
 
 fn free_port() -> u16 {
@@ -128,7 +104,7 @@ fn nan_is_rejected_before_anything_is_logged() {
             radius: 0.1,
         }),
     ));
-    let (rec, guard) = open_stream(&Sink::Memory, &ids(1)).expect("memory sink");
+    let (rec, guard) = open_stream(&Sink::Memory, &ids(1), &scene).expect("memory sink");
     let err = log_scene_cancellable(&rec, &scene, &AtomicBool::new(false));
     assert!(matches!(err, Err(SinkError::Scene(_))), "{err:?}");
     let bytes = guard.finish(rec).expect("finish").expect("memory bytes");
@@ -137,8 +113,9 @@ fn nan_is_rejected_before_anything_is_logged() {
 
 #[test]
 fn a_cancelled_recording_is_still_a_valid_prefix() {
-    let (rec, guard) = open_stream(&Sink::Memory, &ids(1)).expect("memory sink");
-    let outcome = log_scene_cancellable(&rec, &small_demo(1), &AtomicBool::new(true));
+    let scene = small_demo(1);
+    let (rec, guard) = open_stream(&Sink::Memory, &ids(1), &scene).expect("memory sink");
+    let outcome = log_scene_cancellable(&rec, &scene, &AtomicBool::new(true));
     assert_eq!(
         outcome.ok(),
         Some(LogOutcome::Cancelled { next_step: None })
@@ -152,8 +129,9 @@ fn a_cancelled_recording_is_still_a_valid_prefix() {
 fn an_interrupted_save_is_a_valid_file_under_its_name() {
     let dir = scratch_dir("cancel");
     let file = dir.join("cut.rrd");
-    let (rec, guard) = open_stream(&Sink::Save(file.clone()), &ids(2)).expect("save sink");
-    let outcome = log_scene_cancellable(&rec, &small_demo(2), &AtomicBool::new(true));
+    let scene = small_demo(2);
+    let (rec, guard) = open_stream(&Sink::Save(file.clone()), &ids(2), &scene).expect("save sink");
+    let outcome = log_scene_cancellable(&rec, &scene, &AtomicBool::new(true));
     assert!(matches!(outcome, Ok(LogOutcome::Cancelled { .. })));
     guard.finish(rec).expect("finish");
     let bytes = std::fs::read(&file).expect("the file exists under its final name");
@@ -177,8 +155,8 @@ fn an_interrupted_save_is_a_valid_file_under_its_name() {
 fn a_failed_save_leaves_no_file() {
     let dir = scratch_dir("fail");
     let file = dir.join("never.rrd");
-    let (rec, guard) = open_stream(&Sink::Save(file.clone()), &ids(2)).expect("save sink");
     let mut scene = small_demo(2);
+    let (rec, guard) = open_stream(&Sink::Save(file.clone()), &ids(2), &scene).expect("save sink");
     scene.items[0].path = "world//x".into();
     assert!(posecov::sink::log_scene(&rec, &scene).is_err());
     drop(guard);
@@ -194,7 +172,7 @@ fn save_writes_atomically_and_two_processes_write_the_same_content() {
     let files = [dir.join("a.rrd"), dir.join("b.rrd")];
     for file in &files {
         let out = Command::new(BIN)
-            .args(["demo", "--seed", "3", "--samples", "80", "--save"])
+            .args([SCENARIO, "--seed", "3", "--samples", "80", "--save"])
             .arg(file)
             .output()
             .expect("run posecov");
@@ -237,7 +215,7 @@ fn save_writes_atomically_and_two_processes_write_the_same_content() {
 #[test]
 fn stdout_sink_streams_a_recording() {
     let out = Command::new(BIN)
-        .args(["demo", "--samples", "20", "--stdout"])
+        .args([SCENARIO, "--samples", "20", "--stdout"])
         .stdout(Stdio::piped())
         .output()
         .expect("run posecov");
@@ -252,7 +230,7 @@ fn stdout_sink_streams_a_recording() {
 #[test]
 fn png_without_a_viewer_says_what_to_install() {
     let out = Command::new(BIN)
-        .args(["demo", "--png", "/nonexistent/x.png"])
+        .args([SCENARIO, "--png", "/nonexistent/x.png"])
         .env("POSECOV_RERUN", "/nonexistent/rerun")
         .output()
         .expect("run posecov");
@@ -264,9 +242,9 @@ fn png_without_a_viewer_says_what_to_install() {
 #[test]
 fn bad_arguments_fail_with_a_message() {
     for args in [
-        vec!["demo", "--confidence", "1.5"],
-        vec!["demo", "--save", "x.rrd", "--serve"],
-        vec!["demo", "--size", "10x10", "--png", "x.png"],
+        vec![SCENARIO, "--confidence", "1.5"],
+        vec![SCENARIO, "--save", "x.rrd", "--serve"],
+        vec![SCENARIO, "--size", "10x10", "--png", "x.png"],
     ] {
         let out = Command::new(BIN).args(&args).output().expect("run posecov");
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -277,7 +255,11 @@ fn bad_arguments_fail_with_a_message() {
         .output()
         .expect("run posecov");
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("not implemented yet"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("nosuch: cannot read scenario") && stderr.contains("camera_on_robot"),
+        "{stderr}"
+    );
 }
 
 /// GET `path` on 127.0.0.1:`port`; returns the status line.
@@ -298,7 +280,7 @@ fn serve_answers_on_loopback_and_stops_by_itself() {
     let (web, grpc) = (free_port(), free_port());
     let start = Instant::now();
     let mut child = Command::new(BIN)
-        .args(["demo", "--samples", "20", "--serve"])
+        .args([SCENARIO, "--samples", "20", "--serve"])
         .args([
             "--web-port",
             &web.to_string(),
@@ -344,9 +326,9 @@ fn serve_answers_on_loopback_and_stops_by_itself() {
 #[test]
 fn check_subcommand_validates_the_demo() {
     let out = Command::new(BIN)
-        .args(["check", "demo"])
+        .args(["check", SCENARIO])
         .output()
         .expect("run posecov");
     assert!(out.status.success());
-    assert!(String::from_utf8_lossy(&out.stdout).starts_with("demo: ok"));
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("camera_on_robot: ok"));
 }

@@ -35,12 +35,14 @@ pub struct Se2 {
 }
 
 /// The SE(2) "V" block of Exp, V(θ) = [[a, −b], [b, a]] with a = sin θ/θ, b = (1 − cos θ)/θ.
+#[inline]
 fn v_matrix(theta: f64) -> Matrix2<f64> {
     let (a, b) = (sinc(theta), theta * one_minus_cos_by_theta2(theta));
     Matrix2::new(a, -b, b, a)
 }
 
 /// V(θ)⁻¹ = [[h, θ/2], [−θ/2, h]] with h = (θ/2) cot(θ/2) = cos(θ/2) / sinc(θ/2): finite at θ = ±π.
+#[inline]
 fn v_inverse(theta: f64) -> Matrix2<f64> {
     let half = 0.5 * theta;
     let h = half.cos() / sinc(half);
@@ -56,6 +58,7 @@ impl Se2 {
     /// assert_eq!((x.x(), x.y()), (1.0, 2.0));
     /// assert!((x.theta() - 0.5).abs() < 1e-16);
     /// ```
+    #[inline]
     pub fn from_xy_theta(x: f64, y: f64, theta: f64) -> Self {
         Self::from_parts(Vector2::new(x, y), So2::from_angle(theta))
     }
@@ -67,6 +70,7 @@ impl Se2 {
     /// use nalgebra::Vector2;
     /// assert_eq!(Se2::from_parts(Vector2::new(1.0, 0.0), So2::from_angle(0.0)).x(), 1.0);
     /// ```
+    #[inline]
     pub fn from_parts(translation: Vector2<f64>, rotation: So2) -> Self {
         Self {
             rotation,
@@ -107,6 +111,7 @@ impl Se2 {
     /// use posecov::lie::Se2;
     /// assert_eq!(Se2::from_xy_theta(3.0, 0.0, 0.0).x(), 3.0);
     /// ```
+    #[inline]
     pub fn x(&self) -> f64 {
         self.translation.x
     }
@@ -117,6 +122,7 @@ impl Se2 {
     /// use posecov::lie::Se2;
     /// assert_eq!(Se2::from_xy_theta(0.0, 3.0, 0.0).y(), 3.0);
     /// ```
+    #[inline]
     pub fn y(&self) -> f64 {
         self.translation.y
     }
@@ -127,6 +133,7 @@ impl Se2 {
     /// use posecov::lie::Se2;
     /// assert!((Se2::from_xy_theta(0.0, 0.0, -0.5).theta() + 0.5).abs() < 1e-16);
     /// ```
+    #[inline]
     pub fn theta(&self) -> f64 {
         self.rotation.angle()
     }
@@ -137,6 +144,7 @@ impl Se2 {
     /// use posecov::lie::{LieGroup, Se2, So2};
     /// assert_eq!(Se2::identity().rotation(), &So2::identity());
     /// ```
+    #[inline]
     pub fn rotation(&self) -> &So2 {
         &self.rotation
     }
@@ -147,6 +155,7 @@ impl Se2 {
     /// use posecov::lie::Se2;
     /// assert_eq!(Se2::from_xy_theta(1.0, 2.0, 0.0).translation().y, 2.0);
     /// ```
+    #[inline]
     pub fn translation(&self) -> &Vector2<f64> {
         &self.translation
     }
@@ -158,6 +167,7 @@ impl Se2 {
     /// let x = Se2::from_xy_theta(1.0, 2.0, 0.3);
     /// assert_eq!(Se2::from_isometry(&x.to_isometry()), x);
     /// ```
+    #[inline]
     pub fn to_isometry(&self) -> Isometry2<f64> {
         Isometry2::from_parts(
             Translation2::from(self.translation),
@@ -172,6 +182,7 @@ impl Se2 {
     /// use nalgebra::Isometry2;
     /// assert_eq!(Se2::from_isometry(&Isometry2::new(nalgebra::Vector2::new(1.0, 0.0), 0.0)).x(), 1.0);
     /// ```
+    #[inline]
     pub fn from_isometry(iso: &Isometry2<f64>) -> Self {
         Self::from_parts(
             iso.translation.vector,
@@ -187,11 +198,13 @@ impl LieGroup<3> for Se2 {
     type PointJacobian = Matrix2<f64>;
     const NAME: &'static str = "SE(2)";
 
+    #[inline]
     fn identity() -> Self {
         Self::from_xy_theta(0.0, 0.0, 0.0)
     }
 
     /// (R₁, t₁)(R₂, t₂) = (R₁R₂, t₁ + R₁t₂).
+    #[inline]
     fn compose(&self, other: &Self) -> Self {
         Self::from_parts(
             self.translation + self.rotation.act(&other.translation),
@@ -200,33 +213,39 @@ impl LieGroup<3> for Se2 {
     }
 
     /// (R, t)⁻¹ = (Rᵀ, −Rᵀt).
+    #[inline]
     fn inverse(&self) -> Self {
         let r_inv = self.rotation.inverse();
         Self::from_parts(-r_inv.act(&self.translation), r_inv)
     }
 
     /// Exp([ρ; θ]) = (R(θ), V(θ) ρ), V = [[a, −b], [b, a]] (Solà eq. 156).
+    #[inline]
     fn exp(tau: &Tangent<3>) -> Self {
         let rho = Vector2::new(tau.x, tau.y);
         Self::from_parts(v_matrix(tau.z) * rho, So2::from_angle(tau.z))
     }
 
     /// Log(R, t) = [V(θ)⁻¹ t; θ], θ = atan2 ∈ (−π, π] (Solà eq. 157).
+    #[inline]
     fn log(&self) -> Tangent<3> {
         let theta = self.theta();
         let rho = v_inverse(theta) * self.translation;
         Vector3::new(rho.x, rho.y, theta)
     }
 
+    #[inline]
     fn hat(tau: &Tangent<3>) -> Matrix3<f64> {
         Matrix3::new(0.0, -tau.z, tau.x, tau.z, 0.0, tau.y, 0.0, 0.0, 0.0)
     }
 
+    #[inline]
     fn vee(algebra: &Matrix3<f64>) -> Tangent<3> {
         Vector3::new(algebra[(0, 2)], algebra[(1, 2)], algebra[(1, 0)])
     }
 
     /// Ad = [[R, (t_y, −t_x)ᵀ], [0, 0, 1]] (Solà eq. 159).
+    #[inline]
     fn adj(&self) -> TangentMatrix<3> {
         let r = self.rotation.to_matrix();
         let t = &self.translation;
@@ -244,12 +263,14 @@ impl LieGroup<3> for Se2 {
     }
 
     /// ad_[ρ;θ] = [[0, −θ, ρy], [θ, 0, −ρx], [0, 0, 0]] (derivative of Ad at the identity).
+    #[inline]
     fn ad(tau: &Tangent<3>) -> TangentMatrix<3> {
         Matrix3::new(0.0, -tau.z, tau.y, tau.z, 0.0, -tau.x, 0.0, 0.0, 0.0)
     }
 
     /// Jr = [[a, b, ρx θB − ρy A], [−b, a, ρx A + ρy θB], [0, 0, 1]] (Solà eq. 163, with
     /// (θρx − ρy + ρy cos θ − ρx sin θ)/θ² written as ρx θB − ρy A so it is finite at θ = 0).
+    #[inline]
     fn jr(tau: &Tangent<3>) -> TangentMatrix<3> {
         let (x, y, th) = (tau.x, tau.y, tau.z);
         let (a, big_a, th_b) = (
@@ -273,6 +294,7 @@ impl LieGroup<3> for Se2 {
 
     /// Jr⁻¹ = [[M⁻¹, −M⁻¹ m], [0, 1]] for Jr = [[M, m], [0, 1]], M⁻¹ = [[a, −b], [b, a]]/(a² + b²)
     /// (a² + b² = sinc²(θ/2) > 0 for |θ| < 2π).
+    #[inline]
     fn jr_inv(tau: &Tangent<3>) -> TangentMatrix<3> {
         let jr = Self::jr(tau);
         let (a, b) = (jr[(0, 0)], jr[(0, 1)]);
@@ -291,11 +313,13 @@ impl LieGroup<3> for Se2 {
         )
     }
 
+    #[inline]
     fn act(&self, point: &Vector2<f64>) -> Vector2<f64> {
         self.rotation.act(point) + self.translation
     }
 
     /// ∂(R p + t)/∂X = [R, R (−p_y, p_x)ᵀ], ∂(R p + t)/∂p = R (Solà eq. 166).
+    #[inline]
     fn act_jacobians(&self, point: &Vector2<f64>) -> ActJacobians<Matrix2x3<f64>, Matrix2<f64>> {
         let r = self.rotation.to_matrix();
         let col = r * Vector2::new(-point.y, point.x);
@@ -305,10 +329,12 @@ impl LieGroup<3> for Se2 {
         }
     }
 
+    #[inline]
     fn rotate(&self, direction: &Vector2<f64>) -> Vector2<f64> {
         self.rotation.act(direction)
     }
 
+    #[inline]
     fn to_matrix(&self) -> Matrix3<f64> {
         let r = self.rotation.to_matrix();
         let t = &self.translation;

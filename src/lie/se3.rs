@@ -35,6 +35,7 @@ pub struct Se3 {
 }
 
 /// Splits ξ = [ρ; θ] into (ρ, θ).
+#[inline]
 fn split(xi: &Tangent<6>) -> (Vector3<f64>, Vector3<f64>) {
     (
         xi.fixed_rows::<3>(0).into_owned(),
@@ -43,6 +44,7 @@ fn split(xi: &Tangent<6>) -> (Vector3<f64>, Vector3<f64>) {
 }
 
 /// Builds the block upper-triangular matrix [[a, b], [0, a]].
+#[inline]
 fn upper_block(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Matrix6<f64> {
     let mut m = Matrix6::zeros();
     m.fixed_view_mut::<3, 3>(0, 0).copy_from(a);
@@ -60,6 +62,7 @@ impl Se3 {
     /// let x = Se3::from_parts(Vector3::new(1.0, 0.0, 0.0), So3::from_rpy(0.0, 0.0, 0.0));
     /// assert_eq!(x.translation(), &Vector3::new(1.0, 0.0, 0.0));
     /// ```
+    #[inline]
     pub fn from_parts(translation: Vector3<f64>, rotation: So3) -> Self {
         Self {
             rotation,
@@ -129,6 +132,7 @@ impl Se3 {
     /// use posecov::lie::{LieGroup, Se3, So3};
     /// assert_eq!(Se3::identity().rotation(), &So3::identity());
     /// ```
+    #[inline]
     pub fn rotation(&self) -> &So3 {
         &self.rotation
     }
@@ -139,6 +143,7 @@ impl Se3 {
     /// use posecov::lie::{LieGroup, Se3};
     /// assert_eq!(Se3::identity().translation().norm(), 0.0);
     /// ```
+    #[inline]
     pub fn translation(&self) -> &Vector3<f64> {
         &self.translation
     }
@@ -157,6 +162,7 @@ impl Se3 {
     /// let q = Se3::q_matrix(&Vector3::new(1.0, 2.0, 3.0), &Vector3::zeros());
     /// assert!((q[(0, 1)] + 1.5).abs() < 1e-15);
     /// ```
+    #[inline]
     pub fn q_matrix(rho: &Vector3<f64>, theta: &Vector3<f64>) -> Matrix3<f64> {
         let angle = theta.norm();
         let (r, t) = (So3::skew(rho), So3::skew(theta));
@@ -174,6 +180,7 @@ impl Se3 {
     /// let x = Se3::from_xyz_rpy([1.0, 2.0, 3.0], [0.1, 0.2, 0.3]);
     /// assert_eq!(Se3::from_isometry(&x.to_isometry()), x);
     /// ```
+    #[inline]
     pub fn to_isometry(&self) -> Isometry3<f64> {
         Isometry3::from_parts(
             Translation3::from(self.translation),
@@ -189,6 +196,7 @@ impl Se3 {
     /// let iso = Isometry3::translation(1.0, 0.0, 0.0);
     /// assert_eq!(Se3::from_isometry(&iso).translation().x, 1.0);
     /// ```
+    #[inline]
     pub fn from_isometry(iso: &Isometry3<f64>) -> Self {
         Self::from_parts(iso.translation.vector, So3::from_quaternion(iso.rotation))
     }
@@ -201,11 +209,13 @@ impl LieGroup<6> for Se3 {
     type PointJacobian = Matrix3<f64>;
     const NAME: &'static str = "SE(3)";
 
+    #[inline]
     fn identity() -> Self {
         Self::from_parts(Vector3::zeros(), So3::identity())
     }
 
     /// (R₁, t₁)(R₂, t₂) = (R₁R₂, t₁ + R₁t₂).
+    #[inline]
     fn compose(&self, other: &Self) -> Self {
         Self::from_parts(
             self.translation + self.rotation.act(&other.translation),
@@ -214,24 +224,28 @@ impl LieGroup<6> for Se3 {
     }
 
     /// (R, t)⁻¹ = (Rᵀ, −Rᵀt).
+    #[inline]
     fn inverse(&self) -> Self {
         let r_inv = self.rotation.inverse();
         Self::from_parts(-r_inv.act(&self.translation), r_inv)
     }
 
     /// Exp([ρ; θ]) = (Exp(θ), Jl(θ) ρ) (Solà eq. 172; V = Jl of SO(3)).
+    #[inline]
     fn exp(xi: &Tangent<6>) -> Self {
         let (rho, theta) = split(xi);
         Self::from_parts(So3::jl(&theta) * rho, So3::exp(&theta))
     }
 
     /// Log(R, t) = [Jl(θ)⁻¹ t; θ] with θ = Log(R) (Solà eq. 173).
+    #[inline]
     fn log(&self) -> Tangent<6> {
         let theta = self.rotation.log();
         let rho = So3::jl_inv(&theta) * self.translation;
         Vector6::new(rho.x, rho.y, rho.z, theta.x, theta.y, theta.z)
     }
 
+    #[inline]
     fn hat(xi: &Tangent<6>) -> Matrix4<f64> {
         let (rho, theta) = split(xi);
         let mut m = Matrix4::zeros();
@@ -240,6 +254,7 @@ impl LieGroup<6> for Se3 {
         m
     }
 
+    #[inline]
     fn vee(algebra: &Matrix4<f64>) -> Tangent<6> {
         let theta = So3::vee(&algebra.fixed_view::<3, 3>(0, 0).into_owned());
         Vector6::new(
@@ -253,24 +268,28 @@ impl LieGroup<6> for Se3 {
     }
 
     /// Ad = [[R, t^R], [0, R]] (Solà eq. 175).
+    #[inline]
     fn adj(&self) -> TangentMatrix<6> {
         let r = self.rotation.to_matrix();
         upper_block(&r, &(So3::skew(&self.translation) * r))
     }
 
     /// ad_[ρ;θ] = [[θ^, ρ^], [0, θ^]] (Barfoot & Furgale 2014, eq. 12, translation first).
+    #[inline]
     fn ad(xi: &Tangent<6>) -> TangentMatrix<6> {
         let (rho, theta) = split(xi);
         upper_block(&So3::skew(&theta), &So3::skew(&rho))
     }
 
     /// Jr([ρ; θ]) = Jl([−ρ; −θ]) = [[Jr(θ), Q(−ρ, −θ)], [0, Jr(θ)]] (Barfoot & Furgale 2014, eq. 100).
+    #[inline]
     fn jr(xi: &Tangent<6>) -> TangentMatrix<6> {
         let (rho, theta) = split(xi);
         upper_block(&So3::jr(&theta), &Self::q_matrix(&-rho, &-theta))
     }
 
     /// Jr⁻¹ = [[Jr(θ)⁻¹, −Jr(θ)⁻¹ Q(−ρ, −θ) Jr(θ)⁻¹], [0, Jr(θ)⁻¹]] (block inverse; Barfoot & Furgale 2014, eq. 103).
+    #[inline]
     fn jr_inv(xi: &Tangent<6>) -> TangentMatrix<6> {
         let (rho, theta) = split(xi);
         let jr_inv = So3::jr_inv(&theta);
@@ -280,11 +299,13 @@ impl LieGroup<6> for Se3 {
         )
     }
 
+    #[inline]
     fn act(&self, point: &Vector3<f64>) -> Vector3<f64> {
         self.rotation.act(point) + self.translation
     }
 
     /// ∂(R p + t)/∂X = [R, −R p^], ∂(R p + t)/∂p = R (Solà eqs. 181–182).
+    #[inline]
     fn act_jacobians(&self, point: &Vector3<f64>) -> ActJacobians<Matrix3x6<f64>, Matrix3<f64>> {
         let r = self.rotation.to_matrix();
         let mut wrt_group = Matrix3x6::zeros();
@@ -298,10 +319,12 @@ impl LieGroup<6> for Se3 {
         }
     }
 
+    #[inline]
     fn rotate(&self, direction: &Vector3<f64>) -> Vector3<f64> {
         self.rotation.act(direction)
     }
 
+    #[inline]
     fn to_matrix(&self) -> Matrix4<f64> {
         let mut m = Matrix4::identity();
         m.fixed_view_mut::<3, 3>(0, 0)

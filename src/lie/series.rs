@@ -15,6 +15,7 @@ pub const SMALL_ANGLE: f64 = 0.1;
 /// assert!((sinc(0.5) - 0.5f64.sin() / 0.5).abs() < 1e-15);
 /// assert_eq!(sinc(0.0), 1.0);
 /// ```
+#[inline]
 pub fn sinc(theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
         let t2 = theta * theta;
@@ -31,6 +32,7 @@ pub fn sinc(theta: f64) -> f64 {
 /// assert!((a(1.0) - (1.0 - 1f64.cos())).abs() < 1e-15);
 /// assert_eq!(a(0.0), 0.5);
 /// ```
+#[inline]
 pub fn one_minus_cos_by_theta2(theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
         let t2 = theta * theta;
@@ -48,6 +50,7 @@ pub fn one_minus_cos_by_theta2(theta: f64) -> f64 {
 /// assert!((b(1.0) - (1.0 - 1f64.sin())).abs() < 1e-15);
 /// assert!((b(0.0) - 1.0 / 6.0).abs() < 1e-16);
 /// ```
+#[inline]
 pub fn theta_minus_sin_by_theta3(theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
         let t2 = theta * theta;
@@ -68,6 +71,7 @@ pub fn theta_minus_sin_by_theta3(theta: f64) -> f64 {
 /// assert!((c(0.0) - 1.0 / 12.0).abs() < 1e-16);
 /// assert!((c(std::f64::consts::PI) - 1.0 / (std::f64::consts::PI.powi(2))).abs() < 1e-15);
 /// ```
+#[inline]
 pub fn jinv_coefficient(theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
         let t2 = theta * theta;
@@ -86,6 +90,7 @@ pub fn jinv_coefficient(theta: f64) -> f64 {
 /// assert!((c2(t) - (t * t + 2.0 * t.cos() - 2.0) / 2.0).abs() < 1e-15);
 /// assert!((c2(0.0) - 1.0 / 24.0).abs() < 1e-16);
 /// ```
+#[inline]
 pub fn q_coefficient_2(theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
         let t2 = theta * theta;
@@ -104,6 +109,7 @@ pub fn q_coefficient_2(theta: f64) -> f64 {
 /// assert!((c3(t) - (2.0 * t - 3.0 * t.sin() + t * t.cos()) / 2.0).abs() < 1e-15);
 /// assert!((c3(0.0) - 1.0 / 120.0).abs() < 1e-16);
 /// ```
+#[inline]
 pub fn q_coefficient_3(theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
         let t2 = theta * theta;

@@ -31,6 +31,7 @@ pub struct So2 {
 }
 
 /// The 90° rotation [[0, −1], [1, 0]] = hat(1): hat(θ) p = θ · (−p_y, p_x).
+#[inline]
 fn perp(p: &Vector2<f64>) -> Vector2<f64> {
     Vector2::new(-p.y, p.x)
 }
@@ -42,6 +43,7 @@ impl So2 {
     /// use posecov::lie::So2;
     /// assert!((So2::from_angle(0.25).angle() - 0.25).abs() < 1e-16);
     /// ```
+    #[inline]
     pub fn from_angle(angle: f64) -> Self {
         Self {
             complex: UnitComplex::new(angle),
@@ -54,6 +56,7 @@ impl So2 {
     /// use posecov::lie::So2;
     /// assert!((So2::from_angle(3.0 * std::f64::consts::PI).angle() - std::f64::consts::PI).abs() < 1e-12);
     /// ```
+    #[inline]
     pub fn angle(&self) -> f64 {
         self.complex.angle()
     }
@@ -64,6 +67,7 @@ impl So2 {
     /// use posecov::lie::So2;
     /// assert_eq!(So2::from_angle(0.0).complex().re, 1.0);
     /// ```
+    #[inline]
     pub fn complex(&self) -> &UnitComplex<f64> {
         &self.complex
     }
@@ -87,6 +91,7 @@ impl So2 {
     /// use posecov::lie::So2;
     /// assert!((So2::from_angle(0.5).to_rotation2().angle() - 0.5).abs() < 1e-16);
     /// ```
+    #[inline]
     pub fn to_rotation2(&self) -> Rotation2<f64> {
         self.complex.to_rotation_matrix()
     }
@@ -99,16 +104,19 @@ impl LieGroup<1> for So2 {
     type PointJacobian = Matrix2<f64>;
     const NAME: &'static str = "SO(2)";
 
+    #[inline]
     fn identity() -> Self {
         Self::from_angle(0.0)
     }
 
+    #[inline]
     fn compose(&self, other: &Self) -> Self {
         Self {
             complex: self.complex * other.complex,
         }
     }
 
+    #[inline]
     fn inverse(&self) -> Self {
         Self {
             complex: self.complex.inverse(),
@@ -116,48 +124,58 @@ impl LieGroup<1> for So2 {
     }
 
     /// Exp(θ) = cos θ + i sin θ (Solà eq. 81).
+    #[inline]
     fn exp(theta: &Tangent<1>) -> Self {
         Self::from_angle(theta.x)
     }
 
     /// Log(z) = atan2(Im z, Re z) ∈ (−π, π] (Solà eq. 82).
+    #[inline]
     fn log(&self) -> Tangent<1> {
         Vector1::new(self.angle())
     }
 
+    #[inline]
     fn hat(theta: &Tangent<1>) -> Matrix2<f64> {
         Matrix2::new(0.0, -theta.x, theta.x, 0.0)
     }
 
+    #[inline]
     fn vee(algebra: &Matrix2<f64>) -> Tangent<1> {
         Vector1::new(algebra[(1, 0)])
     }
 
     /// Ad = 1 (SO(2) is commutative).
+    #[inline]
     fn adj(&self) -> TangentMatrix<1> {
         Matrix1::identity()
     }
 
     /// ad = 0.
+    #[inline]
     fn ad(_theta: &Tangent<1>) -> TangentMatrix<1> {
         Matrix1::zeros()
     }
 
     /// Jr = 1.
+    #[inline]
     fn jr(_theta: &Tangent<1>) -> TangentMatrix<1> {
         Matrix1::identity()
     }
 
     /// Jr⁻¹ = 1.
+    #[inline]
     fn jr_inv(_theta: &Tangent<1>) -> TangentMatrix<1> {
         Matrix1::identity()
     }
 
+    #[inline]
     fn act(&self, point: &Vector2<f64>) -> Vector2<f64> {
         self.complex * point
     }
 
     /// ∂(R p)/∂θ = R · (−p_y, p_x)ᵀ, ∂(R p)/∂p = R (Solà eq. 153).
+    #[inline]
     fn act_jacobians(&self, point: &Vector2<f64>) -> ActJacobians<Matrix2x1<f64>, Matrix2<f64>> {
         ActJacobians {
             wrt_group: self.complex * perp(point),
@@ -165,10 +183,12 @@ impl LieGroup<1> for So2 {
         }
     }
 
+    #[inline]
     fn rotate(&self, direction: &Vector2<f64>) -> Vector2<f64> {
         self.complex * direction
     }
 
+    #[inline]
     fn to_matrix(&self) -> Matrix2<f64> {
         self.to_rotation2().into_inner()
     }

@@ -73,6 +73,7 @@ impl So3 {
     /// let (a, b) = (Vector3::new(1.0, 2.0, 3.0), Vector3::new(-1.0, 0.5, 2.0));
     /// assert_eq!(So3::skew(&a) * b, a.cross(&b));
     /// ```
+    #[inline]
     pub fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
         Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
     }
@@ -85,6 +86,7 @@ impl So3 {
     /// let r = So3::from_quaternion(UnitQuaternion::from_euler_angles(0.1, 0.2, 0.3));
     /// assert!((r.to_rpy()[2] - 0.3).abs() < 1e-15);
     /// ```
+    #[inline]
     pub fn from_quaternion(quaternion: UnitQuaternion<f64>) -> Self {
         Self { quaternion }
     }
@@ -121,6 +123,7 @@ impl So3 {
     /// use posecov::lie::So3;
     /// assert_eq!(So3::from_rpy(0.0, 0.0, 0.0).to_quaternion_xyzw(), [0.0, 0.0, 0.0, 1.0]);
     /// ```
+    #[inline]
     pub fn to_quaternion_xyzw(&self) -> [f64; 4] {
         let q = self.canonical_quaternion();
         [q.i, q.j, q.k, q.w]
@@ -132,6 +135,7 @@ impl So3 {
     /// use posecov::lie::{LieGroup, So3};
     /// assert_eq!(So3::identity().quaternion().w, 1.0);
     /// ```
+    #[inline]
     pub fn quaternion(&self) -> &UnitQuaternion<f64> {
         &self.quaternion
     }
@@ -226,6 +230,7 @@ impl So3 {
     /// The quaternion with w ≥ 0; at w = 0 (θ = π exactly) the sign that makes the first
     /// non-zero vector component positive. q and −q are the same rotation: this picks the one
     /// whose Log has |θ| ≤ π and makes the result at θ = π defined.
+    #[inline]
     fn canonical_quaternion(&self) -> Quaternion<f64> {
         let q = *self.quaternion.quaternion();
         let first_nonzero = [q.i, q.j, q.k]
@@ -247,20 +252,24 @@ impl LieGroup<3> for So3 {
     type PointJacobian = Matrix3<f64>;
     const NAME: &'static str = "SO(3)";
 
+    #[inline]
     fn identity() -> Self {
         Self::from_quaternion(UnitQuaternion::identity())
     }
 
+    #[inline]
     fn compose(&self, other: &Self) -> Self {
         Self::from_quaternion(self.quaternion * other.quaternion)
     }
 
+    #[inline]
     fn inverse(&self) -> Self {
         Self::from_quaternion(self.quaternion.inverse())
     }
 
     /// Exp(θ) = [cos(|θ|/2), sin(|θ|/2) θ/|θ|] as a quaternion (Solà eq. 101), with
     /// sin(|θ|/2)/|θ| = ½ sinc(|θ|/2) on its Taylor branch near 0.
+    #[inline]
     fn exp(theta: &Tangent<3>) -> Self {
         let angle = theta.norm();
         let half = 0.5 * angle;
@@ -273,6 +282,7 @@ impl LieGroup<3> for So3 {
     /// |θ| ≤ π and the result stays accurate as θ → π (no arccos of a trace). At θ = π exactly
     /// the axis sign follows [`to_quaternion_xyzw`](So3::to_quaternion_xyzw): first non-zero
     /// component positive.
+    #[inline]
     fn log(&self) -> Tangent<3> {
         let q = self.canonical_quaternion();
         let v = Vector3::new(q.i, q.j, q.k);
@@ -286,25 +296,30 @@ impl LieGroup<3> for So3 {
         v * factor
     }
 
+    #[inline]
     fn hat(theta: &Tangent<3>) -> Matrix3<f64> {
         Self::skew(theta)
     }
 
+    #[inline]
     fn vee(algebra: &Matrix3<f64>) -> Tangent<3> {
         Vector3::new(algebra[(2, 1)], algebra[(0, 2)], algebra[(1, 0)])
     }
 
     /// Ad_R = R (Solà eq. 127).
+    #[inline]
     fn adj(&self) -> TangentMatrix<3> {
         self.to_matrix()
     }
 
     /// ad_θ = θ^.
+    #[inline]
     fn ad(theta: &Tangent<3>) -> TangentMatrix<3> {
         Self::skew(theta)
     }
 
     /// Jr(θ) = I − A θ^ + B θ^² (Solà eq. 143).
+    #[inline]
     fn jr(theta: &Tangent<3>) -> TangentMatrix<3> {
         let angle = theta.norm();
         let h = Self::skew(theta);
@@ -313,16 +328,19 @@ impl LieGroup<3> for So3 {
     }
 
     /// Jr⁻¹(θ) = I + ½ θ^ + C θ^² (Solà eq. 144, half-angle form of C).
+    #[inline]
     fn jr_inv(theta: &Tangent<3>) -> TangentMatrix<3> {
         let h = Self::skew(theta);
         Matrix3::identity() + h * 0.5 + h * h * jinv_coefficient(theta.norm())
     }
 
+    #[inline]
     fn act(&self, point: &Vector3<f64>) -> Vector3<f64> {
         self.quaternion * point
     }
 
     /// ∂(R p)/∂R = −R p^, ∂(R p)/∂p = R (Solà eqs. 145–146).
+    #[inline]
     fn act_jacobians(&self, point: &Vector3<f64>) -> ActJacobians<Matrix3<f64>, Matrix3<f64>> {
         let r = self.to_matrix();
         ActJacobians {
@@ -331,10 +349,12 @@ impl LieGroup<3> for So3 {
         }
     }
 
+    #[inline]
     fn rotate(&self, direction: &Vector3<f64>) -> Vector3<f64> {
         self.quaternion * direction
     }
 
+    #[inline]
     fn to_matrix(&self) -> Matrix3<f64> {
         self.quaternion.to_rotation_matrix().into_inner()
     }

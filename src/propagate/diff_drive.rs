@@ -32,9 +32,9 @@
 //! ```
 
 use nalgebra::{Matrix3, Matrix3x2, Vector2, Vector3};
+use rand::Rng;
 use rand_distr::StandardNormal;
 use rayon::prelude::*;
-use rand::Rng;
 
 use crate::error::{Error, Result};
 use crate::lie::{LieGroup, Se2, Tangent};
@@ -62,7 +62,11 @@ fn positive(what: &'static str, value: f64, allow_zero: bool) -> Result<f64> {
         Err(Error::OutOfRange {
             what,
             value,
-            expected: if allow_zero { "finite and ≥ 0" } else { "finite and > 0" },
+            expected: if allow_zero {
+                "finite and ≥ 0"
+            } else {
+                "finite and > 0"
+            },
         })
     }
 }
@@ -168,10 +172,18 @@ impl DiffDrive {
     }
 
     /// Constant-curvature arc at speed v and yaw rate α̇ ≠ 0 for time t, radius a = v/α̇
-    /// (signed), Long et al. 2012, §IV-B, with c = D r²/(α̇ l²):
-    /// Σ₁₁ = c[(4a² + l²)(2α̇t + sin 2α̇t) + 16a²(α̇t − 2 sin α̇t)]/8,
-    /// Σ₁₂ = −(c/2)(4a²(cos α̇t − 1) + l²) sin²(α̇t/2), Σ₁₃ = 2ca(α̇t − sin α̇t),
-    /// Σ₂₂ = −c(4a² + l²)(−2α̇t + sin 2α̇t)/8, Σ₂₃ = −2ca(cos α̇t − 1), Σ₃₃ = 2cα̇.
+    /// (signed, so right turns and reversing work), Long et al. 2012, §IV-B, with
+    /// c = D r²/(α̇ l²) and φ = α̇t:
+    /// Σ₁₁ = c[(4a² + l²)(2φ + sin 2φ) + 16a²(φ − 2 sin φ)]/8,
+    /// Σ₁₂ = −(c/2)(4a²(cos φ − 1) + l²(1 + cos φ)) sin²(φ/2), Σ₁₃ = 2ca(φ − sin φ),
+    /// Σ₂₂ = −c(4a² + l²)(−2φ + sin 2φ)/8, Σ₂₃ = −2ca(cos φ − 1), Σ₃₃ = 2cα̇t.
+    ///
+    /// Σ₁₂ and Σ₃₃ are integrated here from the integrand (with
+    /// Ad(μ(τ)⁻¹) = [[cos ψ, sin ψ, a(1 − cos ψ)], [−sin ψ, cos ψ, a sin ψ], [0, 0, 1]], ψ = α̇τ):
+    /// the forms quoted as "−(c/2)(4a²(cos φ − 1) + l²) sin²(φ/2)" and "2cα̇" agree with them
+    /// only at φ = π/2 and t = 1 (the quarter circle in 1 s of the paper's example); the
+    /// numeric integral confirms the general forms.
+    ///
     /// Errors: α̇ = 0 (use [`straight_closed_form`](Self::straight_closed_form)), non-finite
     /// inputs, t < 0.
     ///
@@ -206,11 +218,13 @@ impl DiffDrive {
             * ((4.0 * a2 + l2) * (2.0 * phi + (2.0 * phi).sin())
                 + 16.0 * a2 * (phi - 2.0 * phi.sin()))
             / 8.0;
-        cov[(0, 1)] = -(c / 2.0) * (4.0 * a2 * (phi.cos() - 1.0) + l2) * (phi / 2.0).sin().powi(2);
+        cov[(0, 1)] = -(c / 2.0)
+            * (4.0 * a2 * (phi.cos() - 1.0) + l2 * (1.0 + phi.cos()))
+            * (phi / 2.0).sin().powi(2);
         cov[(0, 2)] = 2.0 * c * a * (phi - phi.sin());
         cov[(1, 1)] = -c * (4.0 * a2 + l2) * (-2.0 * phi + (2.0 * phi).sin()) / 8.0;
         cov[(1, 2)] = -2.0 * c * a * (phi.cos() - 1.0);
-        cov[(2, 2)] = 2.0 * c * rate;
+        cov[(2, 2)] = 2.0 * c * rate * t;
         let cov = Matrix3::from_fn(|i, j| if i <= j { cov[(i, j)] } else { cov[(j, i)] });
         let mean = Se2::exp(&(Vector3::new(speed, 0.0, yaw_rate) * t));
         Ok(self.result(mean, cov, Method::ClosedForm))
@@ -248,7 +262,11 @@ impl DiffDrive {
         };
         let cov = adaptive_simpson(&integrand, 0.0, duration, tolerance)?;
         let cov = (cov + cov.transpose()) * 0.5;
-        Ok(self.result(self.nominal(wheel_rates, duration), cov, Method::NumericIntegral))
+        Ok(self.result(
+            self.nominal(wheel_rates, duration),
+            cov,
+            Method::NumericIntegral,
+        ))
     }
 
     /// Euler–Maruyama sample paths of the wheel SDE from the identity pose for time t at
@@ -330,10 +348,10 @@ impl PathSimulator {
         let [w1, w2] = self.wheel_rates;
         let (mut x, mut y, mut theta) = (0.0f64, 0.0f64, 0.0f64);
         for k in 0..self.steps {
-            if k % self.stride == 0 {
-                if let Some(t) = trajectory.as_deref_mut() {
-                    t.push(Se2::from_xy_theta(x, y, theta));
-                }
+            if let Some(t) = trajectory.as_deref_mut()
+                && k % self.stride == 0
+            {
+                t.push(Se2::from_xy_theta(x, y, theta));
             }
             let z1: f64 = rng.sample(StandardNormal);
             let z2: f64 = rng.sample(StandardNormal);

@@ -87,7 +87,7 @@ pub enum Variant {
     DoubleBracketProduct,
 }
 
-/// ⟨⟨A⟩⟩ = −tr(A) 1 + A (Barfoot & Furgale 2014, with eq. 55); for A = E[θθᵀ],
+/// ⟨⟨A⟩⟩ = −tr(A) 1 + A (Barfoot & Furgale 2014, with eq. 55); for A = E\[θθᵀ\],
 /// ⟨⟨A⟩⟩ = E[θ^ θ^].
 ///
 /// ```
@@ -99,7 +99,7 @@ pub fn bracket(a: &Matrix3<f64>) -> Matrix3<f64> {
     a - Matrix3::identity() * a.trace()
 }
 
-/// ⟨⟨A, B⟩⟩ = ⟨⟨A⟩⟩⟨⟨B⟩⟩ + ⟨⟨BA⟩⟩ (Barfoot & Furgale 2014, with eq. 55); for A = E[θθᵀ],
+/// ⟨⟨A, B⟩⟩ = ⟨⟨A⟩⟩⟨⟨B⟩⟩ + ⟨⟨BA⟩⟩ (Barfoot & Furgale 2014, with eq. 55); for A = E\[θθᵀ\],
 /// E[θ^ B θ^ᵀ] = ⟨⟨A, B⟩⟩ when B is symmetric.
 ///
 /// ```
@@ -219,10 +219,7 @@ pub fn compound_covariance_variant(
     let a1 = bracket_se3_variant(cov1, variant == Variant::A1Product);
     let a2 = bracket_se3(cov2_prime);
     let b = b_matrix(cov1, cov2_prime, variant);
-    let twelfth = a1 * cov2_prime
-        + cov2_prime * a1.transpose()
-        + a2 * cov1
-        + cov1 * a2.transpose();
+    let twelfth = a1 * cov2_prime + cov2_prime * a1.transpose() + a2 * cov1 + cov1 * a2.transpose();
     symmetrise(&(cov1 + cov2_prime + b * 0.25 + twelfth / 12.0))
 }
 
@@ -258,7 +255,10 @@ pub fn compound_se3(
 }
 
 /// Σ₁ and Σ₂' = Ad(T̄₁) Σ₂ Ad(T̄₁)ᵀ, both on the left side.
-fn left_inputs(a: &UncertainPose<Se3, 6>, b: &UncertainPose<Se3, 6>) -> (Matrix6<f64>, Matrix6<f64>) {
+fn left_inputs(
+    a: &UncertainPose<Se3, 6>,
+    b: &UncertainPose<Se3, 6>,
+) -> (Matrix6<f64>, Matrix6<f64>) {
     let ad = a.mean().adj();
     (a.cov_left(), ad * b.cov_left() * ad.transpose())
 }

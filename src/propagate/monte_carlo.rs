@@ -8,7 +8,7 @@
 //!   of [`crate::sample`]: results are identical for a given seed whatever the thread count.
 //! - The summary is either [`Centring::LieMean`] — the iterative Lie mean (started at the
 //!   nominal output) and the centred 1/(N−1) covariance about it (ROB 530) — or
-//!   [`Centring::Nominal`] — the uncentred E[ξξᵀ] about the nominal (noise-free) output, as in
+//!   [`Centring::Nominal`] — the uncentred E\[ξξᵀ\] about the nominal (noise-free) output, as in
 //!   Barfoot & Furgale 2014's Monte Carlo comparisons (§III-A, Fig. 2).
 //! - Covariances are on [`MonteCarlo::side`] (right / body by default).
 //!
@@ -37,7 +37,7 @@ pub enum Centring {
     /// The iterative Lie mean of the outputs and 1/(N−1) Σ ξᵢξᵢᵀ about it (ROB 530).
     #[default]
     LieMean,
-    /// The nominal (noise-free) output and the uncentred 1/N Σ ξᵢξᵢᵀ about it, E[ξξᵀ]
+    /// The nominal (noise-free) output and the uncentred 1/N Σ ξᵢξᵢᵀ about it, E\[ξξᵀ\]
     /// (Barfoot & Furgale 2014); the reported mean is the nominal output.
     Nominal,
 }
@@ -155,7 +155,11 @@ fn summarise<G: LieGroup<N>, const N: usize>(
             let cov = centred_covariance(samples, &mean.mean, mc.side)?;
             (mean.mean, cov, mean.iterations)
         }
-        Centring::Nominal => (nominal, uncentred_covariance(samples, &nominal, mc.side)?, 0),
+        Centring::Nominal => (
+            nominal,
+            uncentred_covariance(samples, &nominal, mc.side)?,
+            0,
+        ),
     };
     Ok(MonteCarloOutput {
         propagated: Propagated {
@@ -257,7 +261,8 @@ where
     S: Fn(&G, usize, &Tangent<N>) -> G + Sync,
 {
     mc.validate()?;
-    let noise_root = covariance_square_root(&validate_covariance("odometry noise covariance", noise)?)?;
+    let noise_root =
+        covariance_square_root(&validate_covariance("odometry noise covariance", noise)?)?;
     let mut particles = Sampler::new(start)?.draw_par(mc.samples, mc.seed);
     let mut nominal = *start.mean();
     let mut results = Vec::with_capacity(steps + 1);

@@ -16,6 +16,14 @@
 //!   μ ← μ ⊕ Σ Wⱼ⁽ᵐ⁾ (Yⱼ ⊖ μ) from the nominal output; covariance Σ Wⱼ⁽ᶜ⁾ ξⱼ ξⱼᵀ, ξⱼ = Yⱼ ⊖ μ on
 //!   [`Unscented::side`].
 //!
+//! # When it differs from first order
+//! With independent inputs every sigma point moves *one* input. For products of group
+//! elements the output is then exactly linear in that input's tangent
+//! (X · Exp(ε) · Y = XY · Exp(Ad_{Y⁻¹} ε)), so for compose, between, inverse and their chains
+//! the unscented covariance equals the first-order one (cross terms between inputs, which
+//! 4th-order compounding captures, never appear). It differs where the nonlinearity sits
+//! inside one input, e.g. X · Exp(u + w) (REFERENCE_CASES R4) or a map using an input twice.
+//!
 //! # Parameters
 //! Defaults α = 1, β = 2, κ = 0 (λ = 0: points at ±√L σ, W₀⁽ᵐ⁾ = 0, all weights ≥ 0, so the
 //! covariance stays PSD); β = 2 is optimal for Gaussian inputs. Smaller α pulls the points
@@ -102,12 +110,22 @@ impl Unscented {
                 })
             }
         };
-        check("unscented α", self.alpha, self.alpha > 0.0, "a finite α > 0")?;
+        check(
+            "unscented α",
+            self.alpha,
+            self.alpha > 0.0,
+            "a finite α > 0",
+        )?;
         check("unscented β", self.beta, true, "a finite β")?;
         check("unscented κ", self.kappa, true, "a finite κ")?;
         let l = dim as f64;
         let spread = self.alpha * self.alpha * (l + self.kappa); // L + λ
-        check("unscented L + λ = α²(L + κ)", spread, spread > 0.0, "L + λ > 0")?;
+        check(
+            "unscented L + λ = α²(L + κ)",
+            spread,
+            spread > 0.0,
+            "L + λ > 0",
+        )?;
         let lambda = spread - l;
         Ok(SigmaWeights {
             scale: spread.sqrt(),

@@ -14,19 +14,21 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 use toml::Spanned;
 
-use super::model::{AnyEvaluation, Estimate, Evaluation, MatrixFrame, Meta, Node, PointNode, PosePath, Role, Series};
+use super::model::{
+    AnyEvaluation, Estimate, Evaluation, MatrixFrame, Meta, Node, PointNode, PosePath, Role, Series,
+};
 use super::schema::{GroupName, OperationSpec};
 use super::spec::{cov_for, fixed_matrix, mean_for};
 use super::{Scenario, ScenarioError, SpecGroup};
-use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
-use crate::propagate::first_order::{self, CorrelatedPair};
 use crate::interop::VectorChart;
+use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 use crate::propagate::diff_drive::{DiffDrive, EulerMaruyama};
+use crate::propagate::first_order::{self, CorrelatedPair};
 use crate::propagate::fourth_order::{self, Order};
-use crate::propagate::sigma_point::{self, Unscented};
-use crate::propagate::vector_space::{VectorPose, ssc_compose, ssc_odometry};
 use crate::propagate::fusion::{FusionOptions, fuse};
 use crate::propagate::odometry::{InputNoise, propagate_increments, propagate_tangent_inputs};
+use crate::propagate::sigma_point::{self, Unscented};
+use crate::propagate::vector_space::{VectorPose, ssc_compose, ssc_odometry};
 use crate::propagate::{Propagated, relative_frobenius_error};
 use crate::sample::{Sampler, fill_par, sample_statistics, standard_normal};
 use crate::uncertain::{Method, Side, UncertainPose};
@@ -62,7 +64,10 @@ pub struct EvalOptions {
 /// let records = e.records();
 /// assert!(records.iter().any(|r| r.label == "a_inv" && r.relative_error_vs_monte_carlo.is_some()));
 /// ```
-pub fn evaluate(scenario: &Scenario, options: &EvalOptions) -> Result<AnyEvaluation, ScenarioError> {
+pub fn evaluate(
+    scenario: &Scenario,
+    options: &EvalOptions,
+) -> Result<AnyEvaluation, ScenarioError> {
     let meta = meta(scenario, options)?;
     Ok(match meta.group {
         GroupName::So2 => AnyEvaluation::So2(Engine::<So2, 1>::run(scenario, meta, options)?),
@@ -82,12 +87,23 @@ fn meta(scenario: &Scenario, options: &EvalOptions) -> Result<Meta, ScenarioErro
     };
     if !(2..=MAX_SAMPLES).contains(&samples) {
         let span = h.samples.as_ref().map_or(0..0, Spanned::span);
-        return Err(loc.error(span, "scenario.samples", format!("{samples} is out of range: use 2 ..= {MAX_SAMPLES}")));
+        return Err(loc.error(
+            span,
+            "scenario.samples",
+            format!("{samples} is out of range: use 2 ..= {MAX_SAMPLES}"),
+        ));
     }
-    let confidence = options.confidence.or(h.confidence.as_ref().map(|c| *c.get_ref())).unwrap_or(DEFAULT_CONFIDENCE);
+    let confidence = options
+        .confidence
+        .or(h.confidence.as_ref().map(|c| *c.get_ref()))
+        .unwrap_or(DEFAULT_CONFIDENCE);
     if !(confidence > 0.0 && confidence < 1.0) {
         let span = h.confidence.as_ref().map_or(0..0, Spanned::span);
-        return Err(loc.error(span, "scenario.confidence", format!("{confidence} is not a probability in (0, 1), e.g. 0.95")));
+        return Err(loc.error(
+            span,
+            "scenario.confidence",
+            format!("{confidence} is not a probability in (0, 1), e.g. 0.95"),
+        ));
     }
     let mut methods = h.methods.clone();
     methods.dedup();
@@ -111,21 +127,36 @@ pub trait EvalGroup<const N: usize>: SpecGroup<N> {
 
     /// An uncertain point p (covariance rows `cov`, in the pose's frame) seen from an
     /// uncertain pose, to first order: (mean, covariance) in world coordinates, lifted to 3D.
-    fn point_through(pose: &UncertainPose<Self, N>, point: &[f64], cov: &[Vec<f64>]) -> Result<([f64; 3], [[f64; 3]; 3]), String>;
+    fn point_through(
+        pose: &UncertainPose<Self, N>,
+        point: &[f64],
+        cov: &[Vec<f64>],
+    ) -> Result<([f64; 3], [[f64; 3]; 3]), String>;
 
     /// 2nd/4th-order compounding Z = X·Y (Barfoot & Furgale 2014), where defined.
-    fn compound(_x: &UncertainPose<Self, N>, _y: &UncertainPose<Self, N>, _order: Order) -> Option<Propagated<Self, N>> {
+    fn compound(
+        _x: &UncertainPose<Self, N>,
+        _y: &UncertainPose<Self, N>,
+        _order: Order,
+    ) -> Option<Propagated<Self, N>> {
         None
     }
 
     /// Smith–Self–Cheeseman compose in the group's vector coordinates, where defined.
-    fn ssc_compose(_x: &UncertainPose<Self, N>, _y: &UncertainPose<Self, N>) -> Option<crate::Result<Propagated<Self, N>>> {
+    fn ssc_compose(
+        _x: &UncertainPose<Self, N>,
+        _y: &UncertainPose<Self, N>,
+    ) -> Option<crate::Result<Propagated<Self, N>>> {
         None
     }
 
     /// Smith–Self–Cheeseman odometry (increments as group elements, noise read in the vector
     /// coordinates), where defined; one result per step including the start.
-    fn ssc_odometry(_start: &UncertainPose<Self, N>, _increments: &[Self], _noise: &TangentMatrix<N>) -> Option<crate::Result<Vec<Propagated<Self, N>>>> {
+    fn ssc_odometry(
+        _start: &UncertainPose<Self, N>,
+        _increments: &[Self],
+        _noise: &TangentMatrix<N>,
+    ) -> Option<crate::Result<Vec<Propagated<Self, N>>>> {
         None
     }
 
@@ -135,7 +166,11 @@ pub trait EvalGroup<const N: usize>: SpecGroup<N> {
     }
 
     /// Euler integration vs the exponential map, SO(3) only: per step (Euler matrix, Exp element).
-    fn euler_vs_exp(_rate: &Vector3<f64>, _dt: f64, _steps: u64) -> Option<Vec<(Matrix3<f64>, Self)>> {
+    fn euler_vs_exp(
+        _rate: &Vector3<f64>,
+        _dt: f64,
+        _steps: u64,
+    ) -> Option<Vec<(Matrix3<f64>, Self)>> {
         None
     }
 }
@@ -186,36 +221,59 @@ fn point_estimate<G, const N: usize, const D: usize>(
     cov: &[Vec<f64>],
 ) -> Result<([f64; 3], [[f64; 3]; 3]), String>
 where
-    G: LieGroup<N, Point = nalgebra::SVector<f64, D>, ActJacobian = nalgebra::SMatrix<f64, D, N>, PointJacobian = nalgebra::SMatrix<f64, D, D>>,
+    G: LieGroup<
+            N,
+            Point = nalgebra::SVector<f64, D>,
+            ActJacobian = nalgebra::SMatrix<f64, D, N>,
+            PointJacobian = nalgebra::SMatrix<f64, D, D>,
+        >,
 {
     let p = nalgebra::SVector::<f64, D>::from_iterator(point.iter().copied());
     let c = fixed_matrix::<D, D>("point_cov", cov)?;
     let q = first_order::act_point(pose, &p, &c).map_err(|e| e.to_string())?;
     let mut mean = [0.0; 3];
     let mut cov3 = [[0.0; 3]; 3];
-    for r in 0..D {
+    for (r, row) in cov3.iter_mut().enumerate().take(D) {
         mean[r] = q.mean[r];
-        for c in 0..D {
-            cov3[r][c] = q.cov[(r, c)];
+        for (c, value) in row.iter_mut().enumerate().take(D) {
+            *value = q.cov[(r, c)];
         }
     }
     Ok((mean, cov3))
 }
 
-fn ssc_compose_in<G: VectorChart<N>, const N: usize>(x: &UncertainPose<G, N>, y: &UncertainPose<G, N>) -> crate::Result<Propagated<G, N>> {
-    ssc_compose(&VectorPose::from_uncertain(x)?, &VectorPose::from_uncertain(y)?)?.to_uncertain()
+fn ssc_compose_in<G: VectorChart<N>, const N: usize>(
+    x: &UncertainPose<G, N>,
+    y: &UncertainPose<G, N>,
+) -> crate::Result<Propagated<G, N>> {
+    ssc_compose(
+        &VectorPose::from_uncertain(x)?,
+        &VectorPose::from_uncertain(y)?,
+    )?
+    .to_uncertain()
 }
 
-fn ssc_odometry_in<G: VectorChart<N>, const N: usize>(start: &UncertainPose<G, N>, increments: &[G], noise: &TangentMatrix<N>) -> crate::Result<Vec<Propagated<G, N>>> {
+fn ssc_odometry_in<G: VectorChart<N>, const N: usize>(
+    start: &UncertainPose<G, N>,
+    increments: &[G],
+    noise: &TangentMatrix<N>,
+) -> crate::Result<Vec<Propagated<G, N>>> {
     let coordinates: Vec<_> = increments.iter().map(VectorChart::to_coordinates).collect();
-    ssc_odometry(&VectorPose::from_uncertain(start)?, &coordinates, noise)?.iter().map(VectorPose::to_uncertain).collect()
+    ssc_odometry(&VectorPose::from_uncertain(start)?, &coordinates, noise)?
+        .iter()
+        .map(VectorPose::to_uncertain)
+        .collect()
 }
 
 impl EvalGroup<1> for So2 {
     fn point_dims() -> usize {
         2
     }
-    fn point_through(pose: &UncertainPose<Self, 1>, point: &[f64], cov: &[Vec<f64>]) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+    fn point_through(
+        pose: &UncertainPose<Self, 1>,
+        point: &[f64],
+        cov: &[Vec<f64>],
+    ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
         point_estimate::<Self, 1, 2>(pose, point, cov)
     }
 }
@@ -224,7 +282,11 @@ impl EvalGroup<3> for So3 {
     fn point_dims() -> usize {
         3
     }
-    fn point_through(pose: &UncertainPose<Self, 3>, point: &[f64], cov: &[Vec<f64>]) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+    fn point_through(
+        pose: &UncertainPose<Self, 3>,
+        point: &[f64],
+        cov: &[Vec<f64>],
+    ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
         point_estimate::<Self, 3, 3>(pose, point, cov)
     }
     fn euler_vs_exp(rate: &Vector3<f64>, dt: f64, steps: u64) -> Option<Vec<(Matrix3<f64>, Self)>> {
@@ -246,16 +308,31 @@ impl EvalGroup<3> for Se2 {
     fn point_dims() -> usize {
         2
     }
-    fn point_through(pose: &UncertainPose<Self, 3>, point: &[f64], cov: &[Vec<f64>]) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+    fn point_through(
+        pose: &UncertainPose<Self, 3>,
+        point: &[f64],
+        cov: &[Vec<f64>],
+    ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
         point_estimate::<Self, 3, 2>(pose, point, cov)
     }
-    fn compound(x: &UncertainPose<Self, 3>, y: &UncertainPose<Self, 3>, order: Order) -> Option<Propagated<Self, 3>> {
+    fn compound(
+        x: &UncertainPose<Self, 3>,
+        y: &UncertainPose<Self, 3>,
+        order: Order,
+    ) -> Option<Propagated<Self, 3>> {
         Some(fourth_order::compound_se2(x, y, order))
     }
-    fn ssc_compose(x: &UncertainPose<Self, 3>, y: &UncertainPose<Self, 3>) -> Option<crate::Result<Propagated<Self, 3>>> {
+    fn ssc_compose(
+        x: &UncertainPose<Self, 3>,
+        y: &UncertainPose<Self, 3>,
+    ) -> Option<crate::Result<Propagated<Self, 3>>> {
         Some(ssc_compose_in(x, y))
     }
-    fn ssc_odometry(start: &UncertainPose<Self, 3>, increments: &[Self], noise: &TangentMatrix<3>) -> Option<crate::Result<Vec<Propagated<Self, 3>>>> {
+    fn ssc_odometry(
+        start: &UncertainPose<Self, 3>,
+        increments: &[Self],
+        noise: &TangentMatrix<3>,
+    ) -> Option<crate::Result<Vec<Propagated<Self, 3>>>> {
         Some(ssc_odometry_in(start, increments, noise))
     }
     fn diff_drive(p: &DiffDriveParams) -> Option<crate::Result<DiffDriveOutcome<Self, 3>>> {
@@ -268,15 +345,23 @@ impl EvalGroup<3> for Se2 {
             };
             let rates = robot.wheel_rates_for(p.speed, p.turn_rate);
             let integral = robot.numeric_integral(rates, p.duration, 1e-12)?;
-            let nominal_path = (0..=100).map(|i| robot.nominal(rates, p.duration * f64::from(i) / 100.0)).collect();
+            let nominal_path = (0..=100)
+                .map(|i| robot.nominal(rates, p.duration * f64::from(i) / 100.0))
+                .collect();
             let (end_poses, trajectories) = if p.samples > 0 {
-                let settings = EulerMaruyama::new(p.dt, p.samples, p.seed).with_trajectories(DIFF_DRIVE_TRAJECTORIES, 10);
+                let settings = EulerMaruyama::new(p.dt, p.samples, p.seed)
+                    .with_trajectories(DIFF_DRIVE_TRAJECTORIES, 10);
                 let sde = robot.euler_maruyama(rates, p.duration, &settings)?;
                 (sde.end_poses, sde.trajectories)
             } else {
                 (Vec::new(), Vec::new())
             };
-            Ok(DiffDriveOutcome { estimates: vec![closed, integral], end_poses, trajectories, nominal_path })
+            Ok(DiffDriveOutcome {
+                estimates: vec![closed, integral],
+                end_poses,
+                trajectories,
+                nominal_path,
+            })
         })())
     }
 }
@@ -285,16 +370,31 @@ impl EvalGroup<6> for Se3 {
     fn point_dims() -> usize {
         3
     }
-    fn point_through(pose: &UncertainPose<Self, 6>, point: &[f64], cov: &[Vec<f64>]) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+    fn point_through(
+        pose: &UncertainPose<Self, 6>,
+        point: &[f64],
+        cov: &[Vec<f64>],
+    ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
         point_estimate::<Self, 6, 3>(pose, point, cov)
     }
-    fn compound(x: &UncertainPose<Self, 6>, y: &UncertainPose<Self, 6>, order: Order) -> Option<Propagated<Self, 6>> {
+    fn compound(
+        x: &UncertainPose<Self, 6>,
+        y: &UncertainPose<Self, 6>,
+        order: Order,
+    ) -> Option<Propagated<Self, 6>> {
         Some(fourth_order::compound_se3(x, y, order))
     }
-    fn ssc_compose(x: &UncertainPose<Self, 6>, y: &UncertainPose<Self, 6>) -> Option<crate::Result<Propagated<Self, 6>>> {
+    fn ssc_compose(
+        x: &UncertainPose<Self, 6>,
+        y: &UncertainPose<Self, 6>,
+    ) -> Option<crate::Result<Propagated<Self, 6>>> {
         Some(ssc_compose_in(x, y))
     }
-    fn ssc_odometry(start: &UncertainPose<Self, 6>, increments: &[Self], noise: &TangentMatrix<6>) -> Option<crate::Result<Vec<Propagated<Self, 6>>>> {
+    fn ssc_odometry(
+        start: &UncertainPose<Self, 6>,
+        increments: &[Self],
+        noise: &TangentMatrix<6>,
+    ) -> Option<crate::Result<Vec<Propagated<Self, 6>>>> {
         Some(ssc_odometry_in(start, increments, noise))
     }
 }
@@ -310,7 +410,14 @@ fn operation_keys(kind: &str) -> Option<(&'static [&'static str], &'static [&'st
         "odometry" => (&["input", "controls", "noise", "model"], &["steps"]),
         "compound" => (&["input", "by", "noise", "steps"], &[]),
         "diff_drive" => (
-            &["wheel_radius", "wheelbase", "duration", "diffusion", "speed", "turn_rate"],
+            &[
+                "wheel_radius",
+                "wheelbase",
+                "duration",
+                "diffusion",
+                "speed",
+                "turn_rate",
+            ],
             &["input", "dt"],
         ),
         "point_through_pose" => (&["input", "point"], &["point_cov"]),
@@ -370,21 +477,35 @@ struct Engine<'a, G: EvalGroup<N>, const N: usize> {
 }
 
 impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
-    fn run(scenario: &'a Scenario, meta: Meta, options: &EvalOptions) -> Result<Evaluation<G, N>, ScenarioError> {
+    fn run(
+        scenario: &'a Scenario,
+        meta: Meta,
+        options: &EvalOptions,
+    ) -> Result<Evaluation<G, N>, ScenarioError> {
         let monte_carlo = meta.methods.contains(&Method::MonteCarlo);
         let mut engine = Engine {
             scenario,
             monte_carlo,
             cancel: options.cancel.clone(),
             names: HashMap::new(),
-            out: Evaluation { meta: meta.clone(), nodes: Vec::new(), points: Vec::new(), paths: Vec::new(), matrix_frames: Vec::new(), series: Vec::new(), notes: Vec::new() },
+            out: Evaluation {
+                meta: meta.clone(),
+                nodes: Vec::new(),
+                points: Vec::new(),
+                paths: Vec::new(),
+                matrix_frames: Vec::new(),
+                series: Vec::new(),
+                notes: Vec::new(),
+            },
             meta,
             families: 0,
         };
         engine.poses()?;
         for (index, op) in scenario.file.operations.iter().enumerate() {
             if engine.cancelled() {
-                engine.out.notes.push("*Evaluation interrupted: later operations were not evaluated.*".to_owned());
+                engine.out.notes.push(
+                    "*Evaluation interrupted: later operations were not evaluated.*".to_owned(),
+                );
                 break;
             }
             engine.operation(index, op)?;
@@ -394,17 +515,36 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
     }
 
     fn cancelled(&self) -> bool {
-        self.cancel.as_ref().is_some_and(|c| c.load(Ordering::Relaxed))
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
     }
 
-    fn err(&self, span: std::ops::Range<usize>, field: &str, message: impl Into<String>) -> ScenarioError {
+    fn err(
+        &self,
+        span: std::ops::Range<usize>,
+        field: &str,
+        message: impl Into<String>,
+    ) -> ScenarioError {
         self.scenario.locator.error(span, field, message)
     }
 
     /// A key the operation kind requires (checked by `operation_keys`; an error, not a panic,
     /// if that ever disagrees).
-    fn need<'b, T>(&self, value: &'b Option<T>, op: &OperationSpec, field: &str, key: &str) -> Result<&'b T, ScenarioError> {
-        value.as_ref().ok_or_else(|| self.err(op.kind.span(), &format!("{field}.{key}"), format!("`{}` needs `{key}`", op.kind.get_ref())))
+    fn need<'b, T>(
+        &self,
+        value: &'b Option<T>,
+        op: &OperationSpec,
+        field: &str,
+        key: &str,
+    ) -> Result<&'b T, ScenarioError> {
+        value.as_ref().ok_or_else(|| {
+            self.err(
+                op.kind.span(),
+                &format!("{field}.{key}"),
+                format!("`{}` needs `{key}`", op.kind.get_ref()),
+            )
+        })
     }
 
     fn wants(&self, method: Method) -> bool {
@@ -420,26 +560,67 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
     // Inputs.
 
     fn poses(&mut self) -> Result<(), ScenarioError> {
-        let root = self.scenario.file.poses.iter().find(|p| p.cov.is_some()).and_then(|p| parent_frame(p.name.get_ref()));
+        let root = self
+            .scenario
+            .file
+            .poses
+            .iter()
+            .find(|p| p.cov.is_some())
+            .and_then(|p| parent_frame(p.name.get_ref()));
         for (i, spec) in self.scenario.file.poses.iter().enumerate() {
             let field = format!("pose[{i}]");
             let name = spec.name.get_ref().clone();
-            check_name(&name).map_err(|m| self.err(spec.name.span(), &format!("{field}.name"), m))?;
+            check_name(&name)
+                .map_err(|m| self.err(spec.name.span(), &format!("{field}.name"), m))?;
             if self.names.contains_key(&name) {
-                return Err(self.err(spec.name.span(), &format!("{field}.name"), format!("`{name}` is already defined")));
+                return Err(self.err(
+                    spec.name.span(),
+                    &format!("{field}.name"),
+                    format!("`{name}` is already defined"),
+                ));
             }
-            let mean: G = mean_for(spec.mean.get_ref()).map_err(|m| self.err(spec.mean.span(), &format!("{field}.mean"), m))?;
+            let mean: G = mean_for(spec.mean.get_ref())
+                .map_err(|m| self.err(spec.mean.span(), &format!("{field}.mean"), m))?;
             let Some(cov) = &spec.cov else {
                 self.names.insert(name.clone(), Value::Fixed(mean));
-                let draw = spec.draw.unwrap_or_else(|| root.is_some() && parent_frame(&name) == root);
-                self.out.nodes.push(Node { name, role: Role::Fixed, step: None, draw, nominal: mean, estimates: Vec::new(), particles: None });
+                let draw = spec
+                    .draw
+                    .unwrap_or_else(|| root.is_some() && parent_frame(&name) == root);
+                self.out.nodes.push(Node {
+                    name,
+                    role: Role::Fixed,
+                    step: None,
+                    draw,
+                    nominal: mean,
+                    estimates: Vec::new(),
+                    particles: None,
+                });
                 continue;
             };
-            let (cov_matrix, side) = cov_for::<G, N>(cov.get_ref(), &mean).map_err(|m| self.err(cov.span(), &format!("{field}.cov"), m))?;
+            let (cov_matrix, side) = cov_for::<G, N>(cov.get_ref(), &mean)
+                .map_err(|m| self.err(cov.span(), &format!("{field}.cov"), m))?;
             let pose = UncertainPose::new_unchecked(mean, cov_matrix, side);
-            let particles = if self.monte_carlo { Some(Arc::new(self.sample(&pose))) } else { None };
-            let estimate = Estimate { result: Propagated { pose, method: Method::Exact }, error_vs_monte_carlo: None };
-            self.push_node(Node { name, role: Role::Input, step: None, draw: spec.draw.unwrap_or(true), nominal: mean, estimates: vec![estimate], particles });
+            let particles = if self.monte_carlo {
+                Some(Arc::new(self.sample(&pose)))
+            } else {
+                None
+            };
+            let estimate = Estimate {
+                result: Propagated {
+                    pose,
+                    method: Method::Exact,
+                },
+                error_vs_monte_carlo: None,
+            };
+            self.push_node(Node {
+                name,
+                role: Role::Input,
+                step: None,
+                draw: spec.draw.unwrap_or(true),
+                nominal: mean,
+                estimates: vec![estimate],
+                particles,
+            });
         }
         Ok(())
     }
@@ -455,7 +636,8 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
     }
 
     fn push_node(&mut self, node: Node<G, N>) {
-        self.names.insert(node.name.clone(), Value::Node(self.out.nodes.len()));
+        self.names
+            .insert(node.name.clone(), Value::Node(self.out.nodes.len()));
         self.out.nodes.push(node);
     }
 
@@ -464,7 +646,15 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             let mut known: Vec<&String> = self.names.keys().collect();
             known.sort();
             let known: Vec<&str> = known.iter().map(|s| s.as_str()).collect();
-            self.err(name.span(), field, format!("no pose named `{}` (defined so far: {})", name.get_ref(), known.join(", ")))
+            self.err(
+                name.span(),
+                field,
+                format!(
+                    "no pose named `{}` (defined so far: {})",
+                    name.get_ref(),
+                    known.join(", ")
+                ),
+            )
         })
     }
 
@@ -477,7 +667,12 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 let pose = node
                     .estimates
                     .iter()
-                    .find(|e| matches!(e.result.method, Method::Exact | Method::FirstOrder | Method::ClosedForm))
+                    .find(|e| {
+                        matches!(
+                            e.result.method,
+                            Method::Exact | Method::FirstOrder | Method::ClosedForm
+                        )
+                    })
                     .or(node.estimates.first())
                     .map_or(UncertainPose::certain(node.nominal), |e| e.result.pose);
                 (pose, node.particles.clone())
@@ -488,7 +683,14 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
     fn fixed(&self, name: &Spanned<String>, field: &str) -> Result<G, ScenarioError> {
         match self.lookup(name, field)? {
             Value::Fixed(g) => Ok(g),
-            Value::Node(_) => Err(self.err(name.span(), field, format!("`{}` must be a known transform (a pose without `cov`)", name.get_ref()))),
+            Value::Node(_) => Err(self.err(
+                name.span(),
+                field,
+                format!(
+                    "`{}` must be a known transform (a pose without `cov`)",
+                    name.get_ref()
+                ),
+            )),
         }
     }
 
@@ -499,85 +701,171 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         let field = format!("operation[{index}]");
         let kind = op.kind.get_ref().as_str();
         let Some((required, optional)) = operation_keys(kind) else {
-            return Err(self.err(op.kind.span(), &format!("{field}.kind"), format!("unknown operation `{kind}`; expected one of {}", super::schema::OPERATION_KINDS.join(", "))));
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.kind"),
+                format!(
+                    "unknown operation `{kind}`; expected one of {}",
+                    super::schema::OPERATION_KINDS.join(", ")
+                ),
+            ));
         };
         let set = keys_set(op);
-        if let Some(extra) = set.iter().find(|k| !required.contains(k) && !optional.contains(k)) {
+        if let Some(extra) = set
+            .iter()
+            .find(|k| !required.contains(k) && !optional.contains(k))
+        {
             let mut takes: Vec<&str> = required.to_vec();
             takes.extend(optional);
-            return Err(self.err(op.kind.span(), &format!("{field}.{extra}"), format!("`{extra}` does not apply to `{kind}`, which takes {} (and output)", takes.join(", "))));
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.{extra}"),
+                format!(
+                    "`{extra}` does not apply to `{kind}`, which takes {} (and output)",
+                    takes.join(", ")
+                ),
+            ));
         }
         if let Some(missing) = required.iter().find(|k| !set.contains(k)) {
-            return Err(self.err(op.kind.span(), &format!("{field}.{missing}"), format!("`{kind}` needs `{missing}`")));
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.{missing}"),
+                format!("`{kind}` needs `{missing}`"),
+            ));
         }
         let output = op.output.get_ref().clone();
-        check_name(&output).map_err(|m| self.err(op.output.span(), &format!("{field}.output"), m))?;
+        check_name(&output)
+            .map_err(|m| self.err(op.output.span(), &format!("{field}.output"), m))?;
         if self.names.contains_key(&output) {
-            return Err(self.err(op.output.span(), &format!("{field}.output"), format!("`{output}` is already defined")));
+            return Err(self.err(
+                op.output.span(),
+                &format!("{field}.output"),
+                format!("`{output}` is already defined"),
+            ));
         }
         let f = |k: &str| format!("{field}.{k}");
         match kind {
             "inverse" => {
-                let (x, px) = self.gaussian(self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?);
+                let (x, px) = self.gaussian(
+                    self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?,
+                );
                 let fo = first_order::inverse(&x);
                 let particles = px.map(|p| map_particles(&p, |g| g.inverse()));
                 self.output(output, fo, particles, |g: &[G]| g[0].inverse(), &[x]);
             }
             "change_frame_left" => {
-                let (x, px) = self.gaussian(self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?);
+                let (x, px) = self.gaussian(
+                    self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?,
+                );
                 let a = self.fixed(self.need(&op.by, op, &field, "by")?, &f("by"))?;
                 let fo = first_order::change_frame_left(&a, &x);
                 let particles = px.map(|p| map_particles(&p, |g| a.compose(g)));
-                let extra = self.vector_space(&UncertainPose::certain(a), &x, &output).into_iter().collect();
-                self.output_with(output, None, fo, extra, particles, move |g: &[G]| a.compose(&g[0]), &[x]);
+                let extra = self
+                    .vector_space(&UncertainPose::certain(a), &x, &output)
+                    .into_iter()
+                    .collect();
+                self.output_with(
+                    output,
+                    None,
+                    fo,
+                    extra,
+                    particles,
+                    move |g: &[G]| a.compose(&g[0]),
+                    &[x],
+                );
             }
             "change_frame_right" => {
-                let (x, px) = self.gaussian(self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?);
+                let (x, px) = self.gaussian(
+                    self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?,
+                );
                 let b = self.fixed(self.need(&op.by, op, &field, "by")?, &f("by"))?;
                 let fo = first_order::change_frame_right(&x, &b);
                 let particles = px.map(|p| map_particles(&p, |g| g.compose(&b)));
-                let extra = self.vector_space(&x, &UncertainPose::certain(b), &output).into_iter().collect();
-                self.output_with(output, None, fo, extra, particles, move |g: &[G]| g[0].compose(&b), &[x]);
+                let extra = self
+                    .vector_space(&x, &UncertainPose::certain(b), &output)
+                    .into_iter()
+                    .collect();
+                self.output_with(
+                    output,
+                    None,
+                    fo,
+                    extra,
+                    particles,
+                    move |g: &[G]| g[0].compose(&b),
+                    &[x],
+                );
             }
             "compose" | "between" => {
-                let (x, px) = self.gaussian(self.lookup(self.need(&op.lhs, op, &field, "lhs")?, &f("lhs"))?);
-                let (y, py) = self.gaussian(self.lookup(self.need(&op.rhs, op, &field, "rhs")?, &f("rhs"))?);
+                let (x, px) =
+                    self.gaussian(self.lookup(self.need(&op.lhs, op, &field, "lhs")?, &f("lhs"))?);
+                let (y, py) =
+                    self.gaussian(self.lookup(self.need(&op.rhs, op, &field, "rhs")?, &f("rhs"))?);
                 let compose = kind == "compose";
-                let fo = if compose { first_order::compose(&x, &y) } else { first_order::between(&x, &y) };
-                let particles = self.pair_particles(px, py, &x, &y, |a, b| if compose { a.compose(b) } else { a.between(b) });
+                let fo = if compose {
+                    first_order::compose(&x, &y)
+                } else {
+                    first_order::between(&x, &y)
+                };
+                let particles = self.pair_particles(px, py, &x, &y, |a, b| {
+                    if compose { a.compose(b) } else { a.between(b) }
+                });
                 let mut extra = Vec::new();
                 if compose {
-                    for (order, method) in [(Order::Second, Method::SecondOrder), (Order::Fourth, Method::FourthOrder)] {
+                    for (order, method) in [
+                        (Order::Second, Method::SecondOrder),
+                        (Order::Fourth, Method::FourthOrder),
+                    ] {
                         if self.wants(method) {
                             extra.extend(G::compound(&x, &y, order));
                         }
                     }
                     extra.extend(self.vector_space(&x, &y, &output));
                 }
-                let map = move |g: &[G]| if compose { g[0].compose(&g[1]) } else { g[0].between(&g[1]) };
+                let map = move |g: &[G]| {
+                    if compose {
+                        g[0].compose(&g[1])
+                    } else {
+                        g[0].between(&g[1])
+                    }
+                };
                 self.output_with(output, None, fo, extra, particles, map, &[x, y]);
             }
-            "compose_correlated" | "between_correlated" => self.correlated(op, &field, output, kind == "compose_correlated")?,
+            "compose_correlated" | "between_correlated" => {
+                self.correlated(op, &field, output, kind == "compose_correlated")?
+            }
             "odometry" => self.odometry(op, &field, output)?,
             "compound" => self.compound(op, &field, output)?,
             "point_through_pose" => self.point_through_pose(op, &field, output)?,
             "fuse" => self.fuse(op, &field, output)?,
             "diff_drive" => self.diff_drive(op, &field, output)?,
             "euler_vs_exp" => self.euler_vs_exp(op, &field, output)?,
-            _ => return Err(self.err(op.kind.span(), &format!("{field}.kind"), format!("`{kind}` is not available for {} yet", G::NAME))),
+            _ => {
+                return Err(self.err(
+                    op.kind.span(),
+                    &format!("{field}.kind"),
+                    format!("`{kind}` is not available for {} yet", G::NAME),
+                ));
+            }
         }
         Ok(())
     }
 
     /// The Smith–Self–Cheeseman compose X·Y in vector coordinates, when requested and defined.
-    fn vector_space(&mut self, x: &UncertainPose<G, N>, y: &UncertainPose<G, N>, output: &str) -> Option<Propagated<G, N>> {
+    fn vector_space(
+        &mut self,
+        x: &UncertainPose<G, N>,
+        y: &UncertainPose<G, N>,
+        output: &str,
+    ) -> Option<Propagated<G, N>> {
         if !self.wants(Method::VectorSpace) {
             return None;
         }
         match G::ssc_compose(x, y)? {
             Ok(r) => Some(r),
             Err(e) => {
-                self.out.notes.push(format!("Vector-space compose for `{output}` failed: {e}."));
+                self.out
+                    .notes
+                    .push(format!("Vector-space compose for `{output}` failed: {e}."));
                 None
             }
         }
@@ -598,12 +886,21 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         let n = self.meta.samples;
         let px = px.unwrap_or_else(|| Arc::new(vec![*x.mean(); n]));
         let py = py.unwrap_or_else(|| Arc::new(vec![*y.mean(); n]));
-        Some(Arc::new(px.iter().zip(py.iter()).map(|(a, b)| f(a, b)).collect()))
+        Some(Arc::new(
+            px.iter().zip(py.iter()).map(|(a, b)| f(a, b)).collect(),
+        ))
     }
 
     /// Adds an output node with the first-order result and, where requested, the other
     /// general methods (sigma points through `map`, Monte Carlo from the particles).
-    fn output(&mut self, name: String, first: Propagated<G, N>, particles: Option<Arc<Vec<G>>>, map: impl Fn(&[G]) -> G + Sync, inputs: &[UncertainPose<G, N>]) {
+    fn output(
+        &mut self,
+        name: String,
+        first: Propagated<G, N>,
+        particles: Option<Arc<Vec<G>>>,
+        map: impl Fn(&[G]) -> G + Sync,
+        inputs: &[UncertainPose<G, N>],
+    ) {
         self.output_with(name, None, first, Vec::new(), particles, map, inputs);
     }
 
@@ -618,34 +915,89 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         map: impl Fn(&[G]) -> G + Sync,
         inputs: &[UncertainPose<G, N>],
     ) {
-        let mut estimates = vec![Estimate { result: first, error_vs_monte_carlo: None }];
-        estimates.extend(extra.into_iter().map(|result| Estimate { result, error_vs_monte_carlo: None }));
+        let mut estimates = vec![Estimate {
+            result: first,
+            error_vs_monte_carlo: None,
+        }];
+        estimates.extend(extra.into_iter().map(|result| Estimate {
+            result,
+            error_vs_monte_carlo: None,
+        }));
         if self.wants(Method::SigmaPoints) && !inputs.is_empty() {
             match sigma_point::map(inputs, &map, &Unscented::default()) {
-                Ok(result) => estimates.push(Estimate { result, error_vs_monte_carlo: None }),
-                Err(e) => self.out.notes.push(format!("Sigma points for `{name}` failed: {e}.")),
+                Ok(result) => estimates.push(Estimate {
+                    result,
+                    error_vs_monte_carlo: None,
+                }),
+                Err(e) => self
+                    .out
+                    .notes
+                    .push(format!("Sigma points for `{name}` failed: {e}.")),
             }
         }
         let nominal = *first.pose.mean();
-        self.push_node(Node { name, role: Role::Output, step, draw: true, nominal, estimates, particles });
+        self.push_node(Node {
+            name,
+            role: Role::Output,
+            step,
+            draw: true,
+            nominal,
+            estimates,
+            particles,
+        });
     }
 
-    fn correlated(&mut self, op: &OperationSpec, field: &str, output: String, compose: bool) -> Result<(), ScenarioError> {
-        let (x, _) = self.gaussian(self.lookup(self.need(&op.lhs, op, field, "lhs")?, &format!("{field}.lhs"))?);
-        let (y, _) = self.gaussian(self.lookup(self.need(&op.rhs, op, field, "rhs")?, &format!("{field}.rhs"))?);
+    fn correlated(
+        &mut self,
+        op: &OperationSpec,
+        field: &str,
+        output: String,
+        compose: bool,
+    ) -> Result<(), ScenarioError> {
+        let (x, _) = self.gaussian(self.lookup(
+            self.need(&op.lhs, op, field, "lhs")?,
+            &format!("{field}.lhs"),
+        )?);
+        let (y, _) = self.gaussian(self.lookup(
+            self.need(&op.rhs, op, field, "rhs")?,
+            &format!("{field}.rhs"),
+        )?);
         let cross = self.need(&op.cross_cov, op, field, "cross_cov")?;
-        let cross_xy: TangentMatrix<N> = fixed_matrix::<N, N>("cross_cov", cross.get_ref()).map_err(|m| self.err(cross.span(), &format!("{field}.cross_cov"), m))?;
+        let cross_xy: TangentMatrix<N> = fixed_matrix::<N, N>("cross_cov", cross.get_ref())
+            .map_err(|m| self.err(cross.span(), &format!("{field}.cross_cov"), m))?;
         let y = y.to_side(x.side());
         let mut joint = DMatrix::zeros(2 * N, 2 * N);
         joint.view_mut((0, 0), (N, N)).copy_from(x.cov());
         joint.view_mut((0, N), (N, N)).copy_from(&cross_xy);
-        joint.view_mut((N, 0), (N, N)).copy_from(&cross_xy.transpose());
+        joint
+            .view_mut((N, 0), (N, N))
+            .copy_from(&cross_xy.transpose());
         joint.view_mut((N, N), (N, N)).copy_from(y.cov());
-        let pair = CorrelatedPair::try_new(*x.mean(), *y.mean(), &joint, x.side())
-            .map_err(|e| self.err(cross.span(), &format!("{field}.cross_cov"), format!("the joint covariance [[Σ_X, Σ_XY], [Σ_XYᵀ, Σ_Y]] is invalid: {e}")))?;
-        let fo = if compose { first_order::compose_correlated(&pair) } else { first_order::between_correlated(&pair) };
-        let particles = if self.monte_carlo { Some(Arc::new(self.joint_particles(&pair, compose))) } else { None };
-        let map = move |g: &[G]| if compose { g[0].compose(&g[1]) } else { g[0].between(&g[1]) };
+        let pair =
+            CorrelatedPair::try_new(*x.mean(), *y.mean(), &joint, x.side()).map_err(|e| {
+                self.err(
+                    cross.span(),
+                    &format!("{field}.cross_cov"),
+                    format!("the joint covariance [[Σ_X, Σ_XY], [Σ_XYᵀ, Σ_Y]] is invalid: {e}"),
+                )
+            })?;
+        let fo = if compose {
+            first_order::compose_correlated(&pair)
+        } else {
+            first_order::between_correlated(&pair)
+        };
+        let particles = if self.monte_carlo {
+            Some(Arc::new(self.joint_particles(&pair, compose)))
+        } else {
+            None
+        };
+        let map = move |g: &[G]| {
+            if compose {
+                g[0].compose(&g[1])
+            } else {
+                g[0].between(&g[1])
+            }
+        };
         self.output(output, fo, particles, map, &[x, y]);
         Ok(())
     }
@@ -664,7 +1016,8 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             for z in chunk.iter_mut() {
                 let a = standard_normal::<N, _>(rng);
                 let b = standard_normal::<N, _>(rng);
-                let stacked = nalgebra::DVector::from_iterator(2 * N, a.iter().chain(b.iter()).copied());
+                let stacked =
+                    nalgebra::DVector::from_iterator(2 * N, a.iter().chain(b.iter()).copied());
                 let e = &factor * stacked;
                 let ex = Tangent::<N>::from_iterator(e.rows(0, N).iter().copied());
                 let ey = Tangent::<N>::from_iterator(e.rows(N, N).iter().copied());
@@ -672,27 +1025,49 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                     Side::Right => (mx.rplus(&ex), my.rplus(&ey)),
                     Side::Left => (mx.lplus(&ex), my.lplus(&ey)),
                 };
-                *z = if compose { x.compose(&y) } else { x.between(&y) };
+                *z = if compose {
+                    x.compose(&y)
+                } else {
+                    x.between(&y)
+                };
             }
         });
         out
     }
 
-    fn noise_cov(&self, op: &OperationSpec, field: &str, mean: &G) -> Result<(TangentMatrix<N>, Side), ScenarioError> {
+    fn noise_cov(
+        &self,
+        op: &OperationSpec,
+        field: &str,
+        mean: &G,
+    ) -> Result<(TangentMatrix<N>, Side), ScenarioError> {
         let noise = self.need(&op.noise, op, field, "noise")?;
-        cov_for::<G, N>(noise.get_ref(), mean).map_err(|m| self.err(noise.span(), &format!("{field}.noise"), m))
+        cov_for::<G, N>(noise.get_ref(), mean)
+            .map_err(|m| self.err(noise.span(), &format!("{field}.noise"), m))
     }
 
     fn steps(&self, op: &OperationSpec, field: &str) -> Result<Option<u64>, ScenarioError> {
         match &op.steps {
             None => Ok(None),
             Some(s) if (1..=100_000).contains(s.get_ref()) => Ok(Some(*s.get_ref())),
-            Some(s) => Err(self.err(s.span(), &format!("{field}.steps"), format!("{} is out of range: use 1 ..= 100000", s.get_ref()))),
+            Some(s) => Err(self.err(
+                s.span(),
+                &format!("{field}.steps"),
+                format!("{} is out of range: use 1 ..= 100000", s.get_ref()),
+            )),
         }
     }
 
-    fn odometry(&mut self, op: &OperationSpec, field: &str, output: String) -> Result<(), ScenarioError> {
-        let (start, start_particles) = self.gaussian(self.lookup(self.need(&op.input, op, field, "input")?, &format!("{field}.input"))?);
+    fn odometry(
+        &mut self,
+        op: &OperationSpec,
+        field: &str,
+        output: String,
+    ) -> Result<(), ScenarioError> {
+        let (start, start_particles) = self.gaussian(self.lookup(
+            self.need(&op.input, op, field, "input")?,
+            &format!("{field}.input"),
+        )?);
         let model_spec = self.need(&op.model, op, field, "model")?;
         let increment = match model_spec.get_ref().as_str() {
             "increment" => true,
@@ -701,42 +1076,76 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         };
         let (noise, noise_side) = self.noise_cov(op, field, start.mean())?;
         if noise_side != Side::Right {
-            return Err(self.err(self.need(&op.noise, op, field, "noise")?.span(), &format!("{field}.noise"), "odometry noise enters on the right (body frame): remove `side = \"left\"`"));
+            return Err(self.err(
+                self.need(&op.noise, op, field, "noise")?.span(),
+                &format!("{field}.noise"),
+                "odometry noise enters on the right (body frame): remove `side = \"left\"`",
+            ));
         }
         let controls_spec = self.need(&op.controls, op, field, "controls")?;
         let mut controls = Vec::new();
         for (i, c) in controls_spec.get_ref().iter().enumerate() {
-            let control = control_for::<G, N>(c, increment).map_err(|m| self.err(controls_spec.span(), &format!("{field}.controls[{i}]"), m))?;
+            let control = control_for::<G, N>(c, increment).map_err(|m| {
+                self.err(controls_spec.span(), &format!("{field}.controls[{i}]"), m)
+            })?;
             controls.push(control);
         }
         if controls.is_empty() {
-            return Err(self.err(controls_spec.span(), &format!("{field}.controls"), "needs at least one control"));
+            return Err(self.err(
+                controls_spec.span(),
+                &format!("{field}.controls"),
+                "needs at least one control",
+            ));
         }
         if let Some(steps) = self.steps(op, field)? {
             if controls.len() != 1 {
-                return Err(self.err(self.need(&op.steps, op, field, "steps")?.span(), &format!("{field}.steps"), "`steps` repeats a single control: give one control, or drop `steps`"));
+                return Err(self.err(
+                    self.need(&op.steps, op, field, "steps")?.span(),
+                    &format!("{field}.steps"),
+                    "`steps` repeats a single control: give one control, or drop `steps`",
+                ));
             }
             controls = vec![controls[0]; steps as usize];
         }
         // Analytic recursions, one result per step (index 0 is the start).
         let mut tracks: Vec<Vec<Propagated<G, N>>> = Vec::new();
         let start_right = start.to_side(Side::Right);
-        let at = |e: crate::Error| self.err(controls_spec.span(), &format!("{field}.controls"), e.to_string());
+        let at = |e: crate::Error| {
+            self.err(
+                controls_spec.span(),
+                &format!("{field}.controls"),
+                e.to_string(),
+            )
+        };
         if increment {
             let increments: Vec<G> = controls.iter().map(|(g, _)| *g).collect();
             tracks.push(propagate_increments(&start_right, &increments, &noise).map_err(at)?);
         } else {
             let inputs: Vec<Tangent<N>> = controls.iter().map(|(_, u)| *u).collect();
-            tracks.push(propagate_tangent_inputs(&start_right, &inputs, &noise, InputNoise::RightJacobian).map_err(at)?);
+            tracks.push(
+                propagate_tangent_inputs(&start_right, &inputs, &noise, InputNoise::RightJacobian)
+                    .map_err(at)?,
+            );
             if self.wants(Method::LectureNoJr) {
-                tracks.push(propagate_tangent_inputs(&start_right, &inputs, &noise, InputNoise::LectureNoJr).map_err(at)?);
+                tracks.push(
+                    propagate_tangent_inputs(
+                        &start_right,
+                        &inputs,
+                        &noise,
+                        InputNoise::LectureNoJr,
+                    )
+                    .map_err(at)?,
+                );
             }
         }
         if self.wants(Method::VectorSpace) {
             let increments: Vec<G> = controls.iter().map(|(g, _)| *g).collect();
             match G::ssc_odometry(&start_right, &increments, &noise) {
                 Some(Ok(track)) => tracks.push(track),
-                Some(Err(e)) => self.out.notes.push(format!("Vector-space odometry failed: {e}.")),
+                Some(Err(e)) => self
+                    .out
+                    .notes
+                    .push(format!("Vector-space odometry failed: {e}.")),
                 None => {}
             }
         }
@@ -759,7 +1168,11 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 if let Some(sampler) = &sampler {
                     fill_par_map(&mut current, seed, family, |rng, x| {
                         let w = sampler.draw_tangent(rng);
-                        if increment { x.compose(u_group).rplus(&w) } else { x.rplus(&(u_tangent + w)) }
+                        if increment {
+                            x.compose(u_group).rplus(&w)
+                        } else {
+                            x.rplus(&(u_tangent + w))
+                        }
                     });
                 }
                 particle_steps[k + 1] = Some(Arc::new(current.clone()));
@@ -767,35 +1180,81 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         }
         let first = &tracks[0];
         for (k, result) in first.iter().enumerate() {
-            let extra: Vec<Propagated<G, N>> = tracks[1..].iter().filter_map(|t| t.get(k).copied()).collect();
+            let extra: Vec<Propagated<G, N>> = tracks[1..]
+                .iter()
+                .filter_map(|t| t.get(k).copied())
+                .collect();
             let particles = particle_steps.get(k).cloned().flatten();
-            self.output_with(output.clone(), Some(k as u64), *result, extra, particles, |g: &[G]| g[0], &[]);
+            self.output_with(
+                output.clone(),
+                Some(k as u64),
+                *result,
+                extra,
+                particles,
+                |g: &[G]| g[0],
+                &[],
+            );
         }
-        self.out.paths.push(PosePath { name: format!("{output}/nominal"), method: None, poses: first.iter().map(|r| *r.pose.mean()).collect() });
+        self.out.paths.push(PosePath {
+            name: format!("{output}/nominal"),
+            method: None,
+            poses: first.iter().map(|r| *r.pose.mean()).collect(),
+        });
         self.trace_series(&output);
         Ok(())
     }
 
     /// Barfoot & Furgale's repeated compounding T_k = (Exp(w) T̄) · T_{k−1}, left form.
-    fn compound(&mut self, op: &OperationSpec, field: &str, output: String) -> Result<(), ScenarioError> {
-        let (start, start_particles) = self.gaussian(self.lookup(self.need(&op.input, op, field, "input")?, &format!("{field}.input"))?);
+    fn compound(
+        &mut self,
+        op: &OperationSpec,
+        field: &str,
+        output: String,
+    ) -> Result<(), ScenarioError> {
+        let (start, start_particles) = self.gaussian(self.lookup(
+            self.need(&op.input, op, field, "input")?,
+            &format!("{field}.input"),
+        )?);
         let step_mean = self.fixed(self.need(&op.by, op, field, "by")?, &format!("{field}.by"))?;
         let (noise, noise_side) = self.noise_cov(op, field, &step_mean)?;
         let steps = self.steps(op, field)?.unwrap_or(1);
         let increment = UncertainPose::new_unchecked(step_mean, noise, noise_side);
-        let orders: Vec<(Order, Method)> = [(Order::Second, Method::SecondOrder), (Order::Fourth, Method::FourthOrder)]
-            .into_iter()
-            .filter(|(_, m)| self.wants(*m))
+        let orders: Vec<(Order, Method)> = [
+            (Order::Second, Method::SecondOrder),
+            (Order::Fourth, Method::FourthOrder),
+        ]
+        .into_iter()
+        .filter(|(_, m)| self.wants(*m))
+        .collect();
+        let mut first = Propagated {
+            pose: start.to_side(noise_side),
+            method: Method::FirstOrder,
+        };
+        let mut higher: Vec<Propagated<G, N>> = orders
+            .iter()
+            .map(|(_, m)| Propagated {
+                pose: start.to_side(Side::Left),
+                method: *m,
+            })
             .collect();
-        let mut first = Propagated { pose: start.to_side(noise_side), method: Method::Exact };
-        let mut higher: Vec<Propagated<G, N>> = orders.iter().map(|(_, m)| Propagated { pose: start.to_side(Side::Left), method: *m }).collect();
         let mut current: Option<Vec<G>> = if self.monte_carlo {
-            Some(start_particles.map_or_else(|| vec![*start.mean(); self.meta.samples], |p| p.as_ref().clone()))
+            Some(start_particles.map_or_else(
+                || vec![*start.mean(); self.meta.samples],
+                |p| p.as_ref().clone(),
+            ))
         } else {
             None
         };
         let sampler = Sampler::new(&increment).ok();
-        self.output_with(output.clone(), Some(0), first, higher.clone(), current.clone().map(Arc::new), |g: &[G]| g[0], &[]);
+        self.output_with(
+            output.clone(),
+            Some(0),
+            first,
+            higher.clone(),
+            current.clone().map(Arc::new),
+            |g: &[G]| g[0],
+            &[],
+        );
         for k in 1..=steps {
             if self.cancelled() {
                 break;
@@ -808,30 +1267,69 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             }
             if let (Some(particles), Some(sampler)) = (current.as_mut(), &sampler) {
                 let family = self.next_family();
-                fill_par_map(particles, self.meta.seed, family, |rng, x| sampler.draw(rng).compose(x));
+                fill_par_map(particles, self.meta.seed, family, |rng, x| {
+                    sampler.draw(rng).compose(x)
+                });
             }
-            self.output_with(output.clone(), Some(k), first, higher.clone(), current.clone().map(Arc::new), |g: &[G]| g[0], &[]);
+            self.output_with(
+                output.clone(),
+                Some(k),
+                first,
+                higher.clone(),
+                current.clone().map(Arc::new),
+                |g: &[G]| g[0],
+                &[],
+            );
         }
-        let poses = self.out.nodes.iter().filter(|n| n.name == output).map(|n| n.nominal).collect();
-        self.out.paths.push(PosePath { name: format!("{output}/nominal"), method: None, poses });
+        let poses = self
+            .out
+            .nodes
+            .iter()
+            .filter(|n| n.name == output)
+            .map(|n| n.nominal)
+            .collect();
+        self.out.paths.push(PosePath {
+            name: format!("{output}/nominal"),
+            method: None,
+            poses,
+        });
         self.trace_series(&output);
         self.along_track_series(&output);
         Ok(())
     }
 
-    fn point_through_pose(&mut self, op: &OperationSpec, field: &str, output: String) -> Result<(), ScenarioError> {
-        let (pose, particles) = self.gaussian(self.lookup(self.need(&op.input, op, field, "input")?, &format!("{field}.input"))?);
+    fn point_through_pose(
+        &mut self,
+        op: &OperationSpec,
+        field: &str,
+        output: String,
+    ) -> Result<(), ScenarioError> {
+        let (pose, particles) = self.gaussian(self.lookup(
+            self.need(&op.input, op, field, "input")?,
+            &format!("{field}.input"),
+        )?);
         let point = self.need(&op.point, op, field, "point")?;
         let cov = op.point_cov.as_ref();
-        let at = |span: std::ops::Range<usize>, key: &str, m: String| self.err(span, &format!("{field}.{key}"), m);
+        let at = |span: std::ops::Range<usize>, key: &str, m: String| {
+            self.err(span, &format!("{field}.{key}"), m)
+        };
         let dims = G::point_dims();
         if point.get_ref().len() != dims || point.get_ref().iter().any(|v| !v.is_finite()) {
-            return Err(at(point.span(), "point", format!("needs {dims} finite coordinates for {}, got {:?}", G::NAME, point.get_ref())));
+            return Err(at(
+                point.span(),
+                "point",
+                format!(
+                    "needs {dims} finite coordinates for {}, got {:?}",
+                    G::NAME,
+                    point.get_ref()
+                ),
+            ));
         }
         let zeros = vec![vec![0.0; dims]; dims];
         let cov_rows = cov.map_or(&zeros, |c| c.get_ref());
         let cov_span = cov.map_or(point.span(), Spanned::span);
-        let (mean, cov_world) = G::point_through(&pose, point.get_ref(), cov_rows).map_err(|m| at(cov_span.clone(), "point_cov", m))?;
+        let (mean, cov_world) = G::point_through(&pose, point.get_ref(), cov_rows)
+            .map_err(|m| at(cov_span.clone(), "point_cov", m))?;
         let mut estimates = vec![(Method::FirstOrder, mean, cov_world)];
         let mut cloud = None;
         if let Some(particles) = particles.filter(|_| self.monte_carlo) {
@@ -844,57 +1342,114 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 for (i, q) in chunk.iter_mut().enumerate() {
                     let _ = i;
                     let z = standard_normal::<3, _>(rng);
-                    let noise = &factor * nalgebra::DVector::from_iterator(dims, z.iter().take(dims).copied());
+                    let noise = &factor
+                        * nalgebra::DVector::from_iterator(dims, z.iter().take(dims).copied());
                     let p: Vec<f64> = local.iter().zip(noise.iter()).map(|(a, b)| a + b).collect();
-                    *q = [p[0], p.get(1).copied().unwrap_or(0.0), p.get(2).copied().unwrap_or(0.0)];
+                    *q = [
+                        p[0],
+                        p.get(1).copied().unwrap_or(0.0),
+                        p.get(2).copied().unwrap_or(0.0),
+                    ];
                 }
             });
-            let moved: Vec<[f64; 3]> = particles.iter().zip(&points).map(|(x, q)| {
-                let w = x.to_se3().act(&Vector3::new(q[0], q[1], q[2]));
-                [w.x, w.y, w.z]
-            }).collect();
+            let moved: Vec<[f64; 3]> = particles
+                .iter()
+                .zip(&points)
+                .map(|(x, q)| {
+                    let w = x.to_se3().act(&Vector3::new(q[0], q[1], q[2]));
+                    [w.x, w.y, w.z]
+                })
+                .collect();
             let n = moved.len() as f64;
-            let m = moved.iter().fold(Vector3::zeros(), |a, q| a + Vector3::from(*q)) / n;
-            let c = moved.iter().fold(Matrix3::zeros(), |a, q| { let d = Vector3::from(*q) - m; a + d * d.transpose() }) / (n - 1.0);
-            estimates.push((Method::MonteCarlo, [m.x, m.y, m.z], [[c[(0, 0)], c[(0, 1)], c[(0, 2)]], [c[(1, 0)], c[(1, 1)], c[(1, 2)]], [c[(2, 0)], c[(2, 1)], c[(2, 2)]]]));
+            let m = moved
+                .iter()
+                .fold(Vector3::zeros(), |a, q| a + Vector3::from(*q))
+                / n;
+            let c = moved.iter().fold(Matrix3::zeros(), |a, q| {
+                let d = Vector3::from(*q) - m;
+                a + d * d.transpose()
+            }) / (n - 1.0);
+            estimates.push((
+                Method::MonteCarlo,
+                [m.x, m.y, m.z],
+                [
+                    [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
+                    [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
+                    [c[(2, 0)], c[(2, 1)], c[(2, 2)]],
+                ],
+            ));
             cloud = Some(moved);
         }
-        self.names.insert(output.clone(), Value::Fixed(G::identity()));
-        self.out.points.push(PointNode { name: output, estimates, particles: cloud });
+        self.names
+            .insert(output.clone(), Value::Fixed(G::identity()));
+        self.out.points.push(PointNode {
+            name: output,
+            estimates,
+            particles: cloud,
+        });
         Ok(())
     }
 
-    fn fuse(&mut self, op: &OperationSpec, field: &str, output: String) -> Result<(), ScenarioError> {
+    fn fuse(
+        &mut self,
+        op: &OperationSpec,
+        field: &str,
+        output: String,
+    ) -> Result<(), ScenarioError> {
         let inputs = op.inputs.as_deref().unwrap_or(&[]);
         let mut estimates = Vec::new();
         for (i, name) in inputs.iter().enumerate() {
             let (pose, _) = self.gaussian(self.lookup(name, &format!("{field}.inputs[{i}]"))?);
             estimates.push(pose);
         }
-        let fused = fuse(&estimates, FusionOptions::default()).map_err(|e| self.err(op.kind.span(), &format!("{field}.inputs"), e.to_string()))?;
+        let fused = fuse(&estimates, FusionOptions::default())
+            .map_err(|e| self.err(op.kind.span(), &format!("{field}.inputs"), e.to_string()))?;
         self.out.notes.push(format!("Fusion of {} estimates into `{output}`: final cost {:.4} after {} Gauss–Newton iterations.", estimates.len(), fused.cost, fused.iterations));
         self.output(output, fused.result, None, |g: &[G]| g[0], &[]);
         Ok(())
     }
 
-    fn positive(&self, value: &Option<Spanned<f64>>, op: &OperationSpec, field: &str, key: &str, allow_zero: bool) -> Result<f64, ScenarioError> {
+    fn positive(
+        &self,
+        value: &Option<Spanned<f64>>,
+        op: &OperationSpec,
+        field: &str,
+        key: &str,
+        allow_zero: bool,
+    ) -> Result<f64, ScenarioError> {
         let v = self.need(value, op, field, key)?;
         let x = *v.get_ref();
         if x.is_finite() && (x > 0.0 || (allow_zero && x == 0.0)) {
             Ok(x)
         } else {
-            Err(self.err(v.span(), &format!("{field}.{key}"), format!("{x} is out of range: must be finite and {}", if allow_zero { "≥ 0" } else { "> 0" })))
+            Err(self.err(
+                v.span(),
+                &format!("{field}.{key}"),
+                format!(
+                    "{x} is out of range: must be finite and {}",
+                    if allow_zero { "≥ 0" } else { "> 0" }
+                ),
+            ))
         }
     }
 
-    fn diff_drive(&mut self, op: &OperationSpec, field: &str, output: String) -> Result<(), ScenarioError> {
+    fn diff_drive(
+        &mut self,
+        op: &OperationSpec,
+        field: &str,
+        output: String,
+    ) -> Result<(), ScenarioError> {
         let start = match &op.input {
             Some(name) => self.fixed(name, &format!("{field}.input"))?,
             None => G::identity(),
         };
         let turn = self.need(&op.turn_rate, op, field, "turn_rate")?;
         if !turn.get_ref().is_finite() {
-            return Err(self.err(turn.span(), &format!("{field}.turn_rate"), format!("{} is not finite", turn.get_ref())));
+            return Err(self.err(
+                turn.span(),
+                &format!("{field}.turn_rate"),
+                format!("{} is not finite", turn.get_ref()),
+            ));
         }
         let params = DiffDriveParams {
             wheel_radius: self.positive(&op.wheel_radius, op, field, "wheel_radius", false)?,
@@ -903,12 +1458,29 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             diffusion: self.positive(&op.diffusion, op, field, "diffusion", true)?,
             speed: self.positive(&op.speed, op, field, "speed", false)?,
             turn_rate: *turn.get_ref(),
-            dt: if op.dt.is_some() { self.positive(&op.dt, op, field, "dt", false)? } else { 1e-3 },
-            samples: if self.monte_carlo { self.meta.samples } else { 0 },
+            dt: if op.dt.is_some() {
+                self.positive(&op.dt, op, field, "dt", false)?
+            } else {
+                1e-3
+            },
+            samples: if self.monte_carlo {
+                self.meta.samples
+            } else {
+                0
+            },
             seed: self.meta.seed.wrapping_add(self.next_family()),
         };
         let outcome = match G::diff_drive(&params) {
-            None => return Err(self.err(op.kind.span(), &format!("{field}.kind"), format!("`diff_drive` is a planar robot: it needs group = \"se2\", not {}", G::NAME))),
+            None => {
+                return Err(self.err(
+                    op.kind.span(),
+                    &format!("{field}.kind"),
+                    format!(
+                        "`diff_drive` is a planar robot: it needs group = \"se2\", not {}",
+                        G::NAME
+                    ),
+                ));
+            }
             Some(Err(e)) => return Err(self.err(op.kind.span(), field, e.to_string())),
             Some(Ok(o)) => o,
         };
@@ -918,39 +1490,83 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             .estimates
             .iter()
             .filter(|e| self.wants(e.method) || e.method == Method::ClosedForm)
-            .map(|e| Propagated { pose: first_order::change_frame_left(&start, &e.pose).pose, method: e.method })
+            .map(|e| Propagated {
+                pose: first_order::change_frame_left(&start, &e.pose).pose,
+                method: e.method,
+            })
             .collect();
-        let particles = (!outcome.end_poses.is_empty()).then(|| Arc::new(outcome.end_poses.iter().map(moved).collect::<Vec<G>>()));
-        if let Some(p) = &particles {
-            if let (Ok(stats), Some(nominal)) = (sample_statistics(p, Side::Right), outcome.nominal_path.last()) {
-                let lie = stats.mean.to_se3();
-                let cartesian = p.iter().map(|g| *g.to_se3().translation()).sum::<Vector3<f64>>() / p.len() as f64;
-                let nominal = moved(nominal).to_se3();
-                self.out.notes.push(format!(
-                    "`{output}` (D = {}): nominal end ({:.3}, {:.3}); **Lie mean** of the samples ({:.3}, {:.3}); **Cartesian mean** of their positions ({:.3}, {:.3}) — it retreats inside the banana.",
-                    params.diffusion, nominal.translation().x, nominal.translation().y, lie.translation().x, lie.translation().y, cartesian.x, cartesian.y
-                ));
-            }
+        let particles = (!outcome.end_poses.is_empty())
+            .then(|| Arc::new(outcome.end_poses.iter().map(moved).collect::<Vec<G>>()));
+        if let Some(p) = &particles
+            && let (Ok(stats), Some(nominal)) = (
+                sample_statistics(p, Side::Right),
+                outcome.nominal_path.last(),
+            )
+        {
+            let lie = stats.mean.to_se3();
+            let cartesian = p
+                .iter()
+                .map(|g| *g.to_se3().translation())
+                .sum::<Vector3<f64>>()
+                / p.len() as f64;
+            let nominal = moved(nominal).to_se3();
+            self.out.notes.push(format!(
+                "`{output}` (D = {}): nominal end ({:.3}, {:.3}); **Lie mean** of the samples ({:.3}, {:.3}); **Cartesian mean** of their positions ({:.3}, {:.3}) — it retreats inside the banana.",
+                params.diffusion, nominal.translation().x, nominal.translation().y, lie.translation().x, lie.translation().y, cartesian.x, cartesian.y
+            ));
         }
         let first = estimates.remove(0);
-        self.output_with(output.clone(), None, first, estimates, particles, |g: &[G]| g[0], &[]);
-        self.out.paths.push(PosePath { name: format!("{output}/nominal"), method: None, poses: outcome.nominal_path.iter().map(moved).collect() });
+        self.output_with(
+            output.clone(),
+            None,
+            first,
+            estimates,
+            particles,
+            |g: &[G]| g[0],
+            &[],
+        );
+        self.out.paths.push(PosePath {
+            name: format!("{output}/nominal"),
+            method: None,
+            poses: outcome.nominal_path.iter().map(moved).collect(),
+        });
         for (i, t) in outcome.trajectories.iter().enumerate() {
-            self.out.paths.push(PosePath { name: format!("{output}/samples/{i}"), method: Some(Method::MonteCarlo), poses: t.iter().map(moved).collect() });
+            self.out.paths.push(PosePath {
+                name: format!("{output}/samples/{i}"),
+                method: Some(Method::MonteCarlo),
+                poses: t.iter().map(moved).collect(),
+            });
         }
         Ok(())
     }
 
-    fn euler_vs_exp(&mut self, op: &OperationSpec, field: &str, output: String) -> Result<(), ScenarioError> {
+    fn euler_vs_exp(
+        &mut self,
+        op: &OperationSpec,
+        field: &str,
+        output: String,
+    ) -> Result<(), ScenarioError> {
         let rate_spec = self.need(&op.rate, op, field, "rate")?;
         let rate = rate_spec.get_ref();
         if rate.len() != 3 || rate.iter().any(|v| !v.is_finite()) {
-            return Err(self.err(rate_spec.span(), &format!("{field}.rate"), format!("needs 3 finite numbers (rad/s), got {rate:?}")));
+            return Err(self.err(
+                rate_spec.span(),
+                &format!("{field}.rate"),
+                format!("needs 3 finite numbers (rad/s), got {rate:?}"),
+            ));
         }
         let dt = self.positive(&op.dt, op, field, "dt", false)?;
         let steps = self.steps(op, field)?.unwrap_or(1);
-        let Some(track) = G::euler_vs_exp(&Vector3::new(rate[0], rate[1], rate[2]), dt, steps) else {
-            return Err(self.err(op.kind.span(), &format!("{field}.kind"), format!("`euler_vs_exp` integrates a 3D body rate: it needs group = \"so3\", not {}", G::NAME)));
+        let Some(track) = G::euler_vs_exp(&Vector3::new(rate[0], rate[1], rate[2]), dt, steps)
+        else {
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.kind"),
+                format!(
+                    "`euler_vs_exp` integrates a 3D body rate: it needs group = \"so3\", not {}",
+                    G::NAME
+                ),
+            ));
         };
         let drift = |m: &Matrix3<f64>| (m.transpose() * m - Matrix3::identity()).amax();
         let mut euler_line = Vec::new();
@@ -959,23 +1575,56 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             let step = k as u64;
             euler_line.push((step as i64, drift(euler)));
             exp_line.push((step as i64, drift(&exp.to_se3().rotation().to_matrix())));
-            self.out.matrix_frames.push(MatrixFrame { name: format!("{output}/euler"), step: Some(step), columns: *euler, origin: [0.0; 3] });
-            self.push_node(Node { name: format!("{output}_exp"), role: Role::Output, step: Some(step), draw: true, nominal: *exp, estimates: Vec::new(), particles: None });
+            self.out.matrix_frames.push(MatrixFrame {
+                name: format!("{output}/euler"),
+                step: Some(step),
+                columns: *euler,
+                origin: [0.0; 3],
+            });
+            self.push_node(Node {
+                name: format!("{output}_exp"),
+                role: Role::Output,
+                step: Some(step),
+                draw: true,
+                nominal: *exp,
+                estimates: Vec::new(),
+                particles: None,
+            });
         }
-        let (last_euler, last_exp) = track.last().map_or((f64::NAN, f64::NAN), |(m, g)| (drift(m), drift(&g.to_se3().rotation().to_matrix())));
+        let (last_euler, last_exp) = track.last().map_or((f64::NAN, f64::NAN), |(m, g)| {
+            (drift(m), drift(&g.to_se3().rotation().to_matrix()))
+        });
         self.out.notes.push(format!(
             "After {steps} steps of dt = {dt} s: Euler max |RᵀR − I| = **{last_euler:.3}**; exponential map {last_exp:.1e}. The Euler frame (the columns of its matrix, drawn as arrows) stretches; the Exp frame stays a rotation."
         ));
         let quantity = "orthogonality error max |RᵀR − I|";
-        self.out.series.push(Series { quantity: quantity.to_owned(), method: None, label: "Euler steps R(I + ω̂dt)".to_owned(), points: euler_line });
-        self.out.series.push(Series { quantity: quantity.to_owned(), method: Some(Method::Exact), label: "exponential map R·Exp(ωdt)".to_owned(), points: exp_line });
+        self.out.series.push(Series {
+            quantity: quantity.to_owned(),
+            method: None,
+            label: "Euler steps R(I + ω̂dt)".to_owned(),
+            points: euler_line,
+        });
+        self.out.series.push(Series {
+            quantity: quantity.to_owned(),
+            method: Some(Method::Exact),
+            label: "exponential map R·Exp(ωdt)".to_owned(),
+            points: exp_line,
+        });
         Ok(())
     }
 
     /// Trace of the position (or rotation) covariance per method and step, for the plot.
     fn trace_series(&mut self, name: &str) {
-        let block = if G::rotation_range().start == 0 { G::rotation_range() } else { 0..G::rotation_range().start };
-        let quantity = if G::rotation_range().start == 0 { "trace of rotation covariance (rad²)" } else { "trace of position covariance (m², body frame)" };
+        let block = if G::rotation_range().start == 0 {
+            G::rotation_range()
+        } else {
+            0..G::rotation_range().start
+        };
+        let quantity = if G::rotation_range().start == 0 {
+            "trace of rotation covariance (rad²)"
+        } else {
+            "trace of position covariance (m², body frame)"
+        };
         let mut lines: Vec<Series> = Vec::new();
         for node in self.out.nodes.iter().filter(|n| n.name == name) {
             let step = node.step.unwrap_or(0) as i64;
@@ -987,15 +1636,23 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                     (e.result.method, block.clone().map(|i| cov[(i, i)]).sum())
                 })
                 .collect();
-            if let Some(p) = &node.particles {
-                if let Ok(stats) = sample_statistics(p, Side::Right) {
-                    values.push((Method::MonteCarlo, block.clone().map(|i| stats.cov[(i, i)]).sum()));
-                }
+            if let Some(p) = &node.particles
+                && let Ok(stats) = sample_statistics(p, Side::Right)
+            {
+                values.push((
+                    Method::MonteCarlo,
+                    block.clone().map(|i| stats.cov[(i, i)]).sum(),
+                ));
             }
             for (method, value) in values {
                 match lines.iter_mut().find(|l| l.method == Some(method)) {
                     Some(line) => line.points.push((step, value)),
-                    None => lines.push(Series { quantity: quantity.to_owned(), method: Some(method), label: method.label().to_owned(), points: vec![(step, value)] }),
+                    None => lines.push(Series {
+                        quantity: quantity.to_owned(),
+                        method: Some(method),
+                        label: method.label().to_owned(),
+                        points: vec![(step, value)],
+                    }),
                 }
             }
         }
@@ -1012,22 +1669,42 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         let mut lines: Vec<Series> = Vec::new();
         for node in self.out.nodes.iter().filter(|n| n.name == name) {
             let step = node.step.unwrap_or(0) as i64;
-            let mut values: Vec<(Method, f64)> = node.estimates.iter().map(|e| (e.result.method, e.result.pose.cov_left()[(0, 0)])).collect();
-            if let Some(p) = &node.particles {
-                if let Ok(cov) = crate::sample::uncentred_covariance(p, &node.nominal, Side::Left) {
-                    values.push((Method::MonteCarlo, cov[(0, 0)]));
-                }
+            let mut values: Vec<(Method, f64)> = node
+                .estimates
+                .iter()
+                .map(|e| (e.result.method, e.result.pose.cov_left()[(0, 0)]))
+                .collect();
+            if let Some(p) = &node.particles
+                && let Ok(cov) = crate::sample::uncentred_covariance(p, &node.nominal, Side::Left)
+            {
+                values.push((Method::MonteCarlo, cov[(0, 0)]));
             }
             for (method, value) in values {
                 match lines.iter_mut().find(|l| l.method == Some(method)) {
                     Some(line) => line.points.push((step, value)),
-                    None => lines.push(Series { quantity: "along-track variance Σ_ρxρx, left form (m²)".to_owned(), method: Some(method), label: method.label().to_owned(), points: vec![(step, value)] }),
+                    None => lines.push(Series {
+                        quantity: "along-track variance Σ_ρxρx, left form (m²)".to_owned(),
+                        method: Some(method),
+                        label: method.label().to_owned(),
+                        points: vec![(step, value)],
+                    }),
                 }
             }
         }
         if let Some(last) = self.out.nodes.iter().rev().find(|n| n.name == name) {
-            let summary: Vec<String> = lines.iter().filter_map(|l| l.points.last().map(|(_, v)| format!("{} {:.4}", l.label, v))).collect();
-            self.out.notes.push(format!("Along-track variance Σ_ρxρx (left form) at step {}: {}.", last.step.unwrap_or(0), summary.join(", ")));
+            let summary: Vec<String> = lines
+                .iter()
+                .filter_map(|l| {
+                    l.points
+                        .last()
+                        .map(|(_, v)| format!("{} {:.4}", l.label, v))
+                })
+                .collect();
+            self.out.notes.push(format!(
+                "Along-track variance Σ_ρxρx (left form) at step {}: {}.",
+                last.step.unwrap_or(0),
+                summary.join(", ")
+            ));
         }
         self.out.series.extend(lines);
     }
@@ -1035,21 +1712,39 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
     /// Adds each node's Monte Carlo estimate and every other estimate's error against it.
     fn errors_against_monte_carlo(&mut self) {
         for node in &mut self.out.nodes {
-            let Some(particles) = &node.particles else { continue };
+            let Some(particles) = &node.particles else {
+                continue;
+            };
             if node.role == Role::Fixed {
                 continue;
             }
-            let Ok(stats) = sample_statistics(particles, Side::Right) else { continue };
+            let Ok(stats) = sample_statistics(particles, Side::Right) else {
+                continue;
+            };
             for e in &mut node.estimates {
-                e.error_vs_monte_carlo = Some(relative_frobenius_error(&e.result.pose.cov_right(), &stats.cov));
+                e.error_vs_monte_carlo = Some(relative_frobenius_error(
+                    &e.result.pose.cov_right(),
+                    &stats.cov,
+                ));
             }
-            node.estimates.push(Estimate { result: Propagated { pose: stats.to_pose(), method: Method::MonteCarlo }, error_vs_monte_carlo: Some(0.0) });
+            node.estimates.push(Estimate {
+                result: Propagated {
+                    pose: stats.to_pose(),
+                    method: Method::MonteCarlo,
+                },
+                error_vs_monte_carlo: Some(0.0),
+            });
         }
     }
 }
 
 /// `x ← f(rng, x)` over a slice, in parallel, deterministic per seed and family.
-fn fill_par_map<G: Copy + Send + Sync>(xs: &mut [G], seed: u64, family: u64, f: impl Fn(&mut rand_chacha::ChaCha8Rng, &G) -> G + Sync) {
+fn fill_par_map<G: Copy + Send + Sync>(
+    xs: &mut [G],
+    seed: u64,
+    family: u64,
+    f: impl Fn(&mut rand_chacha::ChaCha8Rng, &G) -> G + Sync,
+) {
     fill_par(xs, seed, family, |rng, chunk| {
         for x in chunk.iter_mut() {
             *x = f(rng, x);
@@ -1070,21 +1765,40 @@ fn joint_square_root(joint: &DMatrix<f64>) -> DMatrix<f64> {
 
 /// An odometry control: (increment as a group element, tangent) — the `increment` model reads
 /// the numbers as the group's natural coordinates, the `exp` model as a tangent vector.
-fn control_for<G: SpecGroup<N>, const N: usize>(numbers: &[f64], increment: bool) -> Result<(G, Tangent<N>), String> {
+fn control_for<G: SpecGroup<N>, const N: usize>(
+    numbers: &[f64],
+    increment: bool,
+) -> Result<(G, Tangent<N>), String> {
     if let Some(i) = numbers.iter().position(|v| !v.is_finite()) {
-        return Err(format!("element {i} is {}, every number must be finite", numbers[i]));
+        return Err(format!(
+            "element {i} is {}, every number must be finite",
+            numbers[i]
+        ));
     }
     if numbers.len() != N {
-        return Err(format!("each control needs {N} numbers for {}, got {}", G::NAME, numbers.len()));
+        return Err(format!(
+            "each control needs {N} numbers for {}, got {}",
+            G::NAME,
+            numbers.len()
+        ));
     }
     let tangent = Tangent::<N>::from_column_slice(numbers);
     if !increment {
         return Ok((G::exp(&tangent), tangent));
     }
     let spec = match N {
-        1 => super::schema::MeanSpec { angle: Some(numbers[0]), ..Default::default() },
-        3 if G::rotation_range().start == 2 => super::schema::MeanSpec { xy_theta: Some([numbers[0], numbers[1], numbers[2]]), ..Default::default() },
-        3 => super::schema::MeanSpec { rpy: Some([numbers[0], numbers[1], numbers[2]]), ..Default::default() },
+        1 => super::schema::MeanSpec {
+            angle: Some(numbers[0]),
+            ..Default::default()
+        },
+        3 if G::rotation_range().start == 2 => super::schema::MeanSpec {
+            xy_theta: Some([numbers[0], numbers[1], numbers[2]]),
+            ..Default::default()
+        },
+        3 => super::schema::MeanSpec {
+            rpy: Some([numbers[0], numbers[1], numbers[2]]),
+            ..Default::default()
+        },
         _ => super::schema::MeanSpec {
             xyz: Some([numbers[0], numbers[1], numbers[2]]),
             rpy: Some([numbers[3], numbers[4], numbers[5]]),
@@ -1102,8 +1816,14 @@ fn parent_frame(name: &str) -> Option<&str> {
 
 /// Names become entity-path segments: letters, digits, `_`, `-`, `.`.
 fn check_name(name: &str) -> Result<(), String> {
-    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.')) {
-        return Err(format!("`{name}` is not a valid name: use letters, digits, `_`, `-` or `.` (e.g. `world_from_body`)"));
+    if name.is_empty()
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+    {
+        return Err(format!(
+            "`{name}` is not a valid name: use letters, digits, `_`, `-` or `.` (e.g. `world_from_body`)"
+        ));
     }
     Ok(())
 }

@@ -18,7 +18,9 @@
 //! "#;
 //! let s = Scenario::parse(text, "demo.toml").unwrap();
 //! assert_eq!(s.file.poses.len(), 1);
-//! let err = Scenario::parse(&text.replace("0.2]", "nan]"), "demo.toml").unwrap_err();
+//! // Values are checked when the scenario is evaluated, with their place in the file.
+//! let bad = Scenario::parse(&text.replace("0.2]", "nan]"), "demo.toml").unwrap();
+//! let err = posecov::scenario::eval::evaluate(&bad, &Default::default()).unwrap_err();
 //! assert!(err.to_string().starts_with("demo.toml:8:"), "{err}");
 //! ```
 
@@ -27,8 +29,8 @@ use std::ops::Range;
 use std::path::Path;
 
 pub mod bundled;
-pub mod model;
 pub mod eval;
+pub mod model;
 pub mod schema;
 mod spec;
 
@@ -65,7 +67,9 @@ pub enum ScenarioError {
 impl fmt::Display for ScenarioError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            ScenarioError::Read { path, reason } => write!(f, "{path}: cannot read scenario: {reason}"),
+            ScenarioError::Read { path, reason } => {
+                write!(f, "{path}: cannot read scenario: {reason}")
+            }
             ScenarioError::At {
                 file,
                 line,
@@ -116,13 +120,22 @@ impl Locator {
     /// let e = Locator::new("f.toml", "abc").error(1..2, "k", "m");
     /// assert!(e.to_string().starts_with("f.toml:1:2: k: m"));
     /// ```
-    pub fn error(&self, span: Range<usize>, field: &str, message: impl Into<String>) -> ScenarioError {
+    pub fn error(
+        &self,
+        span: Range<usize>,
+        field: &str,
+        message: impl Into<String>,
+    ) -> ScenarioError {
         let start = span.start.min(self.text.len());
         let before = &self.text[..floor_char_boundary(&self.text, start)];
         let line = before.matches('\n').count() + 1;
         let line_start = before.rfind('\n').map_or(0, |i| i + 1);
         let column = before[line_start..].chars().count() + 1;
-        let source_line = self.text[line_start..].lines().next().unwrap_or("").to_owned();
+        let source_line = self.text[line_start..]
+            .lines()
+            .next()
+            .unwrap_or("")
+            .to_owned();
         ScenarioError::At {
             file: self.file.clone(),
             line,
@@ -167,6 +180,35 @@ impl Scenario {
             locator.error(span, "toml", e.message().trim().to_owned())
         })?;
         Ok(Self { file, locator })
+    }
+
+    /// A bundled scenario by name (see [`bundled::BUNDLED`]), or else a file path. An unknown
+    /// name that is not a file either gets an error listing the bundled names.
+    ///
+    /// ```
+    /// use posecov::scenario::Scenario;
+    /// assert!(Scenario::load_any("so3_sampling").is_ok());
+    /// let e = Scenario::load_any("no_such_scenario").unwrap_err().to_string();
+    /// assert!(e.contains("camera_on_robot"), "{e}");
+    /// ```
+    pub fn load_any(name_or_path: &str) -> Result<Self, ScenarioError> {
+        let path = Path::new(name_or_path);
+        if path.exists() {
+            return Self::load(path);
+        }
+        match bundled::find(name_or_path) {
+            Some(b) => Self::parse(b.text, &format!("{}.toml (bundled)", b.name)),
+            None => {
+                let names: Vec<&str> = bundled::BUNDLED.iter().map(|b| b.name).collect();
+                Err(ScenarioError::Read {
+                    path: name_or_path.to_owned(),
+                    reason: format!(
+                        "no such file, and no bundled scenario of that name (bundled: {})",
+                        names.join(", ")
+                    ),
+                })
+            }
+        }
     }
 
     /// Reads and parses a scenario file.

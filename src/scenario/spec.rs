@@ -49,10 +49,17 @@ pub(crate) fn mean_for<G: SpecGroup<N>, const N: usize>(spec: &MeanSpec) -> Resu
         ));
     }
     let rotations = keys.iter().filter(|k| **k != "xyz").count();
-    if keys.is_empty() || rotations > 1 || (keys.contains(&"xyz") && (keys.contains(&"matrix") || keys.contains(&"tangent"))) {
+    if keys.is_empty()
+        || rotations > 1
+        || (keys.contains(&"xyz") && (keys.contains(&"matrix") || keys.contains(&"tangent")))
+    {
         return Err(format!(
             "give the mean in exactly one way (got {}); {} accepts {}",
-            if keys.is_empty() { "none".to_owned() } else { keys.join(" + ") },
+            if keys.is_empty() {
+                "none".to_owned()
+            } else {
+                keys.join(" + ")
+            },
             G::NAME,
             G::MEAN_KEYS.join(", ")
         ));
@@ -60,7 +67,11 @@ pub(crate) fn mean_for<G: SpecGroup<N>, const N: usize>(spec: &MeanSpec) -> Resu
     if let Some(t) = &spec.tangent {
         check_values("tangent", t)?;
         if t.len() != N {
-            return Err(format!("tangent needs {N} numbers for {}, got {}", G::NAME, t.len()));
+            return Err(format!(
+                "tangent needs {N} numbers for {}, got {}",
+                G::NAME,
+                t.len()
+            ));
         }
         return Ok(G::exp(&Tangent::<N>::from_column_slice(t)));
     }
@@ -69,16 +80,25 @@ pub(crate) fn mean_for<G: SpecGroup<N>, const N: usize>(spec: &MeanSpec) -> Resu
 
 fn check_values(what: &str, values: &[f64]) -> Result<(), String> {
     match values.iter().position(|v| !v.is_finite()) {
-        Some(i) => Err(format!("{what}[{i}] is {}, every number must be finite", values[i])),
+        Some(i) => Err(format!(
+            "{what}[{i}] is {}, every number must be finite",
+            values[i]
+        )),
         None => Ok(()),
     }
 }
 
 /// A row-major `rows` as a fixed R×C matrix, checking its shape and values.
-pub(crate) fn fixed_matrix<const R: usize, const C: usize>(what: &str, rows: &[Vec<f64>]) -> Result<SMatrix<f64, R, C>, String> {
+pub(crate) fn fixed_matrix<const R: usize, const C: usize>(
+    what: &str,
+    rows: &[Vec<f64>],
+) -> Result<SMatrix<f64, R, C>, String> {
     if rows.len() != R || rows.iter().any(|r| r.len() != C) {
         let shape: Vec<usize> = rows.iter().map(Vec::len).collect();
-        return Err(format!("{what} must be {R}×{C} (rows of {C}); got {} rows of lengths {shape:?}", rows.len()));
+        return Err(format!(
+            "{what} must be {R}×{C} (rows of {C}); got {} rows of lengths {shape:?}",
+            rows.len()
+        ));
     }
     for (i, row) in rows.iter().enumerate() {
         check_values(&format!("{what} row {i}"), row)?;
@@ -91,7 +111,8 @@ fn rotation3(spec: &MeanSpec) -> Result<So3, String> {
         return So3::try_from_quaternion_xyzw(q).map_err(|e| e.to_string());
     }
     if let Some(a) = spec.axis_angle {
-        return So3::try_from_axis_angle(&Vector3::new(a[0], a[1], a[2]), a[3]).map_err(|e| e.to_string());
+        return So3::try_from_axis_angle(&Vector3::new(a[0], a[1], a[2]), a[3])
+            .map_err(|e| e.to_string());
     }
     let rpy = spec
         .rpy
@@ -108,9 +129,13 @@ impl SpecGroup<1> for So2 {
     }
     fn mean_from_spec(spec: &MeanSpec) -> Result<Self, String> {
         if let Some(m) = &spec.matrix {
-            return So2::try_from_matrix(&fixed_matrix::<2, 2>("matrix", m)?).map_err(|e| e.to_string());
+            return So2::try_from_matrix(&fixed_matrix::<2, 2>("matrix", m)?)
+                .map_err(|e| e.to_string());
         }
-        let angle = spec.angle.or(spec.angle_deg.map(f64::to_radians)).unwrap_or(0.0);
+        let angle = spec
+            .angle
+            .or(spec.angle_deg.map(f64::to_radians))
+            .unwrap_or(0.0);
         check_values("angle", &[angle])?;
         Ok(So2::from_angle(angle))
     }
@@ -126,7 +151,8 @@ impl SpecGroup<3> for Se2 {
     }
     fn mean_from_spec(spec: &MeanSpec) -> Result<Self, String> {
         if let Some(m) = &spec.matrix {
-            return Se2::try_from_matrix(&fixed_matrix::<3, 3>("matrix", m)?).map_err(|e| e.to_string());
+            return Se2::try_from_matrix(&fixed_matrix::<3, 3>("matrix", m)?)
+                .map_err(|e| e.to_string());
         }
         let v = spec
             .xy_theta
@@ -141,13 +167,21 @@ impl SpecGroup<3> for Se2 {
 }
 
 impl SpecGroup<3> for So3 {
-    const MEAN_KEYS: &'static [&'static str] = &["quaternion_xyzw", "rpy", "rpy_deg", "axis_angle", "matrix", "tangent"];
+    const MEAN_KEYS: &'static [&'static str] = &[
+        "quaternion_xyzw",
+        "rpy",
+        "rpy_deg",
+        "axis_angle",
+        "matrix",
+        "tangent",
+    ];
     fn rotation_range() -> Range<usize> {
         0..3
     }
     fn mean_from_spec(spec: &MeanSpec) -> Result<Self, String> {
         if let Some(m) = &spec.matrix {
-            return So3::try_from_matrix(&fixed_matrix::<3, 3>("matrix", m)?).map_err(|e| e.to_string());
+            return So3::try_from_matrix(&fixed_matrix::<3, 3>("matrix", m)?)
+                .map_err(|e| e.to_string());
         }
         rotation3(spec)
     }
@@ -157,8 +191,15 @@ impl SpecGroup<3> for So3 {
 }
 
 impl SpecGroup<6> for Se3 {
-    const MEAN_KEYS: &'static [&'static str] =
-        &["xyz", "quaternion_xyzw", "rpy", "rpy_deg", "axis_angle", "matrix", "tangent"];
+    const MEAN_KEYS: &'static [&'static str] = &[
+        "xyz",
+        "quaternion_xyzw",
+        "rpy",
+        "rpy_deg",
+        "axis_angle",
+        "matrix",
+        "tangent",
+    ];
     fn rotation_range() -> Range<usize> {
         3..6
     }
@@ -179,28 +220,52 @@ impl SpecGroup<6> for Se3 {
 /// The permutation P with v_rotation_first = P v_translation_first.
 fn rotation_first_permutation<G: SpecGroup<N>, const N: usize>() -> TangentMatrix<N> {
     let rot = G::rotation_range();
-    let order: Vec<usize> = rot.clone().chain((0..N).filter(|i| !rot.contains(i))).collect();
+    let order: Vec<usize> = rot
+        .clone()
+        .chain((0..N).filter(|i| !rot.contains(i)))
+        .collect();
     TangentMatrix::<N>::from_fn(|r, c| if order[r] == c { 1.0 } else { 0.0 })
 }
 
 /// Builds a validated covariance (on its stated side) from a specification.
-pub(crate) fn cov_for<G: SpecGroup<N>, const N: usize>(spec: &CovSpec, mean: &G) -> Result<(TangentMatrix<N>, Side), String> {
-    let given = [spec.std.is_some(), spec.std_deg.is_some(), spec.matrix.is_some(), spec.ros.is_some()];
+pub(crate) fn cov_for<G: SpecGroup<N>, const N: usize>(
+    spec: &CovSpec,
+    mean: &G,
+) -> Result<(TangentMatrix<N>, Side), String> {
+    let given = [
+        spec.std.is_some(),
+        spec.std_deg.is_some(),
+        spec.matrix.is_some(),
+        spec.ros.is_some(),
+    ];
     if given.iter().filter(|g| **g).count() != 1 {
-        return Err("give the covariance in exactly one way: std, std_deg, matrix or ros".to_owned());
+        return Err(
+            "give the covariance in exactly one way: std, std_deg, matrix or ros".to_owned(),
+        );
     }
     let rot = G::rotation_range();
     let from_std = |std: &[f64], degrees: bool| -> Result<TangentMatrix<N>, String> {
         check_values("std", std)?;
         if std.len() != N {
-            return Err(format!("std needs {N} numbers for {} (one per tangent axis), got {}", G::NAME, std.len()));
+            return Err(format!(
+                "std needs {N} numbers for {} (one per tangent axis), got {}",
+                G::NAME,
+                std.len()
+            ));
         }
         if let Some(i) = std.iter().position(|s| *s < 0.0) {
-            return Err(format!("std[{i}] = {} is negative; a standard deviation is ≥ 0", std[i]));
+            return Err(format!(
+                "std[{i}] = {} is negative; a standard deviation is ≥ 0",
+                std[i]
+            ));
         }
         let mut cov = TangentMatrix::<N>::zeros();
         for (i, s) in std.iter().enumerate() {
-            let s = if degrees && rot.contains(&i) { s.to_radians() } else { *s };
+            let s = if degrees && rot.contains(&i) {
+                s.to_radians()
+            } else {
+                *s
+            };
             cov[(i, i)] = s * s;
         }
         Ok(cov)
@@ -219,19 +284,32 @@ pub(crate) fn cov_for<G: SpecGroup<N>, const N: usize>(spec: &CovSpec, mean: &G)
         cov = p.transpose() * cov * p;
     }
     let cov = validate_covariance("covariance", &cov).map_err(|e| e.to_string())?;
-    let side = if spec.ros.is_some() { Side::Right } else { spec.side };
+    let side = if spec.ros.is_some() {
+        Side::Right
+    } else {
+        spec.side
+    };
     Ok((cov, side))
 }
 
 /// ROS (x, y, z, rotX, rotY, rotZ), position error in parent axes, to the right form:
 /// Σ_right = B⁻¹ Σ_ros B⁻ᵀ with B = blkdiag(R, I₃) (first order; CONVENTIONS §6).
-fn ros_covariance<G: SpecGroup<N>, const N: usize>(ros: &[f64], mean: &G) -> Result<TangentMatrix<N>, String> {
+fn ros_covariance<G: SpecGroup<N>, const N: usize>(
+    ros: &[f64],
+    mean: &G,
+) -> Result<TangentMatrix<N>, String> {
     if N != 6 {
-        return Err(format!("`ros` covariances are 6×6 (SE(3)); this scenario's group is {}", G::NAME));
+        return Err(format!(
+            "`ros` covariances are 6×6 (SE(3)); this scenario's group is {}",
+            G::NAME
+        ));
     }
     check_values("ros", ros)?;
     if ros.len() != 36 {
-        return Err(format!("ros needs 36 numbers (6×6 row-major), got {}", ros.len()));
+        return Err(format!(
+            "ros needs 36 numbers (6×6 row-major), got {}",
+            ros.len()
+        ));
     }
     let sigma_ros = Matrix6::from_row_slice(ros);
     let r = mean.to_se3().rotation().to_matrix();

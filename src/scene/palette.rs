@@ -1,137 +1,91 @@
 //! One fixed colour per method, so a method looks the same in every scenario, plot and legend.
 //!
 //! Colours follow the Okabe–Ito palette (distinguishable with the common colour-vision
-//! deficiencies), all of middle lightness so they read on both the native viewer's dark
-//! theme and the web viewer's light one (so no white, black or pale yellow). Monte Carlo (the
-//! reference) is neutral grey.
+//! deficiencies), lightened where needed to read on the viewer's dark background. Monte Carlo
+//! (the reference) is neutral grey; the nominal pose or path is [`NOMINAL`].
 
 use super::Color;
+use crate::uncertain::Method;
 
-/// A way of computing (or showing) an uncertain pose; each has a fixed colour.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Method {
-    /// First-order (linearised, Jacobian / adjoint) propagation.
-    FirstOrder,
-    /// Second-order propagation.
-    SecondOrder,
-    /// Fourth-order compounding (Barfoot & Furgale 2014).
-    FourthOrder,
-    /// Sigma points (unscented transform on the manifold).
-    SigmaPoints,
-    /// Monte-Carlo sampling: the reference.
-    MonteCarlo,
-    /// Vector-space propagation (Smith–Self–Cheeseman), no Lie algebra.
-    VectorSpace,
-    /// The lecture's formula as written (e.g. SE(3) odometry without Jr).
-    LectureFaithful,
-    /// The noise-free (mean) pose or path.
-    Nominal,
-}
+/// Colour of nominal (noise-free) poses and paths: Okabe–Ito blue, readable on the viewer's
+/// dark and light themes.
+pub const NOMINAL: Color = Color::rgb(0, 114, 178);
 
 impl Method {
     /// Every method, in legend order.
-    pub const ALL: [Self; 8] = [
+    pub const ALL: [Self; 10] = [
+        Self::Exact,
         Self::FirstOrder,
+        Self::LectureNoJr,
         Self::SecondOrder,
         Self::FourthOrder,
         Self::SigmaPoints,
         Self::MonteCarlo,
         Self::VectorSpace,
-        Self::LectureFaithful,
-        Self::Nominal,
+        Self::ClosedForm,
+        Self::NumericIntegral,
     ];
 
-    /// The method's colour (opaque).
+    /// The method's colour (opaque). `Exact` shares first order's colour: a deterministic
+    /// operation's result is what first order gives there, and the two never meet on one pose.
     ///
     /// ```
-    /// use posecov::scene::Method;
+    /// use posecov::uncertain::Method;
     /// assert_ne!(Method::FirstOrder.color(), Method::MonteCarlo.color());
     /// ```
     pub const fn color(self) -> Color {
         match self {
-            Self::FirstOrder => Color::rgb(86, 180, 233), // sky blue
-            Self::SecondOrder => Color::rgb(0, 158, 115), // bluish green
-            Self::FourthOrder => Color::rgb(230, 159, 0), // orange
-            Self::SigmaPoints => Color::rgb(204, 121, 167), // reddish purple
-            Self::MonteCarlo => Color::rgb(175, 175, 175), // grey
-            Self::VectorSpace => Color::rgb(213, 94, 0),  // vermillion
-            Self::LectureFaithful => Color::rgb(204, 170, 0), // gold
-            Self::Nominal => Color::rgb(0, 114, 178),     // blue
+            Self::Exact | Self::FirstOrder => Color::rgb(86, 180, 233), // sky blue
+            Self::ClosedForm => Color::rgb(120, 200, 255),              // light sky blue
+            Self::SecondOrder => Color::rgb(0, 158, 115),               // bluish green
+            Self::NumericIntegral => Color::rgb(0, 200, 150),           // light bluish green
+            Self::FourthOrder => Color::rgb(230, 159, 0),               // orange
+            Self::SigmaPoints => Color::rgb(204, 121, 167),             // reddish purple
+            Self::MonteCarlo => Color::rgb(175, 175, 175),              // grey
+            Self::VectorSpace => Color::rgb(213, 94, 0),                // vermillion
+            Self::LectureNoJr => Color::rgb(240, 200, 40),              // gold
         }
     }
 
     /// The colour's name, for the text panel ("first order is drawn in sky blue").
     ///
     /// ```
-    /// assert_eq!(posecov::scene::Method::MonteCarlo.color_name(), "grey");
+    /// assert_eq!(posecov::uncertain::Method::MonteCarlo.color_name(), "grey");
     /// ```
     pub const fn color_name(self) -> &'static str {
         match self {
-            Self::FirstOrder => "sky blue",
+            Self::Exact | Self::FirstOrder => "sky blue",
+            Self::ClosedForm => "light sky blue",
             Self::SecondOrder => "bluish green",
+            Self::NumericIntegral => "light bluish green",
             Self::FourthOrder => "orange",
             Self::SigmaPoints => "reddish purple",
             Self::MonteCarlo => "grey",
             Self::VectorSpace => "vermillion",
-            Self::LectureFaithful => "gold",
-            Self::Nominal => "blue",
+            Self::LectureNoJr => "gold",
         }
     }
 
-    /// Human-readable name, for legends.
+    /// Identifier used in entity paths and scenario files (`first_order`, `monte_carlo`, …):
+    /// the serde name.
     ///
     /// ```
-    /// assert_eq!(posecov::scene::Method::VectorSpace.label(), "vector space (SSC)");
-    /// ```
-    pub const fn label(self) -> &'static str {
-        match self {
-            Self::FirstOrder => "first order",
-            Self::SecondOrder => "second order",
-            Self::FourthOrder => "fourth order",
-            Self::SigmaPoints => "sigma points",
-            Self::MonteCarlo => "Monte Carlo",
-            Self::VectorSpace => "vector space (SSC)",
-            Self::LectureFaithful => "lecture-faithful (no Jr)",
-            Self::Nominal => "nominal",
-        }
-    }
-
-    /// Identifier used in entity paths and scenario files (`first_order`, `monte_carlo`, …).
-    ///
-    /// ```
-    /// use posecov::scene::Method;
-    /// assert_eq!(Method::from_slug(Method::SigmaPoints.slug()), Some(Method::SigmaPoints));
+    /// use posecov::uncertain::Method;
+    /// assert_eq!(Method::SigmaPoints.slug(), "sigma_points");
     /// ```
     pub const fn slug(self) -> &'static str {
         match self {
+            Self::Exact => "exact",
             Self::FirstOrder => "first_order",
+            Self::LectureNoJr => "lecture_no_jr",
             Self::SecondOrder => "second_order",
             Self::FourthOrder => "fourth_order",
             Self::SigmaPoints => "sigma_points",
             Self::MonteCarlo => "monte_carlo",
             Self::VectorSpace => "vector_space",
-            Self::LectureFaithful => "lecture_faithful",
-            Self::Nominal => "nominal",
+            Self::ClosedForm => "closed_form",
+            Self::NumericIntegral => "numeric_integral",
         }
-    }
-
-    /// The method with this [`slug`](Self::slug), if any.
-    pub fn from_slug(slug: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|m| m.slug() == slug)
-    }
-
-    /// A markdown legend line per method: `- **first order**: sky blue`.
-    ///
-    /// ```
-    /// use posecov::scene::Method;
-    /// let md = Method::legend_markdown(&[Method::MonteCarlo]);
-    /// assert_eq!(md, "- **Monte Carlo**: grey\n");
-    /// ```
-    pub fn legend_markdown(methods: &[Self]) -> String {
-        methods
-            .iter()
-            .map(|m| format!("- **{}**: {}\n", m.label(), m.color_name()))
-            .collect()
     }
 }
 
@@ -141,13 +95,23 @@ mod tests {
 
     #[test]
     fn colours_names_and_slugs_are_distinct() {
-        for (i, a) in Method::ALL.iter().enumerate() {
-            for b in &Method::ALL[i + 1..] {
+        let drawn: Vec<Method> = Method::ALL
+            .into_iter()
+            .filter(|m| *m != Method::Exact)
+            .collect();
+        for (i, a) in drawn.iter().enumerate() {
+            for b in &drawn[i + 1..] {
                 assert_ne!(a.color(), b.color(), "{a:?} {b:?}");
                 assert_ne!(a.color_name(), b.color_name());
-                assert_ne!(a.slug(), b.slug());
             }
-            assert_eq!(Method::from_slug(a.slug()), Some(*a));
+            assert_ne!(a.color(), NOMINAL);
+        }
+        for m in Method::ALL {
+            // The slug is the serde name, so scenario files and entity paths agree.
+            assert_eq!(
+                serde_json::to_value(m).unwrap(),
+                serde_json::Value::from(m.slug())
+            );
         }
     }
 }

@@ -406,8 +406,16 @@ mod tests {
     }
 
     #[test]
-    fn accepts_the_demo() {
-        assert_eq!(crate::scene::demo_scene(7).validate(), Ok(()));
+    fn accepts_every_bundled_scenario() {
+        let options = crate::scenario::eval::EvalOptions {
+            samples: Some(30),
+            ..Default::default()
+        };
+        for b in crate::scenario::bundled::BUNDLED {
+            let scenario = crate::scenario::Scenario::load_any(b.name).expect("bundled parses");
+            let scene = crate::draw::scene_of(&scenario, &options).expect("bundled evaluates");
+            assert_eq!(scene.validate(), Ok(()), "{}", b.name);
+        }
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Sinks: where a [`Scene`](crate::scene::Scene) goes. Only this module knows Rerun.
 //!
 //! - [`rerun`]: scene → Rerun 0.36 archetypes (batched, one entity per item) and the default
-//!   layout ([`default_blueprint`]).
+//!   layout ([`blueprint_for`]).
 //! - [`stream`]: opening a [`Sink`] (viewer, file, stdout, web viewer, memory) with
 //!   deterministic content, and finishing it cleanly ([`SinkGuard::finish`]).
 //! - [`viewer`]: finding a native `rerun` 0.36 viewer and rendering PNGs with it.
@@ -16,11 +16,13 @@
 //!
 //! # Example
 //! ```
-//! use posecov::scene::demo_scene;
+//! use posecov::scenario::{Scenario, eval::EvalOptions};
 //! use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
-//! let bytes = scene_to_rrd_bytes(&demo_scene(1), &RecordingIds::for_scenario("demo", 1))?;
+//! let scenario = Scenario::load_any("camera_on_robot")?;
+//! let scene = posecov::draw::scene_of(&scenario, &EvalOptions { samples: Some(50), ..Default::default() })?;
+//! let bytes = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("camera_on_robot", 1))?;
 //! assert!(bytes.len() > 1000);
-//! # Ok::<(), posecov::sink::SinkError>(())
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 pub mod rerun;
@@ -29,9 +31,7 @@ pub mod viewer;
 
 use std::path::PathBuf;
 
-pub use self::rerun::{
-    LogOutcome, STEP_TIMELINE, default_blueprint, log_scene, log_scene_cancellable,
-};
+pub use self::rerun::{LogOutcome, STEP_TIMELINE, blueprint_for, log_scene, log_scene_cancellable};
 pub use self::stream::{SinkGuard, open_stream, scene_to_rrd_bytes};
 pub use self::viewer::{NativeViewer, find_native_viewer, render_png};
 

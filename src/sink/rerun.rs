@@ -95,17 +95,37 @@ pub fn log_scene_cancellable(
     Ok(LogOutcome::Complete)
 }
 
-/// The default layout: the 3-D view of `world` on the left (two thirds), the description
-/// above the plots of `plots` on the right; time panel collapsed to the essentials.
+/// The layout sent with a scene: the 3-D view of `world` on the left (two thirds); on the
+/// right the description above one plot per quantity (`plots/<quantity>/…`), or the
+/// description alone when the scene has no series. The time panel shows the `step` timeline,
+/// following the latest data, so a recording opens on its last step instead of replaying.
 ///
 /// ```
-/// let _blueprint = posecov::sink::default_blueprint();
+/// let _blueprint = posecov::sink::blueprint_for(&posecov::scene::Scene::new("t", "d"));
 /// ```
-pub fn default_blueprint() -> Blueprint {
+pub fn blueprint_for(scene: &Scene) -> Blueprint {
     let view3d = Spatial3DView::new("3D").with_origin(scene::WORLD);
     let text = TextDocumentView::new("Description").with_origin(scene::DESCRIPTION);
-    let plots = TimeSeriesView::new("Per step").with_origin(scene::PLOTS);
-    let right = Vertical::new([text.into(), plots.into()]).with_row_shares([3.0, 2.0]);
+    let mut groups: Vec<(String, String)> = Vec::new();
+    for series in &scene.series {
+        let mut parts = series.path.split('/');
+        if let (Some(_), Some(group)) = (parts.next(), parts.next())
+            && !groups.iter().any(|(g, _)| g == group)
+        {
+            groups.push((group.to_owned(), plot_title(group)));
+        }
+    }
+    let mut right: Vec<rr::blueprint::ContainerLike> = vec![text.into()];
+    let mut shares = vec![3.0];
+    for (group, title) in &groups {
+        right.push(
+            TimeSeriesView::new(title.clone())
+                .with_origin(format!("{}/{group}", scene::PLOTS))
+                .into(),
+        );
+        shares.push(2.0);
+    }
+    let right = Vertical::new(right).with_row_shares(shares);
     Blueprint::new(Horizontal::new([view3d.into(), right.into()]).with_column_shares([2.0, 1.0]))
         .with_auto_views(false)
         .with_blueprint_panel(BlueprintPanel::from_state(PanelState::Collapsed))
@@ -113,8 +133,15 @@ pub fn default_blueprint() -> Blueprint {
         .with_time_panel(
             TimePanel::new()
                 .with_state(PanelState::Collapsed)
-                .with_timeline(STEP_TIMELINE),
+                .with_timeline(STEP_TIMELINE)
+                .with_play_state(rr::blueprint::components::PlayState::Following),
         )
+}
+
+/// A plot title from its entity segment `<index>_<quantity_slug>`.
+fn plot_title(group: &str) -> String {
+    let name = group.split_once('_').map_or(group, |(_, rest)| rest);
+    name.replace('_', " ")
 }
 
 /// Sends one row with all `parts` as one chunk: no log time, no batcher, fixed order.

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use ::rerun as rr;
 
-use super::{APPLICATION_ID, RecordingIds, Sink, SinkError, default_blueprint, find_native_viewer};
+use super::{APPLICATION_ID, RecordingIds, Sink, SinkError, blueprint_for, find_native_viewer};
 use crate::scene::Scene;
 
 /// How long a flush to a remote viewer may take before we give up.
@@ -50,11 +50,12 @@ enum GuardKind {
 pub fn open_stream(
     sink: &Sink,
     ids: &RecordingIds,
+    scene: &Scene,
 ) -> Result<(rr::RecordingStream, SinkGuard), SinkError> {
     let builder = rr::RecordingStreamBuilder::new(APPLICATION_ID)
         .recording_id(ids.recording_id.clone())
         .send_properties(false)
-        .with_blueprint(default_blueprint());
+        .with_blueprint(blueprint_for(scene));
     let plain = |remote| GuardKind::Plain { remote };
     let (rec, kind) = match sink {
         Sink::Save(target) => {
@@ -76,7 +77,7 @@ pub fn open_stream(
                     action: "writing a recording to",
                     path: "stdout".into(),
                     source: std::io::Error::other(
-                        "stdout is a terminal; pipe it, e.g. `posecov demo --stdout | rerun -`",
+                        "stdout is a terminal; pipe it, e.g. `posecov camera_on_robot --stdout | rerun -`",
                     ),
                 });
             }
@@ -241,14 +242,14 @@ impl Drop for SinkGuard {
 /// Anything [`log_scene`](super::log_scene) or [`SinkGuard::finish`] returns.
 ///
 /// ```
-/// use posecov::{scene::demo_scene_with, sink::{RecordingIds, scene_to_rrd_bytes}};
-/// let scene = demo_scene_with(0, 10, 0.9)?;
-/// let bytes = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("demo", 0))?;
+/// use posecov::{scene::Scene, sink::{RecordingIds, scene_to_rrd_bytes}};
+/// let scene = Scene::new("empty", "Nothing but a description.");
+/// let bytes = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("empty", 0))?;
 /// assert!(!bytes.is_empty());
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn scene_to_rrd_bytes(scene: &Scene, ids: &RecordingIds) -> Result<Vec<u8>, SinkError> {
-    let (rec, guard) = open_stream(&Sink::Memory, ids)?;
+    let (rec, guard) = open_stream(&Sink::Memory, ids, scene)?;
     super::log_scene(&rec, scene)?;
     Ok(guard.finish(rec)?.unwrap_or_default())
 }
