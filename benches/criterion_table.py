@@ -12,7 +12,7 @@ import json
 import os
 import sys
 
-ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "target", "criterion")
+ROOT = os.environ.get("CRITERION_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "target", "criterion"))
 BATCH = 1024
 
 

@@ -5,11 +5,12 @@
 //! - `ellipsoid`: the first-order **Cartesian** position region, world frame, at the chosen
 //!   confidence with d = 3 (SE(3)) or d = 2 (SE(2)) degrees of freedom (CONVENTIONS §7);
 //! - `banana`: the **Exp-image** { μ · Exp(L u) : ‖u‖ = r } of the method's tangent-space
-//!   ellipsoid (L Lᵀ = Σ, r² = χ²_N(p) with N the group's DOF), swept over the sphere of the
-//!   three largest principal directions of Σ and drawn through each point's translation — a
-//!   mesh plus the images of its three principal ellipses;
-//! - `axis_x|y|z` (rotations): the Exp-image of the same ellipsoid seen through each body axis
-//!   tip, R̄ Exp(L u) e_k, around each mean axis;
+//!   ellipsoid (L Lᵀ = Σ, r² = χ²_k(p) with k the rank of Σ, at most the group's DOF), swept
+//!   over the sphere of the three largest principal directions of Σ and drawn through each
+//!   point's translation — a mesh for the main method, the images of its three principal
+//!   ellipses for every method;
+//! - `axis_x|y|z` (rotation groups): the Exp-image of the same ellipsoid seen through each
+//!   body axis tip, R̄ Exp(L u) e_k, around each mean axis;
 //! - `monte_carlo/cloud`, `monte_carlo/triads`, `monte_carlo/spray`: particle positions, a
 //!   subsample of small axis triads, and axis-tip sprays.
 
@@ -20,8 +21,9 @@ use nalgebra::{DMatrix, Matrix3, SymmetricEigen, Vector3};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 use crate::lie::{LieGroup, Se3, Tangent, TangentMatrix};
-use crate::scenario::SpecGroup;
 use crate::scenario::model::{AnyEvaluation, Evaluation, Node, Role};
+use crate::scenario::schema::View;
+use crate::scenario::{GroupName, SpecGroup};
 use crate::scene::{
     self, Arrows, Color, Ellipsoid, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud,
     ScalarSeries, Scene, SceneItem, Surface, Timing, Triads, Vec3,
@@ -32,6 +34,9 @@ use crate::uncertain::{Method, Side, UncertainPose};
 const BANANA_MESH: (u32, u32) = (16, 32);
 /// Points per principal-ellipse outline.
 const OUTLINE_POINTS: usize = 96;
+/// Eigenvalues below this fraction of the largest count as zero when choosing the χ² degrees
+/// of freedom of a drawn region.
+const RANK_TOLERANCE: f64 = 1e-9;
 /// At most this many steps of a propagation show their particle clouds.
 const MAX_PARTICLE_STEPS: u64 = 20;
 /// How many Monte Carlo particles get a small axis triad.
@@ -178,6 +183,11 @@ fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
         axis_length,
         particle_stride: last_step.div_ceil(MAX_PARTICLE_STEPS).max(1),
         last_step,
+    };
+    p.scene.planar = match e.meta.draw.view {
+        Some(View::Top) => true,
+        Some(View::Perspective) => false,
+        None => matches!(e.meta.group, GroupName::Se2 | GroupName::So2),
     };
     for node in e.nodes.iter().filter(|n| n.draw) {
         draw_node(&mut p, node, rotation_group, e);
@@ -404,10 +414,7 @@ fn draw_node<G: SpecGroup<N>, const N: usize>(
                 );
             }
         }
-        if draw.orientation
-            && (rotation_group || (N == 6 && is_primary))
-            && method != Method::VectorSpace
-        {
+        if draw.orientation && rotation_group {
             for (k, axis) in ["axis_x", "axis_y", "axis_z"].iter().enumerate() {
                 let len = p.axis_length;
                 let path = format!("{base}/{axis}");
@@ -536,7 +543,8 @@ fn outlines<G: SpecGroup<N>, const N: usize>(
         ItemKind::LineStrips(LineStrips {
             strips,
             color,
-            radius: 0.0015 * p.axis_length / 0.15,
+            // Thin: outlines sit on top of clouds and surfaces.
+            radius: 0.004 * p.axis_length.min(0.5),
         }),
     );
 }
@@ -551,7 +559,15 @@ fn principal_frame<G: SpecGroup<N>, const N: usize>(
     confidence: f64,
 ) -> PrincipalFrame<N> {
     let (values, vectors) = principal_axes(pose.cov());
-    let r = chi2_radius(confidence, N);
+    // A Gaussian of rank k < N lives in a k-dimensional subspace: its p-region has the χ²_k
+    // radius, not χ²_N (R5's yaw-only noise would otherwise be drawn far too wide).
+    let largest = values.first().copied().unwrap_or(0.0);
+    let rank = values
+        .iter()
+        .filter(|l| **l > RANK_TOLERANCE * largest)
+        .count()
+        .max(1);
+    let r = chi2_radius(confidence, rank);
     let column = |i: usize| match (values.get(i), vectors.get(i)) {
         (Some(l), Some(v)) => v * (r * l.sqrt()),
         _ => Tangent::<N>::zeros(),

@@ -292,6 +292,9 @@ pub struct Scene {
     pub items: Vec<SceneItem>,
     /// Plot lines.
     pub series: Vec<ScalarSeries>,
+    /// A planar scene (SE(2), SO(2)) lives in the x–y plane: the sink declares +y as the
+    /// viewer's up axis so the default camera faces that plane instead of grazing it.
+    pub planar: bool,
 }
 
 impl Scene {
@@ -307,6 +310,7 @@ impl Scene {
             description_markdown: description_markdown.into(),
             items: Vec::new(),
             series: Vec::new(),
+            planar: false,
         }
     }
 

@@ -18,6 +18,7 @@ use posecov::sink::{
 };
 mod rrd;
 
+use rerun::log::Chunk;
 use rrd::{assert_same_content, recording_chunks, rerun_cli};
 
 const BIN: &str = env!("CARGO_BIN_EXE_posecov");

@@ -559,14 +559,28 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
     // ------------------------------------------------------------------------------------
     // Inputs.
 
-    fn poses(&mut self) -> Result<(), ScenarioError> {
-        let root = self
-            .scenario
+    /// Whether a pose is drawn by default: `a_from_b` only when `a` is the scenario's root
+    /// frame (the parent of its first uncertain pose) — a relative pose such as `a_from_b` or
+    /// `b_from_world` drawn at world coordinates would mislead; names without the convention
+    /// are drawn.
+    fn drawn_by_default(&self, name: &str) -> bool {
+        match (self.root(), parent_frame(name)) {
+            (Some(root), Some(parent)) => parent == root,
+            _ => true,
+        }
+    }
+
+    fn root(&self) -> Option<&str> {
+        self.scenario
             .file
             .poses
             .iter()
             .find(|p| p.cov.is_some())
-            .and_then(|p| parent_frame(p.name.get_ref()));
+            .and_then(|p| parent_frame(p.name.get_ref()))
+    }
+
+    fn poses(&mut self) -> Result<(), ScenarioError> {
+        let root = self.root().map(str::to_owned);
         for (i, spec) in self.scenario.file.poses.iter().enumerate() {
             let field = format!("pose[{i}]");
             let name = spec.name.get_ref().clone();
@@ -585,7 +599,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 self.names.insert(name.clone(), Value::Fixed(mean));
                 let draw = spec
                     .draw
-                    .unwrap_or_else(|| root.is_some() && parent_frame(&name) == root);
+                    .unwrap_or_else(|| root.is_some() && parent_frame(&name) == root.as_deref());
                 self.out.nodes.push(Node {
                     name,
                     role: Role::Fixed,
@@ -612,11 +626,12 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 },
                 error_vs_monte_carlo: None,
             };
+            let draw = spec.draw.unwrap_or_else(|| self.drawn_by_default(&name));
             self.push_node(Node {
                 name,
                 role: Role::Input,
                 step: None,
-                draw: spec.draw.unwrap_or(true),
+                draw,
                 nominal: mean,
                 estimates: vec![estimate],
                 particles,
@@ -936,11 +951,12 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             }
         }
         let nominal = *first.pose.mean();
+        let draw = self.drawn_by_default(&name);
         self.push_node(Node {
             name,
             role: Role::Output,
             step,
-            draw: true,
+            draw,
             nominal,
             estimates,
             particles,
@@ -1595,9 +1611,9 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             (drift(m), drift(&g.to_se3().rotation().to_matrix()))
         });
         self.out.notes.push(format!(
-            "After {steps} steps of dt = {dt} s: Euler max |RᵀR − I| = **{last_euler:.3}**; exponential map {last_exp:.1e}. The Euler frame (the columns of its matrix, drawn as arrows) stretches; the Exp frame stays a rotation."
+            "After {steps} steps of dt = {dt} s: Euler max |R^T R − I| = **{last_euler:.3}**; exponential map {last_exp:.1e}. The Euler frame (the columns of its matrix, drawn as arrows) stretches; the Exp frame stays a rotation."
         ));
-        let quantity = "orthogonality error max |RᵀR − I|";
+        let quantity = "orthogonality error max |R^T R − I|";
         self.out.series.push(Series {
             quantity: quantity.to_owned(),
             method: None,

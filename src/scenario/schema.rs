@@ -269,6 +269,19 @@ pub struct DrawSpec {
     /// Length of the mean frames' axes (m); default from the scene size.
     #[serde(default)]
     pub axis_length: Option<f64>,
+    /// How the 3D view faces the scene; default `top` for planar groups, else `perspective`.
+    #[serde(default)]
+    pub view: Option<View>,
+}
+
+/// How the 3D view faces the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum View {
+    /// Face the x–y plane (planar motion; the viewer's up axis is +y).
+    Top,
+    /// z up, seen from an angle.
+    Perspective,
 }
 
 impl Default for DrawSpec {
@@ -282,6 +295,7 @@ impl Default for DrawSpec {
             orientation: true,
             trajectories: true,
             axis_length: None,
+            view: None,
         }
     }
 }

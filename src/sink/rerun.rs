@@ -69,7 +69,12 @@ pub fn log_scene_cancellable(
         rec,
         scene::WORLD,
         Timing::Static,
-        &[&rr::ViewCoordinates::RIGHT_HAND_Z_UP()],
+        &[&if scene.planar {
+            // Faces the x–y plane: the default camera then looks at a planar scene, not along it.
+            rr::ViewCoordinates::RIGHT_HAND_Y_UP()
+        } else {
+            rr::ViewCoordinates::RIGHT_HAND_Z_UP()
+        }],
     )?;
     send(
         rec,
