@@ -30,6 +30,7 @@ use std::path::Path;
 
 pub mod bundled;
 pub mod eval;
+pub mod groups;
 pub mod model;
 pub mod schema;
 mod spec;

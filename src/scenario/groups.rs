@@ -1,0 +1,275 @@
+//! Group-specific operations of the scenario evaluator: what only some groups can do
+//! (differential drive on SE(2), Euler vs Exp on SO(3), compounding and the vector-space
+//! baseline on SE(2)/SE(3)), behind one trait the generic engine calls.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::SpecGroup;
+use super::spec::fixed_matrix;
+use crate::interop::VectorChart;
+use crate::lie::{LieGroup, Se2, Se3, So2, So3, TangentMatrix};
+use crate::propagate::Propagated;
+use crate::propagate::diff_drive::{DiffDrive, EulerMaruyama};
+use crate::propagate::first_order;
+use crate::propagate::fourth_order::{self, Order};
+use crate::propagate::vector_space::{VectorPose, ssc_compose, ssc_odometry};
+use crate::uncertain::UncertainPose;
+
+/// Group-specific operations the generic engine asks for; `None` where a group has none.
+pub trait EvalGroup<const N: usize>: SpecGroup<N> {
+    /// Coordinates of a point of the space the group acts on (2 or 3).
+    fn point_dims() -> usize;
+
+    /// An uncertain point p (covariance rows `cov`, in the pose's frame) seen from an
+    /// uncertain pose, to first order: (mean, covariance) in world coordinates, lifted to 3D.
+    fn point_through(
+        pose: &UncertainPose<Self, N>,
+        point: &[f64],
+        cov: &[Vec<f64>],
+    ) -> Result<([f64; 3], [[f64; 3]; 3]), String>;
+
+    /// 2nd/4th-order compounding Z = X·Y (Barfoot & Furgale 2014), where defined.
+    fn compound(
+        _x: &UncertainPose<Self, N>,
+        _y: &UncertainPose<Self, N>,
+        _order: Order,
+    ) -> Option<Propagated<Self, N>> {
+        None
+    }
+
+    /// Smith–Self–Cheeseman compose in the group's vector coordinates, where defined.
+    fn ssc_compose(
+        _x: &UncertainPose<Self, N>,
+        _y: &UncertainPose<Self, N>,
+    ) -> Option<crate::Result<Propagated<Self, N>>> {
+        None
+    }
+
+    /// Smith–Self–Cheeseman odometry (increments as group elements, noise read in the vector
+    /// coordinates), where defined; one result per step including the start.
+    fn ssc_odometry(
+        _start: &UncertainPose<Self, N>,
+        _increments: &[Self],
+        _noise: &TangentMatrix<N>,
+    ) -> Option<crate::Result<Vec<Propagated<Self, N>>>> {
+        None
+    }
+
+    /// Differential drive (Long et al. 2012), SE(2) only.
+    fn diff_drive(_params: &DiffDriveParams) -> Option<crate::Result<DiffDriveOutcome<Self, N>>> {
+        None
+    }
+
+    /// Euler integration vs the exponential map, SO(3) only: per step (Euler matrix, Exp element).
+    fn euler_vs_exp(
+        _rate: &Vector3<f64>,
+        _dt: f64,
+        _steps: u64,
+    ) -> Option<Vec<(Matrix3<f64>, Self)>> {
+        None
+    }
+}
+
+/// Parameters of a `diff_drive` operation (validated by [`DiffDrive::try_new`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DiffDriveParams {
+    /// Wheel radius r (m).
+    pub wheel_radius: f64,
+    /// Wheelbase l (m).
+    pub wheelbase: f64,
+    /// Duration T (s).
+    pub duration: f64,
+    /// Wheel noise intensity D.
+    pub diffusion: f64,
+    /// Forward speed v (m/s).
+    pub speed: f64,
+    /// Turn rate α̇ (rad/s).
+    pub turn_rate: f64,
+    /// Euler–Maruyama step (s).
+    pub dt: f64,
+    /// Monte Carlo samples (0: none).
+    pub samples: usize,
+    /// Seed.
+    pub seed: u64,
+}
+
+/// What a differential-drive run produces.
+#[derive(Debug, Clone)]
+pub struct DiffDriveOutcome<G: LieGroup<N>, const N: usize> {
+    /// Closed form and numeric integral (relative to the start pose).
+    pub estimates: Vec<Propagated<G, N>>,
+    /// Euler–Maruyama end poses.
+    pub end_poses: Vec<G>,
+    /// A few sampled trajectories.
+    pub trajectories: Vec<Vec<G>>,
+    /// The nominal path.
+    pub nominal_path: Vec<G>,
+}
+
+/// Trajectories kept from the SDE sampling, for drawing.
+const DIFF_DRIVE_TRAJECTORIES: usize = 30;
+
+/// First-order point through pose for a group acting on ℝᴰ, lifted to 3D (z = 0 in the plane).
+fn point_estimate<G, const N: usize, const D: usize>(
+    pose: &UncertainPose<G, N>,
+    point: &[f64],
+    cov: &[Vec<f64>],
+) -> Result<([f64; 3], [[f64; 3]; 3]), String>
+where
+    G: LieGroup<
+            N,
+            Point = nalgebra::SVector<f64, D>,
+            ActJacobian = nalgebra::SMatrix<f64, D, N>,
+            PointJacobian = nalgebra::SMatrix<f64, D, D>,
+        >,
+{
+    let p = nalgebra::SVector::<f64, D>::from_iterator(point.iter().copied());
+    let c = fixed_matrix::<D, D>("point_cov", cov)?;
+    let q = first_order::act_point(pose, &p, &c).map_err(|e| e.to_string())?;
+    let mut mean = [0.0; 3];
+    let mut cov3 = [[0.0; 3]; 3];
+    for (r, row) in cov3.iter_mut().enumerate().take(D) {
+        mean[r] = q.mean[r];
+        for (c, value) in row.iter_mut().enumerate().take(D) {
+            *value = q.cov[(r, c)];
+        }
+    }
+    Ok((mean, cov3))
+}
+
+fn ssc_compose_in<G: VectorChart<N>, const N: usize>(
+    x: &UncertainPose<G, N>,
+    y: &UncertainPose<G, N>,
+) -> crate::Result<Propagated<G, N>> {
+    ssc_compose(
+        &VectorPose::from_uncertain(x)?,
+        &VectorPose::from_uncertain(y)?,
+    )?
+    .to_uncertain()
+}
+
+fn ssc_odometry_in<G: VectorChart<N>, const N: usize>(
+    start: &UncertainPose<G, N>,
+    increments: &[G],
+    noise: &TangentMatrix<N>,
+) -> crate::Result<Vec<Propagated<G, N>>> {
+    let coordinates: Vec<_> = increments.iter().map(VectorChart::to_coordinates).collect();
+    ssc_odometry(&VectorPose::from_uncertain(start)?, &coordinates, noise)?
+        .iter()
+        .map(VectorPose::to_uncertain)
+        .collect()
+}
+
+impl EvalGroup<1> for So2 {
+    fn point_dims() -> usize {
+        2
+    }
+    fn point_through(
+        pose: &UncertainPose<Self, 1>,
+        point: &[f64],
+        cov: &[Vec<f64>],
+    ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+        point_estimate::<Self, 1, 2>(pose, point, cov)
+    }
+}
+
+impl EvalGroup<3> for So3 {
+    fn point_dims() -> usize {
+        3
+    }
+    fn point_through(
+        pose: &UncertainPose<Self, 3>,
+        point: &[f64],
+        cov: &[Vec<f64>],
+    ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+        point_estimate::<Self, 3, 3>(pose, point, cov)
+    }
+    fn euler_vs_exp(rate: &Vector3<f64>, dt: f64, steps: u64) -> Option<Vec<(Matrix3<f64>, Self)>> {
+        let step = rate * dt;
+        let increment = Matrix3::identity() + So3::hat(&step);
+        let mut euler = Matrix3::identity();
+        let mut exp = So3::identity();
+        let mut out = vec![(euler, exp)];
+        for _ in 0..steps {
+            euler *= increment;
+            exp = exp.rplus(&step);
+            out.push((euler, exp));
+        }
+        Some(out)
+    }
+}
+
+/// The operations SE(2) and SE(3) share: point through pose, 2nd/4th-order compounding, and
+/// the Smith–Self–Cheeseman baseline in their vector coordinates.
+macro_rules! pose_group_ops {
+    ($N:literal, $D:literal, $compound:path) => {
+        fn point_dims() -> usize {
+            $D
+        }
+        fn point_through(
+            pose: &UncertainPose<Self, $N>,
+            point: &[f64],
+            cov: &[Vec<f64>],
+        ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+            point_estimate::<Self, $N, $D>(pose, point, cov)
+        }
+        fn compound(
+            x: &UncertainPose<Self, $N>,
+            y: &UncertainPose<Self, $N>,
+            order: Order,
+        ) -> Option<Propagated<Self, $N>> {
+            Some($compound(x, y, order))
+        }
+        fn ssc_compose(
+            x: &UncertainPose<Self, $N>,
+            y: &UncertainPose<Self, $N>,
+        ) -> Option<crate::Result<Propagated<Self, $N>>> {
+            Some(ssc_compose_in(x, y))
+        }
+        fn ssc_odometry(
+            start: &UncertainPose<Self, $N>,
+            increments: &[Self],
+            noise: &TangentMatrix<$N>,
+        ) -> Option<crate::Result<Vec<Propagated<Self, $N>>>> {
+            Some(ssc_odometry_in(start, increments, noise))
+        }
+    };
+}
+
+impl EvalGroup<3> for Se2 {
+    pose_group_ops!(3, 2, fourth_order::compound_se2);
+
+    fn diff_drive(p: &DiffDriveParams) -> Option<crate::Result<DiffDriveOutcome<Self, 3>>> {
+        Some((|| {
+            let robot = DiffDrive::try_new(p.wheel_radius, p.wheelbase, p.diffusion)?;
+            let closed = if p.turn_rate == 0.0 {
+                robot.straight_closed_form(p.speed, p.duration)?
+            } else {
+                robot.arc_closed_form(p.speed, p.turn_rate, p.duration)?
+            };
+            let rates = robot.wheel_rates_for(p.speed, p.turn_rate);
+            let integral = robot.numeric_integral(rates, p.duration, 1e-12)?;
+            let nominal_path = (0..=100)
+                .map(|i| robot.nominal(rates, p.duration * f64::from(i) / 100.0))
+                .collect();
+            let (end_poses, trajectories) = if p.samples > 0 {
+                let settings = EulerMaruyama::new(p.dt, p.samples, p.seed)
+                    .with_trajectories(DIFF_DRIVE_TRAJECTORIES, 10);
+                let sde = robot.euler_maruyama(rates, p.duration, &settings)?;
+                (sde.end_poses, sde.trajectories)
+            } else {
+                (Vec::new(), Vec::new())
+            };
+            Ok(DiffDriveOutcome {
+                estimates: vec![closed, integral],
+                end_poses,
+                trajectories,
+                nominal_path,
+            })
+        })())
+    }
+}
+
+impl EvalGroup<6> for Se3 {
+    pose_group_ops!(6, 3, fourth_order::compound_se3);
+}
