@@ -142,7 +142,7 @@ pub enum RotationFirstSource {
     /// sophus-rs `Isometry3`: tangent rotation first. It carries no covariance convention
     /// of its own; posecov assumes right (body) perturbations X · Exp(ξ) as in its optimiser.
     SophusRs,
-    /// Columbia EEME E6911 slides: δ = [ω; v] with left perturbations T̃ = e^[δ] T.
+    /// Columbia EEME E6911 slides: δ = [ω; v] with left perturbations T̃ = e^\[δ\] T.
     EemeE6911,
 }
 

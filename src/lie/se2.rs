@@ -262,7 +262,7 @@ impl LieGroup<3> for Se2 {
         )
     }
 
-    /// ad_[ρ;θ] = [[0, −θ, ρy], [θ, 0, −ρx], [0, 0, 0]] (derivative of Ad at the identity).
+    /// ad_\[ρ;θ\] = [[0, −θ, ρy], [θ, 0, −ρx], [0, 0, 0]] (derivative of Ad at the identity).
     #[inline]
     fn ad(tau: &Tangent<3>) -> TangentMatrix<3> {
         Matrix3::new(0.0, -tau.z, tau.y, tau.z, 0.0, -tau.x, 0.0, 0.0, 0.0)

@@ -274,7 +274,7 @@ impl LieGroup<6> for Se3 {
         upper_block(&r, &(So3::skew(&self.translation) * r))
     }
 
-    /// ad_[ρ;θ] = [[θ^, ρ^], [0, θ^]] (Barfoot & Furgale 2014, eq. 12, translation first).
+    /// ad_\[ρ;θ\] = [[θ^, ρ^], [0, θ^]] (Barfoot & Furgale 2014, eq. 12, translation first).
     #[inline]
     fn ad(xi: &Tangent<6>) -> TangentMatrix<6> {
         let (rho, theta) = split(xi);

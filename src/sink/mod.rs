@@ -58,7 +58,7 @@ pub enum Sink {
         /// Open the viewer URL in the default browser.
         open_browser: bool,
     },
-    /// Keep everything in memory (tests); read it with [`SinkGuard::take_bytes`].
+    /// Keep everything in memory (tests); read it with [`SinkGuard::finish`].
     Memory,
 }
 
