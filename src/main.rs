@@ -193,25 +193,25 @@ impl ScenarioArgs {
                 .unwrap_or_else(|_| ProgressStyle::default_spinner()),
         );
         // The spinner draws only on a terminal (indicatif hides it otherwise) and only after
-        // 0.3 s, so quick scenarios print nothing.
+        // 0.3 s, so quick scenarios print nothing; the evaluation wakes the ticker when done.
         let done = AtomicBool::new(false);
-        let ticking = std::thread::scope(|scope| {
+        let result = std::thread::scope(|scope| {
             let ticker = scope.spawn(|| {
                 let start = std::time::Instant::now();
-                while !done.load(Ordering::Relaxed) {
+                while !done.load(Ordering::Acquire) {
                     if start.elapsed() > Duration::from_millis(300) {
                         spinner.tick();
                     }
-                    std::thread::sleep(Duration::from_millis(80));
+                    std::thread::park_timeout(Duration::from_millis(80));
                 }
             });
             let result = evaluate(&scenario, &self.options(cancel));
-            done.store(true, Ordering::Relaxed);
-            let _ = ticker.join();
+            done.store(true, Ordering::Release);
+            ticker.thread().unpark();
             result
         });
         spinner.finish_and_clear();
-        Ok(ticking?)
+        Ok(result?)
     }
 
     /// The seed in effect (for the recording id): the flag, else the scenario's.
