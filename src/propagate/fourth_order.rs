@@ -42,10 +42,12 @@
 //! assert!(c.pose.cov()[(0, 0)] > 0.0);
 //! ```
 
-use nalgebra::{Matrix3, Matrix6, Vector3};
+use nalgebra::{Matrix3, Matrix6};
 
 use super::Propagated;
-use crate::lie::{LieGroup, Se2, Se3, So3};
+/// SE(2) as the planar subgroup of SE(3) (re-exported: one definition, in [`crate::convert`]).
+pub use crate::convert::se2_to_se3;
+use crate::lie::{LieGroup, Se2, Se3};
 use crate::uncertain::{Method, Side, UncertainPose};
 
 /// Which truncation of the compound covariance.
@@ -283,21 +285,6 @@ pub fn compound_se3_variant(
 
 /// Tangent indices of SE(2)'s [ρx, ρy, θ] inside SE(3)'s [ρ; θ].
 const SE2_IN_SE3: [usize; 3] = [0, 1, 5];
-
-/// SE(2) as the planar subgroup of SE(3): (x, y, θ) ↦ translation (x, y, 0), yaw θ.
-///
-/// ```
-/// use posecov::lie::{LieGroup, Se2};
-/// use posecov::propagate::fourth_order::{se2_to_se3, se3_to_se2};
-/// let x = Se2::from_xy_theta(1.0, 2.0, 0.5);
-/// assert!(se3_to_se2(&se2_to_se3(&x)).is_approx(&x, 1e-15));
-/// ```
-pub fn se2_to_se3(x: &Se2) -> Se3 {
-    Se3::from_parts(
-        Vector3::new(x.x(), x.y(), 0.0),
-        So3::from_rpy(0.0, 0.0, x.theta()),
-    )
-}
 
 /// The planar part of an SE(3) pose: (x, y, yaw), dropping z, roll and pitch (the inverse of
 /// [`se2_to_se3`] on the planar subgroup).
