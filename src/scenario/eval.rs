@@ -175,6 +175,9 @@ fn keys_set(op: &OperationSpec) -> Vec<&'static str> {
     .collect()
 }
 
+/// Monte Carlo particles of a node, shared between the operations that read it.
+type Particles<G> = Option<Arc<Vec<G>>>;
+
 /// A named thing an operation can take as input.
 #[derive(Clone, Copy)]
 enum Value<G: LieGroup<N>, const N: usize> {
@@ -393,7 +396,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
     }
 
     /// The first-order Gaussian and the particles of a named value.
-    fn gaussian(&self, value: Value<G, N>) -> (UncertainPose<G, N>, Option<Arc<Vec<G>>>) {
+    fn gaussian(&self, value: Value<G, N>) -> (UncertainPose<G, N>, Particles<G>) {
         match value {
             Value::Fixed(g) => (UncertainPose::certain(g), None),
             Value::Node(i) => {
@@ -412,6 +415,18 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 (pose, node.particles.clone())
             }
         }
+    }
+
+    /// The Gaussian and particles of the pose an operation key (`input`, `lhs`, `rhs`) names.
+    fn input_gaussian(
+        &self,
+        op: &OperationSpec,
+        field: &str,
+        key: &str,
+        value: &Option<Spanned<String>>,
+    ) -> Result<(UncertainPose<G, N>, Particles<G>), ScenarioError> {
+        let name = self.need(value, op, field, key)?;
+        Ok(self.gaussian(self.lookup(name, &format!("{field}.{key}"))?))
     }
 
     fn fixed(&self, name: &Spanned<String>, field: &str) -> Result<G, ScenarioError> {
@@ -480,17 +495,13 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         let f = |k: &str| format!("{field}.{k}");
         match kind {
             "inverse" => {
-                let (x, px) = self.gaussian(
-                    self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?,
-                );
+                let (x, px) = self.input_gaussian(op, &field, "input", &op.input)?;
                 let fo = first_order::inverse(&x);
                 let particles = px.map(|p| map_particles(&p, |g| g.inverse()));
                 self.output(output, fo, particles, |g: &[G]| g[0].inverse(), &[x]);
             }
             "change_frame_left" => {
-                let (x, px) = self.gaussian(
-                    self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?,
-                );
+                let (x, px) = self.input_gaussian(op, &field, "input", &op.input)?;
                 let a = self.fixed(self.need(&op.by, op, &field, "by")?, &f("by"))?;
                 let fo = first_order::change_frame_left(&a, &x);
                 let particles = px.map(|p| map_particles(&p, |g| a.compose(g)));
@@ -509,9 +520,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 );
             }
             "change_frame_right" => {
-                let (x, px) = self.gaussian(
-                    self.lookup(self.need(&op.input, op, &field, "input")?, &f("input"))?,
-                );
+                let (x, px) = self.input_gaussian(op, &field, "input", &op.input)?;
                 let b = self.fixed(self.need(&op.by, op, &field, "by")?, &f("by"))?;
                 let fo = first_order::change_frame_right(&x, &b);
                 let particles = px.map(|p| map_particles(&p, |g| g.compose(&b)));
@@ -530,10 +539,8 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 );
             }
             "compose" | "between" => {
-                let (x, px) =
-                    self.gaussian(self.lookup(self.need(&op.lhs, op, &field, "lhs")?, &f("lhs"))?);
-                let (y, py) =
-                    self.gaussian(self.lookup(self.need(&op.rhs, op, &field, "rhs")?, &f("rhs"))?);
+                let (x, px) = self.input_gaussian(op, &field, "lhs", &op.lhs)?;
+                let (y, py) = self.input_gaussian(op, &field, "rhs", &op.rhs)?;
                 let compose = kind == "compose";
                 let fo = if compose {
                     first_order::compose(&x, &y)
@@ -689,14 +696,8 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         output: String,
         compose: bool,
     ) -> Result<(), ScenarioError> {
-        let (x, _) = self.gaussian(self.lookup(
-            self.need(&op.lhs, op, field, "lhs")?,
-            &format!("{field}.lhs"),
-        )?);
-        let (y, _) = self.gaussian(self.lookup(
-            self.need(&op.rhs, op, field, "rhs")?,
-            &format!("{field}.rhs"),
-        )?);
+        let (x, _) = self.input_gaussian(op, field, "lhs", &op.lhs)?;
+        let (y, _) = self.input_gaussian(op, field, "rhs", &op.rhs)?;
         let cross = self.need(&op.cross_cov, op, field, "cross_cov")?;
         let cross_xy: TangentMatrix<N> = fixed_matrix::<N, N>("cross_cov", cross.get_ref())
             .map_err(|m| self.err(cross.span(), &format!("{field}.cross_cov"), m))?;
@@ -799,10 +800,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         field: &str,
         output: String,
     ) -> Result<(), ScenarioError> {
-        let (start, start_particles) = self.gaussian(self.lookup(
-            self.need(&op.input, op, field, "input")?,
-            &format!("{field}.input"),
-        )?);
+        let (start, start_particles) = self.input_gaussian(op, field, "input", &op.input)?;
         let model_spec = self.need(&op.model, op, field, "model")?;
         let increment = match model_spec.get_ref().as_str() {
             "increment" => true,
@@ -946,10 +944,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         field: &str,
         output: String,
     ) -> Result<(), ScenarioError> {
-        let (start, start_particles) = self.gaussian(self.lookup(
-            self.need(&op.input, op, field, "input")?,
-            &format!("{field}.input"),
-        )?);
+        let (start, start_particles) = self.input_gaussian(op, field, "input", &op.input)?;
         let step_mean = self.fixed(self.need(&op.by, op, field, "by")?, &format!("{field}.by"))?;
         let (noise, noise_side) = self.noise_cov(op, field, &step_mean)?;
         let steps = self.steps(op, field)?.unwrap_or(1);
@@ -1039,10 +1034,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         field: &str,
         output: String,
     ) -> Result<(), ScenarioError> {
-        let (pose, particles) = self.gaussian(self.lookup(
-            self.need(&op.input, op, field, "input")?,
-            &format!("{field}.input"),
-        )?);
+        let (pose, particles) = self.input_gaussian(op, field, "input", &op.input)?;
         let point = self.need(&op.point, op, field, "point")?;
         let cov = op.point_cov.as_ref();
         let at = |span: std::ops::Range<usize>, key: &str, m: String| {
