@@ -15,7 +15,9 @@ use std::fmt;
 
 use nalgebra::{Isometry2, Matrix2, Matrix2x3, Matrix3, Translation2, Vector2, Vector3};
 
-use super::series::{one_minus_cos_by_theta2, sinc, theta_minus_sin_by_theta3};
+use super::series::{
+    half_theta_cot_half_theta, one_minus_cos_by_theta2, sinc, theta_minus_sin_by_theta3,
+};
 use super::{ActJacobians, LieGroup, So2, Tangent, TangentMatrix};
 use crate::error::{Error, Result, check_finite};
 
@@ -34,18 +36,24 @@ pub struct Se2 {
     translation: Vector2<f64>,
 }
 
-/// The SE(2) "V" block of Exp, V(θ) = [[a, −b], [b, a]] with a = sin θ/θ, b = (1 − cos θ)/θ.
+/// The SE(2) "V" block of Exp, V(θ) = [[a, −b], [b, a]] with a = sin θ/θ, b = (1 − cos θ)/θ,
+/// from θ and its cos and sin (computed once by the caller); Taylor branches below
+/// [`SMALL_ANGLE`](super::series::SMALL_ANGLE).
 #[inline]
-fn v_matrix(theta: f64) -> Matrix2<f64> {
-    let (a, b) = (sinc(theta), theta * one_minus_cos_by_theta2(theta));
+fn v_matrix(theta: f64, cos_theta: f64, sin_theta: f64) -> Matrix2<f64> {
+    let (a, b) = if theta.abs() < super::series::SMALL_ANGLE {
+        (sinc(theta), theta * one_minus_cos_by_theta2(theta))
+    } else {
+        (sin_theta / theta, (1.0 - cos_theta) / theta)
+    };
     Matrix2::new(a, -b, b, a)
 }
 
-/// V(θ)⁻¹ = [[h, θ/2], [−θ/2, h]] with h = (θ/2) cot(θ/2) = cos(θ/2) / sinc(θ/2): finite at θ = ±π.
+/// V(θ)⁻¹ = [[h, θ/2], [−θ/2, h]] with h = (θ/2) cot(θ/2): finite at θ = ±π.
 #[inline]
-fn v_inverse(theta: f64) -> Matrix2<f64> {
+fn v_inverse(theta: f64, cos_theta: f64, sin_theta: f64) -> Matrix2<f64> {
+    let h = half_theta_cot_half_theta(theta, cos_theta, sin_theta);
     let half = 0.5 * theta;
-    let h = half.cos() / sinc(half);
     Matrix2::new(h, half, -half, h)
 }
 
@@ -223,14 +231,17 @@ impl LieGroup<3> for Se2 {
     #[inline]
     fn exp(tau: &Tangent<3>) -> Self {
         let rho = Vector2::new(tau.x, tau.y);
-        Self::from_parts(v_matrix(tau.z) * rho, So2::from_angle(tau.z))
+        let (sin_theta, cos_theta) = tau.z.sin_cos();
+        let rotation = So2::from_cos_sin_unchecked(cos_theta, sin_theta);
+        Self::from_parts(v_matrix(tau.z, cos_theta, sin_theta) * rho, rotation)
     }
 
     /// Log(R, t) = [V(θ)⁻¹ t; θ], θ = atan2 ∈ (−π, π] (Solà eq. 157).
     #[inline]
     fn log(&self) -> Tangent<3> {
         let theta = self.theta();
-        let rho = v_inverse(theta) * self.translation;
+        let z = self.rotation.complex();
+        let rho = v_inverse(theta, z.re, z.im) * self.translation;
         Vector3::new(rho.x, rho.y, theta)
     }
 

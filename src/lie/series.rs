@@ -120,6 +120,27 @@ pub fn q_coefficient_3(theta: f64) -> f64 {
     }
 }
 
+/// h(θ) = (θ/2) cot(θ/2), the diagonal of the SE(2) V(θ)⁻¹ (Solà et al. 2018, eq. 158),
+/// from θ and its already-computed cos θ and sin θ: (θ/2) sin θ / (1 − cos θ) above
+/// [`SMALL_ANGLE`] (0 at θ = ±π, no 0/0 there), 1 − θ²/12 − θ⁴/720 − θ⁶/30240 below.
+///
+/// ```
+/// use posecov::lie::series::half_theta_cot_half_theta as h;
+/// let t: f64 = 1.0;
+/// assert!((h(t, t.cos(), t.sin()) - 0.5 / (0.5f64).tan()).abs() < 1e-15);
+/// assert_eq!(h(0.0, 1.0, 0.0), 1.0);
+/// assert_eq!(h(std::f64::consts::PI, -1.0, 0.0), 0.0);
+/// ```
+#[inline]
+pub fn half_theta_cot_half_theta(theta: f64, cos_theta: f64, sin_theta: f64) -> f64 {
+    if theta.abs() < SMALL_ANGLE {
+        let t2 = theta * theta;
+        1.0 - t2 / 12.0 - t2 * t2 / 720.0 - t2 * t2 * t2 / 30240.0
+    } else {
+        0.5 * theta * sin_theta / (1.0 - cos_theta)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -129,7 +150,9 @@ mod tests {
     fn branches_meet_at_the_threshold() {
         let below = SMALL_ANGLE * (1.0 - 1e-12);
         let above = SMALL_ANGLE * (1.0 + 1e-12);
+        let h = |t: f64| half_theta_cot_half_theta(t, t.cos(), t.sin());
         for f in [
+            h,
             sinc,
             one_minus_cos_by_theta2,
             theta_minus_sin_by_theta3,

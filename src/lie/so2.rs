@@ -50,6 +50,15 @@ impl So2 {
         }
     }
 
+    /// From cos θ and sin θ already computed (and of unit norm): saves the trigonometry when a
+    /// caller needs both anyway (SE(2) Exp).
+    #[inline]
+    pub(crate) fn from_cos_sin_unchecked(cos_theta: f64, sin_theta: f64) -> Self {
+        Self {
+            complex: UnitComplex::from_cos_sin_unchecked(cos_theta, sin_theta),
+        }
+    }
+
     /// The angle in (−π, π].
     ///
     /// ```
