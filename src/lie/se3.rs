@@ -15,7 +15,9 @@ use std::fmt;
 
 use nalgebra::{Isometry3, Matrix3, Matrix3x6, Matrix4, Matrix6, Translation3, Vector3, Vector6};
 
-use super::series::{q_coefficient_2, q_coefficient_3, theta_minus_sin_by_theta3};
+use super::series::{
+    one_minus_cos_by_theta2, q_coefficient_2, q_coefficient_3, theta_minus_sin_by_theta3,
+};
 use super::{ActJacobians, LieGroup, So3, Tangent, TangentMatrix};
 use crate::error::{Error, Result, check_finite};
 
@@ -234,7 +236,13 @@ impl LieGroup<6> for Se3 {
     #[inline]
     fn exp(xi: &Tangent<6>) -> Self {
         let (rho, theta) = split(xi);
-        Self::from_parts(So3::jl(&theta) * rho, So3::exp(&theta))
+        // Jl(θ) ρ = ρ + A θ×ρ + B θ×(θ×ρ): the same V·ρ without building 3×3 matrices.
+        let angle = theta.norm();
+        let theta_x_rho = theta.cross(&rho);
+        let translation = rho
+            + theta_x_rho * one_minus_cos_by_theta2(angle)
+            + theta.cross(&theta_x_rho) * theta_minus_sin_by_theta3(angle);
+        Self::from_parts(translation, So3::exp(&theta))
     }
 
     /// Log(R, t) = [Jl(θ)⁻¹ t; θ] with θ = Log(R) (Solà eq. 173).
