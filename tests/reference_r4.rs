@@ -4,8 +4,8 @@
 
 mod common;
 
-use common::assert_close;
-use nalgebra::{Matrix6, Vector3, Vector6};
+use common::{assert_close, r4_inputs, r4_noise};
+use nalgebra::{Vector3, Vector6};
 use posecov::lie::{LieGroup, Se3};
 use posecov::propagate::Propagated;
 use posecov::propagate::odometry::{InputNoise, propagate_tangent_inputs};
@@ -14,38 +14,9 @@ use posecov::uncertain::{Method, Side, UncertainPose};
 /// The table's 6 decimals.
 const TABLE_TOL: f64 = 1e-6;
 
-fn inputs() -> Vec<Vector6<f64>> {
-    // v1 = linspace(0, 4, 4) = (0, 4/3, 8/3, 4), printed as 1.333333, 2.666667.
-    (0..4)
-        .map(|k| {
-            let t = k as f64;
-            let v1 = 4.0 * t / 3.0;
-            Vector6::new(
-                v1,
-                1.5 * v1,
-                0.05 * (0.6 * v1).exp() - 0.05,
-                0.5 * t / 3.0,
-                0.3 * t / 3.0,
-                0.7 * t / 3.0,
-            )
-        })
-        .collect()
-}
-
-fn cov_w() -> Matrix6<f64> {
-    Matrix6::from_diagonal(&Vector6::new(
-        0.01f64.powi(2),
-        0.01f64.powi(2),
-        0.05f64.powi(2),
-        0.05f64.powi(2),
-        0.05f64.powi(2),
-        0.2f64.powi(2),
-    ))
-}
-
 fn run(noise: InputNoise, side: Side) -> Vec<Propagated<Se3, 6>> {
     let start = UncertainPose::certain(Se3::identity()).to_side(side);
-    propagate_tangent_inputs(&start, &inputs(), &cov_w(), noise).expect("valid R4 inputs")
+    propagate_tangent_inputs(&start, &r4_inputs(), &r4_noise(), noise).expect("valid R4 inputs")
 }
 
 #[test]

@@ -7,6 +7,9 @@
 //! = 0.45 % (Gaussian), so the 2 % criterion of R4 is > 4 standard errors away from sampling
 //! noise; the rest of the 2 % is the first-order truncation (≈ 1 % here).
 
+mod common;
+
+use common::{r4_inputs, r4_noise};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use posecov::lie::{LieGroup, Se2, Se3};
 use posecov::propagate::monte_carlo::{MonteCarlo, odometry_increments, odometry_tangent_inputs};
@@ -15,36 +18,6 @@ use posecov::propagate::relative_frobenius_error;
 use posecov::uncertain::{Method, Side, UncertainPose};
 
 const N: usize = 100_000;
-
-fn r4_inputs() -> Vec<Vector6<f64>> {
-    let v1: [f64; 4] = [0.0, 4.0 / 3.0, 8.0 / 3.0, 4.0];
-    let w1 = [0.0, 1.0 / 6.0, 1.0 / 3.0, 0.5];
-    let w2 = [0.0, 0.1, 0.2, 0.3];
-    let w3 = [0.0, 0.7 / 3.0, 1.4 / 3.0, 0.7];
-    (0..4)
-        .map(|k| {
-            Vector6::new(
-                v1[k],
-                1.5 * v1[k],
-                0.05 * (0.6 * v1[k]).exp() - 0.05,
-                w1[k],
-                w2[k],
-                w3[k],
-            )
-        })
-        .collect()
-}
-
-fn r4_noise() -> Matrix6<f64> {
-    Matrix6::from_diagonal(&Vector6::new(
-        0.01f64.powi(2),
-        0.01f64.powi(2),
-        0.05f64.powi(2),
-        0.05f64.powi(2),
-        0.05f64.powi(2),
-        0.2f64.powi(2),
-    ))
-}
 
 #[track_caller]
 fn assert_diagonal(cov: &Matrix6<f64>, expected: [f64; 6], tol: f64, what: &str) {

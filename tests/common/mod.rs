@@ -129,3 +129,35 @@ pub fn uncentred_cov<const N: usize>(samples: &[SVector<f64, N>]) -> SMatrix<f64
     }
     cov / samples.len() as f64
 }
+
+/// REFERENCE_CASES R4 inputs u_k = (v1, 1.5 v1, 0.05 e^(0.6 v1) − 0.05, ω1, ω2, ω3), k = 0..3.
+pub fn r4_inputs() -> Vec<nalgebra::Vector6<f64>> {
+    let v1: [f64; 4] = [0.0, 4.0 / 3.0, 8.0 / 3.0, 4.0];
+    let w1 = [0.0, 1.0 / 6.0, 1.0 / 3.0, 0.5];
+    let w2 = [0.0, 0.1, 0.2, 0.3];
+    let w3 = [0.0, 0.7 / 3.0, 1.4 / 3.0, 0.7];
+    (0..4)
+        .map(|k| {
+            nalgebra::Vector6::new(
+                v1[k],
+                1.5 * v1[k],
+                0.05 * (0.6 * v1[k]).exp() - 0.05,
+                w1[k],
+                w2[k],
+                w3[k],
+            )
+        })
+        .collect()
+}
+
+/// REFERENCE_CASES R4 noise Σ_w = diag(0.01², 0.01², 0.05², 0.05², 0.05², 0.2²).
+pub fn r4_noise() -> nalgebra::Matrix6<f64> {
+    nalgebra::Matrix6::from_diagonal(&nalgebra::Vector6::new(
+        0.01f64.powi(2),
+        0.01f64.powi(2),
+        0.05f64.powi(2),
+        0.05f64.powi(2),
+        0.05f64.powi(2),
+        0.2f64.powi(2),
+    ))
+}
