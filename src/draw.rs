@@ -12,7 +12,10 @@
 //! - `axis_x|y|z` (rotation groups): the Exp-image of the same ellipsoid seen through each
 //!   body axis tip, R̄ Exp(L u) e_k, around each mean axis;
 //! - `monte_carlo/cloud`, `monte_carlo/triads`, `monte_carlo/spray`: particle positions, a
-//!   subsample of small axis triads, and axis-tip sprays.
+//!   subsample of small axis triads, and axis-tip sprays. A sample simulated in blocks
+//!   ([blocked Monte Carlo](crate::scenario::eval#blocked-monte-carlo-bounded-memory)) draws
+//!   its first block here and each later block `k` as a child `…/cloud/block_k` (and
+//!   `spray_x/block_k`, …) from [`particle_parts`].
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -75,6 +78,99 @@ pub fn build_scene(evaluation: &AnyEvaluation) -> Scene {
         AnyEvaluation::So3(e) => build(e),
         AnyEvaluation::Se3(e) => build(e),
     }
+}
+
+/// The clouds of a blocked Monte Carlo sample beyond its first block
+/// ([blocked Monte Carlo](crate::scenario::eval#blocked-monte-carlo-bounded-memory)): one
+/// scene per block `k ≥ 1`, evaluated when the iterator reaches it and holding only that
+/// block's particle clouds and axis-tip sprays, at `…/monte_carlo/cloud/block_k` (and
+/// `spray_x/block_k`, …), drawn with `main`'s sizes. Log each with
+/// `sink::log_part_cancellable` after the main scene and drop it: memory stays bounded.
+/// Empty when the whole sample fit in one block.
+///
+/// ```
+/// use posecov::scenario::{Scenario, eval::{EvalOptions, evaluate}};
+/// let s = Scenario::load_any("camera_on_robot").unwrap();
+/// let options = EvalOptions { samples: Some(3000), block_samples: Some(1024), ..Default::default() };
+/// let main = evaluate(&s, &options).unwrap();
+/// let parts: Vec<_> = posecov::draw::particle_parts(&s, &options, &main).collect::<Result<_, _>>().unwrap();
+/// assert_eq!(parts.len(), 2); // samples 1024..2048 and 2048..3000
+/// assert!(parts[1].items.iter().any(|i| i.path.ends_with("/cloud/block_2")));
+/// ```
+pub fn particle_parts<'a>(
+    scenario: &'a crate::scenario::Scenario,
+    options: &'a crate::scenario::eval::EvalOptions,
+    main: &'a AnyEvaluation,
+) -> impl Iterator<Item = Result<Scene, crate::scenario::ScenarioError>> + 'a {
+    (1..).map_while(move |k| {
+        match crate::scenario::eval::evaluate_block(scenario, options, main, k) {
+            Ok(Some(block)) => Some(Ok(particle_part(main, &block, k))),
+            Ok(None) => None,
+            Err(e) => Some(Err(e)),
+        }
+    })
+}
+
+/// The particle items of `block` (block `part` of `main`'s sample), sized as in `main`'s scene.
+fn particle_part(main: &AnyEvaluation, block: &AnyEvaluation, part: usize) -> Scene {
+    match (main, block) {
+        (AnyEvaluation::So2(m), AnyEvaluation::So2(b)) => part_of(m, b, part),
+        (AnyEvaluation::Se2(m), AnyEvaluation::Se2(b)) => part_of(m, b, part),
+        (AnyEvaluation::So3(m), AnyEvaluation::So3(b)) => part_of(m, b, part),
+        (AnyEvaluation::Se3(m), AnyEvaluation::Se3(b)) => part_of(m, b, part),
+        _ => Scene::new(main.meta().title.clone(), String::new()),
+    }
+}
+
+fn part_of<G: SpecGroup<N>, const N: usize>(
+    main: &Evaluation<G, N>,
+    block: &Evaluation<G, N>,
+    part: usize,
+) -> Scene {
+    let rotation_group = G::rotation_range().start == 0;
+    let mut p = painter(main);
+    p.scene = Scene::new(main.meta.title.clone(), String::new());
+    for node in block
+        .nodes
+        .iter()
+        .filter(|n| n.draw && n.role != Role::Fixed)
+    {
+        if let Some(particles) = node
+            .particles
+            .as_ref()
+            .filter(|_| p.particles_at(node.step))
+        {
+            draw_particles(
+                &mut p,
+                node,
+                particles,
+                rotation_group,
+                &main.meta.draw,
+                Some(part),
+            );
+        }
+    }
+    if main.meta.draw.clouds {
+        for point in &block.points {
+            if let Some(particles) = &point.particles {
+                p.push(
+                    format!("world/{}/monte_carlo/cloud/block_{part}", point.name),
+                    None,
+                    point_cloud_item(particles.clone()),
+                );
+            }
+        }
+    }
+    p.scene
+}
+
+/// The Monte Carlo points of a `point_through_pose` output.
+fn point_cloud_item(positions: Vec<Vec3>) -> ItemKind {
+    ItemKind::Points(PointCloud {
+        positions,
+        color: cloud_color(),
+        radius: 0.01,
+    })
 }
 
 /// χ²_d quantile radius r = √χ²_d(p): the Mahalanobis radius of a p-confidence region.
@@ -152,6 +248,8 @@ struct Painter {
     scene: Scene,
     confidence: f64,
     axis_length: f64,
+    /// Size of the drawing, metres ([`scene_extent`]).
+    extent: f64,
     /// Particles are drawn every `particle_stride` steps (and at the last), so long
     /// propagations stay light.
     particle_stride: u64,
@@ -168,7 +266,8 @@ impl Painter {
     }
 }
 
-fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
+/// The sizes of a scenario's drawing (from its nominal poses and paths) and an empty scene.
+fn painter<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Painter {
     let rotation_group = G::rotation_range().start == 0;
     let extent = scene_extent(e);
     let axis_length = e.meta.draw.axis_length.unwrap_or(if rotation_group {
@@ -177,13 +276,20 @@ fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
         (0.12 * extent).clamp(0.05, 2.0)
     });
     let last_step = e.nodes.iter().filter_map(|n| n.step).max().unwrap_or(0);
-    let mut p = Painter {
+    Painter {
         scene: Scene::new(e.meta.title.clone(), description(e)),
         confidence: e.meta.confidence,
         axis_length,
+        extent,
         particle_stride: last_step.div_ceil(MAX_PARTICLE_STEPS).max(1),
         last_step,
-    };
+    }
+}
+
+fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
+    let rotation_group = G::rotation_range().start == 0;
+    let mut p = painter(e);
+    let extent = p.extent;
     p.scene.planar = match e.meta.draw.view {
         Some(View::Top) => true,
         Some(View::Perspective) => false,
@@ -231,11 +337,7 @@ fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
             p.push(
                 format!("world/{}/monte_carlo/cloud", point.name),
                 None,
-                ItemKind::Points(PointCloud {
-                    positions: particles.clone(),
-                    color: cloud_color(),
-                    radius: 0.01,
-                }),
+                point_cloud_item(particles.clone()),
             );
         }
     }
@@ -430,7 +532,7 @@ fn draw_node<G: SpecGroup<N>, const N: usize>(
         .as_ref()
         .filter(|_| p.particles_at(node.step))
     {
-        draw_particles(p, node, particles, rotation_group, draw);
+        draw_particles(p, node, particles, rotation_group, draw, None);
     }
 }
 
@@ -594,12 +696,15 @@ fn draw_particles<G: SpecGroup<N>, const N: usize>(
     particles: &[G],
     rotation_group: bool,
     draw: &crate::scenario::schema::DrawSpec,
+    part: Option<usize>,
 ) {
     let base = format!("world/{}/monte_carlo", node.name);
+    // Later blocks of a blocked sample: their points only, as children of the first block's.
+    let suffix = part.map_or_else(String::new, |k| format!("/block_{k}"));
     let poses: Vec<Se3> = particles.iter().map(SpecGroup::to_se3).collect();
     if draw.clouds && !rotation_group {
         p.push(
-            format!("{base}/cloud"),
+            format!("{base}/cloud{suffix}"),
             node.step,
             ItemKind::Points(PointCloud {
                 positions: poses.iter().map(|x| v3(x.translation())).collect(),
@@ -608,7 +713,9 @@ fn draw_particles<G: SpecGroup<N>, const N: usize>(
             }),
         );
     }
-    if draw.sample_axes && !rotation_group && N == 3 {
+    if part.is_some() {
+        // Triads and headings are a subsample, drawn once from the first block.
+    } else if draw.sample_axes && !rotation_group && N == 3 {
         // Planar poses: a heading arrow per subsampled particle (a z axis would only clutter).
         let stride = (poses.len() / TRIAD_SUBSAMPLE).max(1);
         let subsample: Vec<&Se3> = poses.iter().step_by(stride).take(TRIAD_SUBSAMPLE).collect();
@@ -657,7 +764,7 @@ fn draw_particles<G: SpecGroup<N>, const N: usize>(
                 })
                 .collect();
             p.push(
-                format!("{base}/{name}"),
+                format!("{base}/{name}{suffix}"),
                 node.step,
                 ItemKind::Points(PointCloud {
                     positions: tips,

@@ -186,6 +186,7 @@ pub trait LieGroup<const N: usize>:
     /// let x = So2::from_angle(0.3).rplus(&Vector1::new(0.2));
     /// assert!((x.angle() - 0.5).abs() < 1e-15);
     /// ```
+    #[inline]
     fn rplus(&self, tau: &Tangent<N>) -> Self {
         self.compose(&Self::exp(tau))
     }
@@ -201,6 +202,7 @@ pub trait LieGroup<const N: usize>:
     /// let right = x.rplus(&(x.inverse().adj() * t));
     /// assert!(x.lplus(&t).rminus(&right).norm() < 1e-14);
     /// ```
+    #[inline]
     fn lplus(&self, tau: &Tangent<N>) -> Self {
         Self::exp(tau).compose(self)
     }

@@ -85,6 +85,11 @@ struct ScenarioArgs {
     /// Probability inside drawn regions, strictly between 0 and 1 (default: the scenario's).
     #[arg(long, value_parser = parse_probability)]
     confidence: Option<f64>,
+    /// Monte-Carlo particles held in memory at once, rounded up to a multiple of 1024
+    /// (default: what fits 128 MiB, at most 65536). Larger samples are simulated block by block: memory
+    /// stays bounded, statistics use every sample, and each block's cloud is logged in turn.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    block_samples: Option<u64>,
 }
 
 #[derive(Debug, Args)]
@@ -179,12 +184,13 @@ impl ScenarioArgs {
             samples: self.samples,
             confidence: self.confidence,
             cancel,
+            block_samples: self.block_samples.map(|b| b as usize),
         }
     }
 
     /// Loads (bundled name or file) and evaluates the scenario, with a spinner when it takes
     /// more than a moment.
-    fn evaluate(&self, cancel: Option<Arc<AtomicBool>>) -> anyhow::Result<AnyEvaluation> {
+    fn evaluate(&self, cancel: Option<Arc<AtomicBool>>) -> anyhow::Result<Evaluated> {
         let scenario = Scenario::load_any(self.scenario())?;
         let spinner =
             ProgressBar::new_spinner().with_message(format!("evaluating {}", self.scenario()));
@@ -205,18 +211,40 @@ impl ScenarioArgs {
                     std::thread::park_timeout(Duration::from_millis(80));
                 }
             });
-            let result = evaluate(&scenario, &self.options(cancel));
+            let options = self.options(cancel);
+            let result = evaluate(&scenario, &options);
             done.store(true, Ordering::Release);
             ticker.thread().unpark();
-            result
+            result.map(|evaluation| (options, evaluation))
         });
         spinner.finish_and_clear();
-        Ok(result?)
+        let (options, evaluation) = result?;
+        Ok(Evaluated {
+            scenario,
+            options,
+            evaluation,
+        })
     }
 
     /// The seed in effect (for the recording id): the flag, else the scenario's.
     fn seed_of(&self, evaluation: &AnyEvaluation) -> u64 {
         self.seed.unwrap_or(evaluation.meta().seed)
+    }
+}
+
+/// A scenario with the options it was evaluated with and the result (kept together: the
+/// clouds of a blocked Monte Carlo sample are re-simulated from them while logging).
+struct Evaluated {
+    scenario: Scenario,
+    options: EvalOptions,
+    evaluation: AnyEvaluation,
+}
+
+impl Evaluated {
+    /// How many Monte Carlo blocks beyond the first get logged after the main scene.
+    fn later_blocks(&self) -> u64 {
+        let meta = self.evaluation.meta();
+        (meta.samples.div_ceil(meta.block_samples.max(1)) as u64).saturating_sub(1)
     }
 }
 
@@ -240,7 +268,7 @@ fn list() -> anyhow::Result<ExitCode> {
 
 /// `posecov report`: every mean, covariance, method and error, as JSON or as text.
 fn report(args: &ScenarioArgs, json: bool) -> anyhow::Result<ExitCode> {
-    let evaluation = args.evaluate(None)?;
+    let evaluation = args.evaluate(None)?.evaluation;
     let records = evaluation.records();
     let meta = evaluation.meta();
     if json {
@@ -300,7 +328,7 @@ fn check(args: &ScenarioArgs) -> anyhow::Result<ExitCode> {
         samples: Some(args.samples.unwrap_or(32).min(32)),
         ..args.clone()
     };
-    let evaluation = quick.evaluate(None)?;
+    let evaluation = quick.evaluate(None)?.evaluation;
     let scene = build_scene(&evaluation);
     scene.validate().context("the scene is not drawable")?;
     println!(
@@ -338,22 +366,22 @@ fn view(args: &ViewArgs) -> anyhow::Result<ExitCode> {
     if args.watch {
         return watch(args, &cancel);
     }
-    let evaluation = args.scenario.evaluate(Some(Arc::clone(&cancel)))?;
-    let scene = build_scene(&evaluation);
+    let evaluated = args.scenario.evaluate(Some(Arc::clone(&cancel)))?;
+    let scene = build_scene(&evaluated.evaluation);
     scene.validate().context("the scene is not drawable")?;
     let ids = RecordingIds::for_scenario(
         &scenario_name(args.scenario.scenario()),
-        args.scenario.seed_of(&evaluation),
+        args.scenario.seed_of(&evaluated.evaluation),
     );
     if let Some(png) = &args.png {
-        return render(args, &scene, &ids, png, &cancel);
+        return render(args, &evaluated, &scene, &ids, png, &cancel);
     }
     let sink = choose_sink(&args.sink, &args.serve)?;
     let (rec, guard) = open_stream(&sink, &ids, &scene).context("opening the recording")?;
     if let Some(url) = guard.viewer_url() {
         println!("Web viewer: {url}");
     }
-    let outcome = run(&rec, &scene, &cancel)?;
+    let outcome = run(&rec, &evaluated, &scene, &cancel)?;
     if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
         serve(&args.serve, &guard, &cancel)?;
     }
@@ -402,16 +430,18 @@ fn watch(args: &ViewArgs, cancel: &AtomicBool) -> anyhow::Result<ExitCode> {
         let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
         if modified != last_seen {
             last_seen = modified;
-            match args
-                .scenario
-                .evaluate(None)
-                .map(|e| (build_scene(&e), args.scenario.seed_of(&e)))
-            {
+            match args.scenario.evaluate(None).map(|e| {
+                (
+                    build_scene(&e.evaluation),
+                    args.scenario.seed_of(&e.evaluation),
+                    e,
+                )
+            }) {
                 Err(err) => eprintln!(
                     "error: {err:#}\n(waiting for the next change of {})",
                     path.display()
                 ),
-                Ok((scene, seed)) => {
+                Ok((scene, seed, evaluated)) => {
                     let mut ids =
                         RecordingIds::for_scenario(&scenario_name(args.scenario.scenario()), seed);
                     ids.recording_id = format!("{}/gen-{generation}", ids.recording_id);
@@ -425,7 +455,7 @@ fn watch(args: &ViewArgs, cancel: &AtomicBool) -> anyhow::Result<ExitCode> {
                     if let Some(url) = guard.viewer_url() {
                         println!("Web viewer: {url}");
                     }
-                    run(&rec, &scene, cancel)?;
+                    run(&rec, &evaluated, &scene, cancel)?;
                     if matches!(sink, Sink::Serve { .. }) {
                         // The served viewer lives as long as this first stream's guard.
                         rec.flush_blocking()
@@ -455,13 +485,56 @@ fn watch(args: &ViewArgs, cancel: &AtomicBool) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Logs the scene; reports how far it got if Ctrl-C interrupted it.
+/// Logs the scene, then the clouds of any later Monte Carlo blocks one block at a time
+/// (each re-simulated, logged, flushed and dropped: memory stays bounded); reports how far it
+/// got if Ctrl-C interrupted it.
 fn run(
     rec: &rerun::RecordingStream,
+    evaluated: &Evaluated,
     scene: &Scene,
     cancel: &AtomicBool,
 ) -> anyhow::Result<LogOutcome> {
-    let outcome = sink::log_scene_cancellable(rec, scene, cancel).context("logging the scene")?;
+    let mut outcome =
+        sink::log_scene_cancellable(rec, scene, cancel).context("logging the scene")?;
+    let later = evaluated.later_blocks();
+    if outcome == LogOutcome::Complete && later > 0 {
+        let bar = ProgressBar::new(later).with_message("logging Monte Carlo blocks");
+        bar.set_style(
+            ProgressStyle::with_template("{msg} {pos}/{len} ({elapsed}, eta {eta})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        let parts = posecov::draw::particle_parts(
+            &evaluated.scenario,
+            &evaluated.options,
+            &evaluated.evaluation,
+        );
+        for part in parts {
+            if cancel.load(Ordering::Relaxed) {
+                outcome = LogOutcome::Cancelled { next_step: None };
+                break;
+            }
+            let part = part.context("evaluating a Monte Carlo block")?;
+            outcome = sink::log_part_cancellable(rec, &part, cancel)
+                .context("logging a Monte Carlo block")?;
+            drop(part);
+            // Hands the block to the sink's writer before the next one is simulated.
+            rec.flush_blocking()
+                .map_err(|e| anyhow::anyhow!("flushing a Monte Carlo block: {e}"))?;
+            bar.inc(1);
+            if outcome != LogOutcome::Complete {
+                break;
+            }
+        }
+        bar.finish_and_clear();
+        if outcome != LogOutcome::Complete {
+            eprintln!(
+                "Interrupted: recorded the scene and the clouds of the first {} of {} Monte Carlo blocks.",
+                bar.position() + 1,
+                later + 1
+            );
+            return Ok(outcome);
+        }
+    }
     if let LogOutcome::Cancelled { next_step } = outcome {
         match next_step {
             Some(k) => eprintln!("Interrupted: recorded the static items and steps before {k}."),
@@ -534,6 +607,7 @@ fn serve_limit(args: &ServeArgs) -> anyhow::Result<Option<Duration>> {
 /// `--png`: record to an .rrd (the `--save` file, or a temporary one) and render it.
 fn render(
     args: &ViewArgs,
+    evaluated: &Evaluated,
     scene: &Scene,
     ids: &RecordingIds,
     png: &Path,
@@ -549,7 +623,7 @@ fn render(
     };
     let sink = Sink::Save(rrd.clone());
     let (rec, guard) = open_stream(&sink, ids, scene).context("opening the recording")?;
-    let outcome = run(&rec, scene, cancel)?;
+    let outcome = run(&rec, evaluated, scene, cancel)?;
     guard.finish(rec).context("finishing the recording")?;
     if outcome != LogOutcome::Complete {
         return Ok(ExitCode::from(EXIT_INTERRUPTED));

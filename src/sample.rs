@@ -95,9 +95,32 @@ where
     T: Send,
     F: Fn(&mut ChaCha8Rng, &mut [T]) + Sync,
 {
+    fill_par_from(out, seed, family, 0, fill);
+}
+
+/// [`fill_par`] for a block of a larger sample: `out[0]` is sample `first_chunk · CHUNK_SIZE`
+/// of the whole, so chunk `c` of `out` uses [`chunk_rng`]`(seed, family, first_chunk + c)`.
+/// Filling a sample block by block therefore gives exactly the draws of one `fill_par` over
+/// all of it (what lets a 10⁷-sample Monte Carlo run in bounded memory).
+///
+/// ```
+/// use posecov::sample::{CHUNK_SIZE, fill_par, fill_par_from};
+/// use rand::Rng;
+/// let draw = |rng: &mut rand_chacha::ChaCha8Rng, c: &mut [f64]| c.iter_mut().for_each(|x| *x = rng.random());
+/// let mut whole = vec![0.0; 3 * CHUNK_SIZE];
+/// fill_par(&mut whole, 7, 1, draw);
+/// let mut tail = vec![0.0; 2 * CHUNK_SIZE];
+/// fill_par_from(&mut tail, 7, 1, 1, draw);
+/// assert_eq!(&whole[CHUNK_SIZE..], &tail[..]);
+/// ```
+pub fn fill_par_from<T, F>(out: &mut [T], seed: u64, family: u64, first_chunk: u64, fill: F)
+where
+    T: Send,
+    F: Fn(&mut ChaCha8Rng, &mut [T]) + Sync,
+{
     out.par_chunks_mut(CHUNK_SIZE)
         .enumerate()
-        .for_each(|(c, chunk)| fill(&mut chunk_rng(seed, family, c as u64), chunk));
+        .for_each(|(c, chunk)| fill(&mut chunk_rng(seed, family, first_chunk + c as u64), chunk));
 }
 
 /// A standard normal vector z ~ N(0, I) in ℝᴺ.
@@ -107,6 +130,7 @@ where
 /// let z = standard_normal::<3, _>(&mut posecov::sample::chunk_rng(0, 0, 0));
 /// assert!(z.iter().all(|v| v.is_finite()));
 /// ```
+#[inline]
 pub fn standard_normal<const N: usize, R: Rng + ?Sized>(rng: &mut R) -> Tangent<N> {
     Tangent::<N>::from_fn(|_, _| rng.sample(StandardNormal))
 }
@@ -159,6 +183,7 @@ pub fn tangent_about<G: LieGroup<N>, const N: usize>(x: &G, mean: &G, side: Side
 /// use posecov::uncertain::Side;
 /// assert!((retract(&So2::from_angle(0.2), &nalgebra::Vector1::new(0.3), Side::Left).angle() - 0.5).abs() < 1e-15);
 /// ```
+#[inline]
 pub fn retract<G: LieGroup<N>, const N: usize>(mean: &G, step: &Tangent<N>, side: Side) -> G {
     match side {
         Side::Right => mean.rplus(step),
@@ -229,6 +254,7 @@ impl<G: LieGroup<N>, const N: usize> Sampler<G, N> {
     /// let s = Sampler::new(&UncertainPose::certain(So2::identity())).unwrap();
     /// assert_eq!(s.draw_tangent(&mut chunk_rng(0, 0, 0))[0], 0.0);
     /// ```
+    #[inline]
     pub fn draw_tangent<R: Rng + ?Sized>(&self, rng: &mut R) -> Tangent<N> {
         self.factor * standard_normal::<N, R>(rng)
     }
@@ -242,6 +268,7 @@ impl<G: LieGroup<N>, const N: usize> Sampler<G, N> {
     /// let s = Sampler::new(&UncertainPose::certain(So2::from_angle(0.1))).unwrap();
     /// assert!((s.perturb(&nalgebra::Vector1::new(0.2)).angle() - 0.3).abs() < 1e-15);
     /// ```
+    #[inline]
     pub fn perturb(&self, eps: &Tangent<N>) -> G {
         retract(&self.mean, eps, self.side)
     }
@@ -256,6 +283,7 @@ impl<G: LieGroup<N>, const N: usize> Sampler<G, N> {
     /// let x = Sampler::new(&p).unwrap().draw(&mut chunk_rng(3, 0, 0));
     /// assert!(x.rminus(&Se2::identity()).norm() < 1.0);
     /// ```
+    #[inline]
     pub fn draw<R: Rng + ?Sized>(&self, rng: &mut R) -> G {
         self.perturb(&self.draw_tangent(rng))
     }
@@ -303,7 +331,25 @@ impl<G: LieGroup<N>, const N: usize> Sampler<G, N> {
     /// assert!(out.iter().any(|x| x.angle() != 0.0));
     /// ```
     pub fn fill_par(&self, out: &mut [G], seed: u64, family: u64) {
-        fill_par(out, seed, family, |rng, chunk| {
+        self.fill_par_from(out, seed, family, 0);
+    }
+
+    /// [`fill_par`](Self::fill_par) for the block of a larger sample that starts at chunk
+    /// `first_chunk` (see [`fill_par_from`]).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::sample::{CHUNK_SIZE, Sampler};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let s = Sampler::new(&UncertainPose::try_from_std_devs(So2::identity(), [0.1], Side::Right).unwrap()).unwrap();
+    /// let mut whole = vec![So2::identity(); 2 * CHUNK_SIZE];
+    /// s.fill_par(&mut whole, 3, 0);
+    /// let mut second = vec![So2::identity(); CHUNK_SIZE];
+    /// s.fill_par_from(&mut second, 3, 0, 1);
+    /// assert_eq!(&whole[CHUNK_SIZE..], &second[..]);
+    /// ```
+    pub fn fill_par_from(&self, out: &mut [G], seed: u64, family: u64, first_chunk: u64) {
+        fill_par_from(out, seed, family, first_chunk, |rng, chunk| {
             chunk.iter_mut().for_each(|x| *x = self.draw(rng));
         });
     }
@@ -402,6 +448,29 @@ fn weighted_tangent_sum<G: LieGroup<N>, const N: usize>(
         })
         .collect();
     chunk_sums.iter().sum()
+}
+
+/// The first two tangent moments of `samples` about `about`: (Σᵢ ξᵢ, Σᵢ ξᵢ ξᵢᵀ) with
+/// ξᵢ = Log(about⁻¹ Xᵢ) (right) or Log(Xᵢ about⁻¹) (left), summed in chunk order
+/// (deterministic). Summed over the blocks of a sample too large to hold, they give one
+/// iteration of the Lie mean and the covariance about `about` (see `scenario::eval`).
+///
+/// ```
+/// use posecov::lie::{LieGroup, So2};
+/// use posecov::sample::tangent_moments;
+/// use posecov::uncertain::Side;
+/// let (sum, outer) = tangent_moments(&[So2::from_angle(0.1), So2::from_angle(0.3)], &So2::identity(), Side::Right);
+/// assert!((sum[0] - 0.4).abs() < 1e-15 && (outer[(0, 0)] - 0.1).abs() < 1e-15);
+/// ```
+pub fn tangent_moments<G: LieGroup<N>, const N: usize>(
+    samples: &[G],
+    about: &G,
+    side: Side,
+) -> (Tangent<N>, TangentMatrix<N>) {
+    (
+        weighted_tangent_sum(samples, None, about, side),
+        weighted_outer_sum(samples, None, about, side),
+    )
 }
 
 /// The Lie (Fréchet / Karcher) mean of weighted points from the initial guess `initial`:

@@ -18,10 +18,35 @@ pub const SMALL_ANGLE: f64 = 0.1;
 #[inline]
 pub fn sinc(theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
-        let t2 = theta * theta;
-        1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0))
+        sinc_taylor(theta)
     } else {
         theta.sin() / theta
+    }
+}
+
+/// Taylor series of sin θ / θ through θ⁶ (nested form): the branch of [`sinc`] below
+/// [`SMALL_ANGLE`].
+#[inline]
+pub(crate) fn sinc_taylor(theta: f64) -> f64 {
+    let t2 = theta * theta;
+    1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0))
+}
+
+/// sin θ / θ from θ and its already-computed `sin_theta` (no trigonometry here): the same
+/// value as [`sinc`] when `sin_theta` is `theta.sin()`; Taylor branch below [`SMALL_ANGLE`].
+///
+/// ```
+/// use posecov::lie::series::{sinc, sinc_from_sin};
+/// for t in [0.0, 0.05, 0.1, 1.0, 3.0] {
+///     assert_eq!(sinc_from_sin(t, t.sin()), sinc(t));
+/// }
+/// ```
+#[inline]
+pub fn sinc_from_sin(theta: f64, sin_theta: f64) -> f64 {
+    if theta.abs() < SMALL_ANGLE {
+        sinc_taylor(theta)
+    } else {
+        sin_theta / theta
     }
 }
 
@@ -34,13 +59,34 @@ pub fn sinc(theta: f64) -> f64 {
 /// ```
 #[inline]
 pub fn one_minus_cos_by_theta2(theta: f64) -> f64 {
+    one_minus_cos_by_theta2_from_half_sin(theta, (0.5 * theta).sin())
+}
+
+/// A(θ) = (1 − cos θ) / θ² from θ and its already-computed `sin_half_theta` = sin(θ/2), using
+/// 1 − cos θ = 2 sin²(θ/2) (no cancellation; Solà et al. 2018, eq. 143 for A). The same value
+/// as [`one_minus_cos_by_theta2`], which calls it; Taylor branch below [`SMALL_ANGLE`].
+///
+/// ```
+/// use posecov::lie::series::{one_minus_cos_by_theta2, one_minus_cos_by_theta2_from_half_sin};
+/// for t in [0.0, 0.05, 0.1, 1.0, 3.0] {
+///     assert_eq!(one_minus_cos_by_theta2_from_half_sin(t, (0.5 * t).sin()), one_minus_cos_by_theta2(t));
+/// }
+/// ```
+#[inline]
+pub fn one_minus_cos_by_theta2_from_half_sin(theta: f64, sin_half_theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
-        let t2 = theta * theta;
-        0.5 - t2 / 24.0 + t2 * t2 / 720.0 - t2 * t2 * t2 / 40320.0
+        one_minus_cos_by_theta2_taylor(theta)
     } else {
-        let half_sin = (0.5 * theta).sin();
-        2.0 * half_sin * half_sin / (theta * theta)
+        2.0 * sin_half_theta * sin_half_theta / (theta * theta)
     }
+}
+
+/// Taylor series of (1 − cos θ) / θ² through θ⁶: the branch of [`one_minus_cos_by_theta2`]
+/// below [`SMALL_ANGLE`].
+#[inline]
+pub(crate) fn one_minus_cos_by_theta2_taylor(theta: f64) -> f64 {
+    let t2 = theta * theta;
+    0.5 - t2 / 24.0 + t2 * t2 / 720.0 - t2 * t2 * t2 / 40320.0
 }
 
 /// B(θ) = (θ − sin θ) / θ³, the coefficient of φ^² in the SO(3) Jacobians (Solà et al. 2018, eq. 143).
@@ -52,12 +98,38 @@ pub fn one_minus_cos_by_theta2(theta: f64) -> f64 {
 /// ```
 #[inline]
 pub fn theta_minus_sin_by_theta3(theta: f64) -> f64 {
+    theta_minus_sin_by_theta3_from_sin(theta, theta.sin())
+}
+
+/// B(θ) = (θ − sin θ) / θ³ from θ and its already-computed `sin_theta` (Solà et al. 2018,
+/// eq. 143 for B); the same value as [`theta_minus_sin_by_theta3`], which calls it. Taylor
+/// branch below [`SMALL_ANGLE`], where θ − sin θ ≈ θ³/6 cancels; above it an absolute error δ
+/// in `sin_theta` becomes a relative error ≈ 6δ/θ³ in B. [`Se3::exp`](crate::lie::Se3) uses
+/// sin θ = 2 sin(θ/2) cos(θ/2) (δ ≲ 2 ulp(sin θ), against ½ ulp for `theta.sin()`): ≲ 2e-13
+/// relative in B at θ = 0.1 and less above; B multiplies θ×(θ×ρ), |θ×(θ×ρ)| ≤ θ²|ρ|, so the
+/// translation moves by ≲ 4e-16 |ρ| (B θ² ≈ 1.7e-3 at θ = 0.1), a few ulps of ρ.
+///
+/// ```
+/// use posecov::lie::series::{theta_minus_sin_by_theta3, theta_minus_sin_by_theta3_from_sin};
+/// for t in [0.0, 0.05, 0.1, 1.0, 3.0] {
+///     assert_eq!(theta_minus_sin_by_theta3_from_sin(t, t.sin()), theta_minus_sin_by_theta3(t));
+/// }
+/// ```
+#[inline]
+pub fn theta_minus_sin_by_theta3_from_sin(theta: f64, sin_theta: f64) -> f64 {
     if theta.abs() < SMALL_ANGLE {
-        let t2 = theta * theta;
-        1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0 - t2 * t2 * t2 / 362_880.0
+        theta_minus_sin_by_theta3_taylor(theta)
     } else {
-        (theta - theta.sin()) / (theta * theta * theta)
+        (theta - sin_theta) / (theta * theta * theta)
     }
+}
+
+/// Taylor series of (θ − sin θ) / θ³ through θ⁶: the branch of [`theta_minus_sin_by_theta3`]
+/// below [`SMALL_ANGLE`].
+#[inline]
+pub(crate) fn theta_minus_sin_by_theta3_taylor(theta: f64) -> f64 {
+    let t2 = theta * theta;
+    1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0 - t2 * t2 * t2 / 362_880.0
 }
 
 /// C(θ) = 1/θ² − cot(θ/2) / (2θ), the coefficient of φ^² in Jr⁻¹ and Jl⁻¹ of SO(3)

@@ -307,6 +307,7 @@ impl DiffDrive {
             .par_chunks_mut(CHUNK_SIZE)
             .enumerate()
             .map(|(c, chunk)| {
+                let c = settings.first_chunk as usize + c;
                 let mut rng = chunk_rng(settings.seed, 0, c as u64);
                 let mut trajectories = Vec::new();
                 for (i, end) in chunk.iter_mut().enumerate() {
@@ -383,6 +384,10 @@ pub struct EulerMaruyama {
     pub trajectories: usize,
     /// Keep every this-many steps of a kept path (default 1).
     pub trajectory_stride: usize,
+    /// Chunk index of the first path (default 0): path `i` of this run is path
+    /// `first_chunk · CHUNK_SIZE + i` of the whole sample, with that path's random stream, so a
+    /// large sample can be simulated block by block.
+    pub first_chunk: u64,
 }
 
 impl EulerMaruyama {
@@ -399,6 +404,27 @@ impl EulerMaruyama {
             seed,
             trajectories: 0,
             trajectory_stride: 1,
+            first_chunk: 0,
+        }
+    }
+
+    /// Simulates the block of a larger sample that starts at chunk `first_chunk` (kept
+    /// trajectories count from the whole sample's first path).
+    ///
+    /// ```
+    /// use posecov::propagate::diff_drive::{DiffDrive, EulerMaruyama};
+    /// use posecov::sample::CHUNK_SIZE;
+    /// let robot = DiffDrive::try_new(0.033, 0.2, 1.0).unwrap();
+    /// let rates = robot.wheel_rates_for(1.0, 0.5);
+    /// let whole = robot.euler_maruyama(rates, 0.1, &EulerMaruyama::new(0.01, 2 * CHUNK_SIZE, 3)).unwrap();
+    /// let tail = EulerMaruyama::new(0.01, CHUNK_SIZE, 3).starting_at_chunk(1);
+    /// let tail = robot.euler_maruyama(rates, 0.1, &tail).unwrap();
+    /// assert_eq!(&whole.end_poses[CHUNK_SIZE..], &tail.end_poses[..]);
+    /// ```
+    pub fn starting_at_chunk(self, first_chunk: u64) -> Self {
+        Self {
+            first_chunk,
+            ..self
         }
     }
 

@@ -6,8 +6,21 @@
 //! particles, drawing fresh process noise where the operation has some. Each node's Monte
 //! Carlo estimate is the iterative Lie mean and 1/(N−1) covariance of its particles (right
 //! side). Analytic methods propagate Gaussians operation by operation.
+//!
+//! # Blocked Monte Carlo: bounded memory
+//! Every random draw comes from the stream of its 1024-sample chunk
+//! ([`crate::sample::chunk_rng`]), so any block of samples `k·1024 ..` can be simulated
+//! through all operations on its own and gets exactly the particles a whole-sample run would.
+//! When the particles of all nodes would exceed [`PARTICLE_MEMORY_BUDGET`] (e.g. 10⁷ samples),
+//! the sample is split into blocks: the statistics are summed block by block (one pass over
+//! the blocks per Lie-mean iteration, each pass re-simulating the blocks; nothing but the
+//! current block is held), the evaluation keeps the first block's particles for drawing, and
+//! [`evaluate_block`] re-simulates any later block for its clouds. Memory is then bounded by
+//! the budget whatever the sample count; time grows by the number of passes (typically 3–5)
+//! plus one. Samples that fit are evaluated exactly as before, in one block.
 
 use std::collections::HashMap;
+use std::ops::Range;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -28,7 +41,10 @@ use crate::propagate::fusion::{FusionOptions, fuse};
 use crate::propagate::odometry::{InputNoise, propagate_increments, propagate_tangent_inputs};
 use crate::propagate::sigma_point::{self, Unscented};
 use crate::propagate::{Propagated, relative_frobenius_error};
-use crate::sample::{Sampler, fill_par, sample_statistics, standard_normal};
+use crate::sample::{
+    CHUNK_SIZE, LIE_MEAN_MAX_ITERATIONS, LIE_MEAN_TOLERANCE, SampleStatistics, Sampler,
+    fill_par_from, retract, sample_statistics, standard_normal, tangent_moments,
+};
 use crate::uncertain::{Method, Side, UncertainPose};
 
 /// Defaults when neither the file nor the command line says.
@@ -49,7 +65,19 @@ pub struct EvalOptions {
     pub confidence: Option<f64>,
     /// Set to stop a long evaluation early (Ctrl-C): evaluation returns what it has so far.
     pub cancel: Option<Arc<AtomicBool>>,
+    /// Monte Carlo particles held in memory at once (rounded up to a multiple of
+    /// [`CHUNK_SIZE`]); `None` chooses from [`PARTICLE_MEMORY_BUDGET`]. See
+    /// [blocked Monte Carlo](self#blocked-monte-carlo-bounded-memory).
+    pub block_samples: Option<usize>,
 }
+
+/// Bytes of Monte Carlo particles (all nodes together) an evaluation holds at once; larger
+/// samples are simulated in blocks ([blocked Monte Carlo](self#blocked-monte-carlo-bounded-memory)).
+pub const PARTICLE_MEMORY_BUDGET: usize = 128 << 20;
+/// Samples up to this count are never split into blocks.
+pub const MIN_BLOCK_SAMPLES: usize = 16 * CHUNK_SIZE;
+/// At most this many particles per block (also the size of the drawn first block's clouds).
+pub const MAX_BLOCK_SAMPLES: usize = 64 * CHUNK_SIZE;
 
 /// Evaluates a parsed scenario.
 ///
@@ -68,11 +96,319 @@ pub fn evaluate(
 ) -> Result<AnyEvaluation, ScenarioError> {
     let meta = meta(scenario, options)?;
     Ok(match meta.group {
-        GroupName::So2 => AnyEvaluation::So2(Engine::<So2, 1>::run(scenario, meta, options)?),
-        GroupName::Se2 => AnyEvaluation::Se2(Engine::<Se2, 3>::run(scenario, meta, options)?),
-        GroupName::So3 => AnyEvaluation::So3(Engine::<So3, 3>::run(scenario, meta, options)?),
-        GroupName::Se3 => AnyEvaluation::Se3(Engine::<Se3, 6>::run(scenario, meta, options)?),
+        GroupName::So2 => AnyEvaluation::So2(run::<So2, 1>(scenario, meta, options)?),
+        GroupName::Se2 => AnyEvaluation::Se2(run::<Se2, 3>(scenario, meta, options)?),
+        GroupName::So3 => AnyEvaluation::So3(run::<So3, 3>(scenario, meta, options)?),
+        GroupName::Se3 => AnyEvaluation::Se3(run::<Se3, 6>(scenario, meta, options)?),
     })
+}
+
+/// Evaluates block `block` (0-based) of a blocked Monte Carlo sample for its particles only:
+/// nodes carry the particles of samples `block · b ..` (b = `main.meta().block_samples`) and
+/// no Monte Carlo statistics. `None` past the last block. This is what draws the clouds of a
+/// large sample a block at a time (`draw::particle_parts`).
+///
+/// ```
+/// use posecov::scenario::{Scenario, eval::{EvalOptions, evaluate, evaluate_block}};
+/// let s = Scenario::load_any("so3_sampling").unwrap();
+/// let options = EvalOptions { samples: Some(5000), block_samples: Some(2048), ..Default::default() };
+/// let main = evaluate(&s, &options).unwrap();
+/// assert_eq!(main.meta().block_samples, 2048);
+/// assert!(evaluate_block(&s, &options, &main, 2).unwrap().is_some()); // samples 4096..5000
+/// assert!(evaluate_block(&s, &options, &main, 3).unwrap().is_none());
+/// ```
+pub fn evaluate_block(
+    scenario: &Scenario,
+    options: &EvalOptions,
+    main: &AnyEvaluation,
+    block: usize,
+) -> Result<Option<AnyEvaluation>, ScenarioError> {
+    let meta = main.meta().clone();
+    let (n, b) = (meta.samples, meta.block_samples.max(1));
+    let start = block.saturating_mul(b);
+    if start >= n || !meta.methods.contains(&Method::MonteCarlo) {
+        return Ok(None);
+    }
+    let range = start..(start + b).min(n);
+    Ok(Some(match meta.group {
+        GroupName::So2 => AnyEvaluation::So2(particles_only(scenario, meta, options, range)?),
+        GroupName::Se2 => AnyEvaluation::Se2(particles_only(scenario, meta, options, range)?),
+        GroupName::So3 => AnyEvaluation::So3(particles_only(scenario, meta, options, range)?),
+        GroupName::Se3 => AnyEvaluation::Se3(particles_only(scenario, meta, options, range)?),
+    }))
+}
+
+/// Samples `range` of a blocked sample, for their particles only (no statistics).
+fn particles_only<G: EvalGroup<N>, const N: usize>(
+    scenario: &Scenario,
+    meta: Meta,
+    options: &EvalOptions,
+    range: Range<usize>,
+) -> Result<Evaluation<G, N>, ScenarioError> {
+    Engine::run(scenario, meta, options, range, StatsSource::Skip)
+}
+
+/// One evaluation, in one block when the particles fit [`PARTICLE_MEMORY_BUDGET`], else
+/// blocked ([`run_blocked`]).
+fn run<G: EvalGroup<N>, const N: usize>(
+    scenario: &Scenario,
+    mut meta: Meta,
+    options: &EvalOptions,
+) -> Result<Evaluation<G, N>, ScenarioError> {
+    let n = meta.samples;
+    let block = block_samples::<G, N>(scenario, &meta, options)?;
+    meta.block_samples = block.min(n);
+    if block >= n {
+        return Engine::run(scenario, meta, options, 0..n, StatsSource::Own);
+    }
+    run_blocked(scenario, meta, options)
+}
+
+/// Particles per block: `options.block_samples`, else as many as fit the budget given how
+/// many nodes hold particles (counted by an evaluation without Monte Carlo), within
+/// [`MIN_BLOCK_SAMPLES`] ..= [`MAX_BLOCK_SAMPLES`]; always a multiple of [`CHUNK_SIZE`].
+fn block_samples<G: EvalGroup<N>, const N: usize>(
+    scenario: &Scenario,
+    meta: &Meta,
+    options: &EvalOptions,
+) -> Result<usize, ScenarioError> {
+    let round = |b: usize| b.div_ceil(CHUNK_SIZE).max(1) * CHUNK_SIZE;
+    if let Some(b) = options.block_samples {
+        return Ok(round(b));
+    }
+    if meta.samples <= MIN_BLOCK_SAMPLES || !meta.methods.contains(&Method::MonteCarlo) {
+        return Ok(meta.samples);
+    }
+    let mut dry = meta.clone();
+    dry.methods.retain(|m| *m != Method::MonteCarlo);
+    let shape = Engine::<G, N>::run(scenario, dry, options, 0..0, StatsSource::Skip)?;
+    let nodes = shape.nodes.iter().filter(|n| n.role != Role::Fixed).count();
+    let bytes = nodes * std::mem::size_of::<G>() + shape.points.len() * 24;
+    let fit = PARTICLE_MEMORY_BUDGET / bytes.max(1);
+    Ok(fit.clamp(MIN_BLOCK_SAMPLES, MAX_BLOCK_SAMPLES) / CHUNK_SIZE * CHUNK_SIZE)
+}
+
+/// Blocked Monte Carlo: block 0 is evaluated (its particles are what gets drawn), then
+/// every block is re-simulated once per pass of the Lie-mean iteration, summing each node's
+/// tangent moments ([`BlockedStats`]); finally block 0 again, with those statistics.
+fn run_blocked<G: EvalGroup<N>, const N: usize>(
+    scenario: &Scenario,
+    meta: Meta,
+    options: &EvalOptions,
+) -> Result<Evaluation<G, N>, ScenarioError> {
+    let (n, b) = (meta.samples, meta.block_samples);
+    let blocks: Vec<Range<usize>> = (0..n).step_by(b).map(|s| s..(s + b).min(n)).collect();
+    let first = Engine::<G, N>::run(scenario, meta.clone(), options, 0..b, StatsSource::Own)?;
+    let cancelled = || {
+        options
+            .cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    };
+    let mut stats = BlockedStats::start(&first);
+    let mut pass = 0;
+    while stats.iterating() && pass < LIE_MEAN_MAX_ITERATIONS {
+        for range in &blocks {
+            if cancelled() {
+                return Engine::run(scenario, meta, options, 0..b, StatsSource::Own);
+            }
+            if range.start == 0 {
+                stats.add(&first, pass == 0);
+            } else {
+                let e = particles_only(scenario, meta.clone(), options, range.clone())?;
+                stats.add(&e, pass == 0);
+            }
+        }
+        stats.finish_pass(n);
+        pass += 1;
+    }
+    drop(first);
+    let mut out = Engine::run(
+        scenario,
+        meta,
+        options,
+        0..b,
+        StatsSource::Blocked(Arc::new(stats)),
+    )?;
+    out.notes.push(format!(
+        "Monte Carlo: {n} samples simulated in {} blocks of {b} to bound memory; the statistics \
+         use every sample ({pass} passes of the Lie-mean iteration); the clouds of samples \
+         beyond the first block are logged block by block.",
+        blocks.len()
+    ));
+    Ok(out)
+}
+
+/// Running sums of one node's particles over the blocks of a sample.
+struct NodeMoments<G: LieGroup<N>, const N: usize> {
+    /// The Lie-mean estimate μ of the current pass (right side).
+    mean: G,
+    iterations: usize,
+    /// Σ ξ and Σ ξξᵀ of ξ = Log(μ⁻¹ X) in the current pass.
+    sum: Tangent<N>,
+    outer: TangentMatrix<N>,
+    /// Set when the iteration converged; the covariance is the converged pass's
+    /// (Σ ξξᵀ − n s sᵀ)/(n − 1) about μ, s = Σ ξ / n (‖s‖ < the tolerance 1e-10, so this
+    /// equals the covariance about the final mean to that order).
+    result: Option<SampleStatistics<G, N>>,
+    failed: bool,
+    /// Σ Log_left(X nominal⁻¹) Log_left(…)ᵀ (first pass).
+    left_outer: TangentMatrix<N>,
+    /// Positions are summed relative to `shift` (block 0's mean) to avoid cancellation.
+    shift: Vector3<f64>,
+    translation_sum: Vector3<f64>,
+}
+
+/// Running sums of one point node's Monte Carlo points (relative to `shift`).
+struct PointMoments {
+    shift: Vector3<f64>,
+    sum: Vector3<f64>,
+    outer: Matrix3<f64>,
+}
+
+impl PointMoments {
+    /// Mean and 1/(n−1) covariance of `n` points.
+    fn statistics(&self, n: usize) -> (Vector3<f64>, Matrix3<f64>) {
+        let d = self.sum / n as f64;
+        let cov = (self.outer - d * d.transpose() * n as f64) / (n as f64 - 1.0);
+        (self.shift + d, cov)
+    }
+}
+
+/// Monte Carlo statistics of a sample too large to hold, gathered block by block: per node
+/// the iterative Lie mean (one pass over every block per iteration, as
+/// [`crate::sample::lie_mean`] with the same tolerance and iteration cap, started from block
+/// 0's mean) and its covariance; the uncentred left covariance about the nominal and the
+/// mean position; per point node the mean and covariance of the points.
+struct BlockedStats<G: LieGroup<N>, const N: usize> {
+    nodes: Vec<Option<NodeMoments<G, N>>>,
+    points: Vec<Option<PointMoments>>,
+}
+
+impl<G: EvalGroup<N>, const N: usize> BlockedStats<G, N> {
+    fn start(first: &Evaluation<G, N>) -> Self {
+        let nodes = first
+            .nodes
+            .iter()
+            .map(|node| {
+                let particles = node
+                    .particles
+                    .as_ref()
+                    .filter(|_| node.role != Role::Fixed)?;
+                let mean = node
+                    .estimates
+                    .iter()
+                    .rev()
+                    .find(|e| e.result.method == Method::MonteCarlo)
+                    .map_or(*particles.first()?, |e| *e.result.pose.mean());
+                let shift = particles
+                    .iter()
+                    .map(|g| *g.to_se3().translation())
+                    .sum::<Vector3<f64>>()
+                    / particles.len() as f64;
+                Some(NodeMoments {
+                    mean,
+                    iterations: 0,
+                    sum: Tangent::<N>::zeros(),
+                    outer: TangentMatrix::<N>::zeros(),
+                    result: None,
+                    failed: false,
+                    left_outer: TangentMatrix::<N>::zeros(),
+                    shift,
+                    translation_sum: Vector3::zeros(),
+                })
+            })
+            .collect();
+        let points = first
+            .points
+            .iter()
+            .map(|p| {
+                let q = p.particles.as_ref().filter(|q| !q.is_empty())?;
+                let shift =
+                    q.iter().map(|x| Vector3::from(*x)).sum::<Vector3<f64>>() / q.len() as f64;
+                Some(PointMoments {
+                    shift,
+                    sum: Vector3::zeros(),
+                    outer: Matrix3::zeros(),
+                })
+            })
+            .collect();
+        Self { nodes, points }
+    }
+
+    fn node(&self, index: usize) -> Option<&NodeMoments<G, N>> {
+        self.nodes.get(index).and_then(Option::as_ref)
+    }
+
+    /// Whether some node's Lie mean is still iterating.
+    fn iterating(&self) -> bool {
+        self.nodes
+            .iter()
+            .flatten()
+            .any(|n| n.result.is_none() && !n.failed)
+    }
+
+    /// Adds one block's particles (`first_pass`: also the one-pass sums).
+    fn add(&mut self, block: &Evaluation<G, N>, first_pass: bool) {
+        for (acc, node) in self.nodes.iter_mut().zip(&block.nodes) {
+            let (Some(acc), Some(particles)) = (acc.as_mut(), node.particles.as_ref()) else {
+                continue;
+            };
+            if acc.result.is_none() && !acc.failed {
+                let (sum, outer) = tangent_moments(particles, &acc.mean, Side::Right);
+                acc.sum += sum;
+                acc.outer += outer;
+            }
+            if first_pass {
+                acc.left_outer += tangent_moments(particles, &node.nominal, Side::Left).1;
+                acc.translation_sum += particles
+                    .iter()
+                    .map(|g| g.to_se3().translation() - acc.shift)
+                    .sum::<Vector3<f64>>();
+            }
+        }
+        if first_pass {
+            for (acc, point) in self.points.iter_mut().zip(&block.points) {
+                let (Some(acc), Some(q)) = (acc.as_mut(), point.particles.as_ref()) else {
+                    continue;
+                };
+                for x in q {
+                    let d = Vector3::from(*x) - acc.shift;
+                    acc.sum += d;
+                    acc.outer += d * d.transpose();
+                }
+            }
+        }
+    }
+
+    /// Ends a pass over all `n` samples: one Lie-mean step per node still iterating.
+    fn finish_pass(&mut self, n: usize) {
+        for acc in self.nodes.iter_mut().flatten() {
+            if acc.result.is_some() || acc.failed {
+                continue;
+            }
+            acc.iterations += 1;
+            let step = acc.sum / n as f64;
+            let norm = step.norm();
+            if !norm.is_finite() || acc.iterations >= LIE_MEAN_MAX_ITERATIONS {
+                acc.failed = norm >= LIE_MEAN_TOLERANCE || !norm.is_finite();
+            }
+            if !acc.failed && norm < LIE_MEAN_TOLERANCE {
+                let centred = acc.outer - step * step.transpose() * n as f64;
+                acc.result = Some(SampleStatistics {
+                    mean: retract(&acc.mean, &step, Side::Right),
+                    cov: (centred + centred.transpose()) * (0.5 / (n as f64 - 1.0)),
+                    side: Side::Right,
+                    count: n,
+                    iterations: acc.iterations,
+                });
+            } else if !acc.failed {
+                acc.mean = retract(&acc.mean, &step, Side::Right);
+            }
+            acc.sum = Tangent::<N>::zeros();
+            acc.outer = TangentMatrix::<N>::zeros();
+        }
+    }
 }
 
 fn meta(scenario: &Scenario, options: &EvalOptions) -> Result<Meta, ScenarioError> {
@@ -106,6 +442,7 @@ fn meta(scenario: &Scenario, options: &EvalOptions) -> Result<Meta, ScenarioErro
     let mut methods = h.methods.clone();
     methods.dedup();
     Ok(Meta {
+        block_samples: samples as usize,
         title: h.title.clone(),
         description: h.description.clone(),
         source: h.source.clone(),
@@ -178,6 +515,16 @@ fn keys_set(op: &OperationSpec) -> Vec<&'static str> {
 /// Monte Carlo particles of a node, shared between the operations that read it.
 type Particles<G> = Option<Arc<Vec<G>>>;
 
+/// Where an engine run takes its Monte Carlo statistics from.
+enum StatsSource<G: LieGroup<N>, const N: usize> {
+    /// From this run's particles: the whole sample, when it fits in one block.
+    Own,
+    /// Nowhere: a pass over one block of a larger sample, run for its particles only.
+    Skip,
+    /// From passes over every block of a larger sample ([`BlockedStats`]).
+    Blocked(Arc<BlockedStats<G, N>>),
+}
+
 /// A named thing an operation can take as input.
 #[derive(Clone, Copy)]
 enum Value<G: LieGroup<N>, const N: usize> {
@@ -196,6 +543,10 @@ struct Engine<'a, G: EvalGroup<N>, const N: usize> {
     out: Evaluation<G, N>,
     /// Random families already used (one per sampled input or noise source).
     families: u64,
+    /// The particles this run simulates: sample indices `block`, `block.start` a multiple of
+    /// [`CHUNK_SIZE`], so that every random draw is the one the whole sample would make.
+    block: Range<usize>,
+    stats: StatsSource<G, N>,
 }
 
 impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
@@ -203,6 +554,8 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         scenario: &'a Scenario,
         meta: Meta,
         options: &EvalOptions,
+        block: Range<usize>,
+        stats: StatsSource<G, N>,
     ) -> Result<Evaluation<G, N>, ScenarioError> {
         let monte_carlo = meta.methods.contains(&Method::MonteCarlo);
         let mut engine = Engine {
@@ -221,6 +574,8 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             },
             meta,
             families: 0,
+            block,
+            stats,
         };
         engine.poses()?;
         for (index, op) in scenario.file.operations.iter().enumerate() {
@@ -271,6 +626,82 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
 
     fn wants(&self, method: Method) -> bool {
         self.meta.methods.contains(&method)
+    }
+
+    /// The chunk index of this run's first particle (see [`fill_par_from`]).
+    fn first_chunk(&self) -> u64 {
+        (self.block.start / CHUNK_SIZE) as u64
+    }
+
+    /// Monte Carlo Lie mean and covariance (right side) of node `index`.
+    fn mc_stats(&self, index: usize) -> Option<SampleStatistics<G, N>> {
+        match &self.stats {
+            StatsSource::Own => self.out.nodes[index]
+                .particles
+                .as_ref()
+                .and_then(|p| sample_statistics(p, Side::Right).ok()),
+            StatsSource::Skip => None,
+            StatsSource::Blocked(b) => b.node(index).and_then(|n| n.result),
+        }
+    }
+
+    /// Monte Carlo E[ξξᵀ] of node `index` about its nominal, left side (uncentred).
+    fn mc_uncentred_left(&self, index: usize) -> Option<TangentMatrix<N>> {
+        let node = &self.out.nodes[index];
+        match &self.stats {
+            StatsSource::Own => node.particles.as_ref().and_then(|p| {
+                crate::sample::uncentred_covariance(p, &node.nominal, Side::Left).ok()
+            }),
+            StatsSource::Skip => None,
+            StatsSource::Blocked(b) => b
+                .node(index)
+                .map(|n| n.left_outer / self.meta.samples as f64),
+        }
+    }
+
+    /// Mean of the particles' positions (Cartesian) of node `index`.
+    fn mc_translation_mean(&self, index: usize) -> Option<Vector3<f64>> {
+        match &self.stats {
+            StatsSource::Own => self.out.nodes[index].particles.as_ref().map(|p| {
+                p.iter()
+                    .map(|g| *g.to_se3().translation())
+                    .sum::<Vector3<f64>>()
+                    / p.len() as f64
+            }),
+            StatsSource::Skip => None,
+            StatsSource::Blocked(b) => b
+                .node(index)
+                .map(|n| n.shift + n.translation_sum / self.meta.samples as f64),
+        }
+    }
+
+    /// Mean and 1/(N−1) covariance of the Monte Carlo points of point node `index`
+    /// (`moved`: this run's points).
+    fn mc_point_stats(
+        &self,
+        index: usize,
+        moved: &[[f64; 3]],
+    ) -> Option<(Vector3<f64>, Matrix3<f64>)> {
+        match &self.stats {
+            StatsSource::Own => {
+                let n = moved.len() as f64;
+                let m = moved
+                    .iter()
+                    .fold(Vector3::zeros(), |a, q| a + Vector3::from(*q))
+                    / n;
+                let c = moved.iter().fold(Matrix3::zeros(), |a, q| {
+                    let d = Vector3::from(*q) - m;
+                    a + d * d.transpose()
+                }) / (n - 1.0);
+                Some((m, c))
+            }
+            StatsSource::Skip => None,
+            StatsSource::Blocked(b) => b
+                .points
+                .get(index)
+                .and_then(Option::as_ref)
+                .map(|p| p.statistics(self.meta.samples)),
+        }
     }
 
     fn next_family(&mut self) -> u64 {
@@ -364,10 +795,10 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
 
     fn sample(&mut self, pose: &UncertainPose<G, N>) -> Vec<G> {
         let family = self.next_family();
-        let mut out = vec![*pose.mean(); self.meta.samples];
+        let mut out = vec![*pose.mean(); self.block.len()];
         // A valid covariance always has a square root; fall back to the mean if not.
         if let Ok(sampler) = Sampler::new(pose) {
-            sampler.fill_par(&mut out, self.meta.seed, family);
+            sampler.fill_par_from(&mut out, self.meta.seed, family, self.first_chunk());
         }
         out
     }
@@ -624,7 +1055,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         if !self.monte_carlo || (px.is_none() && py.is_none()) {
             return None;
         }
-        let n = self.meta.samples;
+        let n = self.block.len();
         let px = px.unwrap_or_else(|| Arc::new(vec![*x.mean(); n]));
         let py = py.unwrap_or_else(|| Arc::new(vec![*y.mean(); n]));
         Some(Arc::new(
@@ -747,27 +1178,33 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         let factor = joint_square_root(&joint);
         let (mx, my) = pair.means();
         let side = pair.side();
-        let mut out = vec![mx; self.meta.samples];
-        fill_par(&mut out, self.meta.seed, family, |rng, chunk| {
-            for z in chunk.iter_mut() {
-                let a = standard_normal::<N, _>(rng);
-                let b = standard_normal::<N, _>(rng);
-                let stacked =
-                    nalgebra::DVector::from_iterator(2 * N, a.iter().chain(b.iter()).copied());
-                let e = &factor * stacked;
-                let ex = Tangent::<N>::from_iterator(e.rows(0, N).iter().copied());
-                let ey = Tangent::<N>::from_iterator(e.rows(N, N).iter().copied());
-                let (x, y) = match side {
-                    Side::Right => (mx.rplus(&ex), my.rplus(&ey)),
-                    Side::Left => (mx.lplus(&ex), my.lplus(&ey)),
-                };
-                *z = if compose {
-                    x.compose(&y)
-                } else {
-                    x.between(&y)
-                };
-            }
-        });
+        let mut out = vec![mx; self.block.len()];
+        fill_par_from(
+            &mut out,
+            self.meta.seed,
+            family,
+            self.first_chunk(),
+            |rng, chunk| {
+                for z in chunk.iter_mut() {
+                    let a = standard_normal::<N, _>(rng);
+                    let b = standard_normal::<N, _>(rng);
+                    let stacked =
+                        nalgebra::DVector::from_iterator(2 * N, a.iter().chain(b.iter()).copied());
+                    let e = &factor * stacked;
+                    let ex = Tangent::<N>::from_iterator(e.rows(0, N).iter().copied());
+                    let ey = Tangent::<N>::from_iterator(e.rows(N, N).iter().copied());
+                    let (x, y) = match side {
+                        Side::Right => (mx.rplus(&ex), my.rplus(&ey)),
+                        Side::Left => (mx.lplus(&ex), my.lplus(&ey)),
+                    };
+                    *z = if compose {
+                        x.compose(&y)
+                    } else {
+                        x.between(&y)
+                    };
+                }
+            },
+        );
         out
     }
 
@@ -887,7 +1324,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
         if self.monte_carlo {
             let mut current: Vec<G> = match start_particles {
                 Some(p) => p.as_ref().clone(),
-                None => vec![*start.mean(); self.meta.samples],
+                None => vec![*start.mean(); self.block.len()],
             };
             particle_steps[0] = Some(Arc::new(current.clone()));
             let noise_pose = UncertainPose::new_unchecked(G::identity(), noise, Side::Right);
@@ -897,9 +1334,9 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                     break;
                 }
                 let family = self.next_family();
-                let seed = self.meta.seed;
+                let (seed, first_chunk) = (self.meta.seed, self.first_chunk());
                 if let Some(sampler) = &sampler {
-                    fill_par_map(&mut current, seed, family, |rng, x| {
+                    fill_par_map(&mut current, seed, family, first_chunk, |rng, x| {
                         let w = sampler.draw_tangent(rng);
                         if increment {
                             x.compose(u_group).rplus(&w)
@@ -969,7 +1406,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             .collect();
         let mut current: Option<Vec<G>> = if self.monte_carlo {
             Some(start_particles.map_or_else(
-                || vec![*start.mean(); self.meta.samples],
+                || vec![*start.mean(); self.block.len()],
                 |p| p.as_ref().clone(),
             ))
         } else {
@@ -997,7 +1434,8 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             }
             if let (Some(particles), Some(sampler)) = (current.as_mut(), &sampler) {
                 let family = self.next_family();
-                fill_par_map(particles, self.meta.seed, family, |rng, x| {
+                let first_chunk = self.first_chunk();
+                fill_par_map(particles, self.meta.seed, family, first_chunk, |rng, x| {
                     sampler.draw(rng).compose(x)
                 });
             }
@@ -1064,8 +1502,8 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             let factor = joint_square_root(&DMatrix::from_fn(dims, dims, |r, c| cov_rows[r][c]));
             let local = point.get_ref().clone();
             let mut points = vec![[0.0; 3]; particles.len()];
-            let seed = self.meta.seed;
-            fill_par(&mut points, seed, family, |rng, chunk| {
+            let (seed, first_chunk) = (self.meta.seed, self.first_chunk());
+            fill_par_from(&mut points, seed, family, first_chunk, |rng, chunk| {
                 for (i, q) in chunk.iter_mut().enumerate() {
                     let _ = i;
                     let z = standard_normal::<3, _>(rng);
@@ -1087,24 +1525,17 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                     [w.x, w.y, w.z]
                 })
                 .collect();
-            let n = moved.len() as f64;
-            let m = moved
-                .iter()
-                .fold(Vector3::zeros(), |a, q| a + Vector3::from(*q))
-                / n;
-            let c = moved.iter().fold(Matrix3::zeros(), |a, q| {
-                let d = Vector3::from(*q) - m;
-                a + d * d.transpose()
-            }) / (n - 1.0);
-            estimates.push((
-                Method::MonteCarlo,
-                [m.x, m.y, m.z],
-                [
-                    [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
-                    [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
-                    [c[(2, 0)], c[(2, 1)], c[(2, 2)]],
-                ],
-            ));
+            if let Some((m, c)) = self.mc_point_stats(self.out.points.len(), &moved) {
+                estimates.push((
+                    Method::MonteCarlo,
+                    [m.x, m.y, m.z],
+                    [
+                        [c[(0, 0)], c[(0, 1)], c[(0, 2)]],
+                        [c[(1, 0)], c[(1, 1)], c[(1, 2)]],
+                        [c[(2, 0)], c[(2, 1)], c[(2, 2)]],
+                    ],
+                ));
+            }
             cloud = Some(moved);
         }
         self.names
@@ -1191,10 +1622,11 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                 1e-3
             },
             samples: if self.monte_carlo {
-                self.meta.samples
+                self.block.len()
             } else {
                 0
             },
+            first_chunk: self.first_chunk(),
             seed: self.meta.seed.wrapping_add(self.next_family()),
         };
         let outcome = match G::diff_drive(&params) {
@@ -1224,24 +1656,6 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             .collect();
         let particles = (!outcome.end_poses.is_empty())
             .then(|| Arc::new(outcome.end_poses.iter().map(moved).collect::<Vec<G>>()));
-        if let Some(p) = &particles
-            && let (Ok(stats), Some(nominal)) = (
-                sample_statistics(p, Side::Right),
-                outcome.nominal_path.last(),
-            )
-        {
-            let lie = stats.mean.to_se3();
-            let cartesian = p
-                .iter()
-                .map(|g| *g.to_se3().translation())
-                .sum::<Vector3<f64>>()
-                / p.len() as f64;
-            let nominal = moved(nominal).to_se3();
-            self.out.notes.push(format!(
-                "`{output}` (D = {}): nominal end ({:.3}, {:.3}); **Lie mean** of the samples ({:.3}, {:.3}); **Cartesian mean** of their positions ({:.3}, {:.3}) — it retreats inside the banana.",
-                params.diffusion, nominal.translation().x, nominal.translation().y, lie.translation().x, lie.translation().y, cartesian.x, cartesian.y
-            ));
-        }
         let first = estimates.remove(0);
         self.output_with(
             output.clone(),
@@ -1252,6 +1666,19 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             |g: &[G]| g[0],
             &[],
         );
+        let node = self.out.nodes.len() - 1;
+        if let (Some(stats), Some(cartesian), Some(nominal)) = (
+            self.mc_stats(node),
+            self.mc_translation_mean(node),
+            outcome.nominal_path.last(),
+        ) {
+            let lie = stats.mean.to_se3();
+            let nominal = moved(nominal).to_se3();
+            self.out.notes.push(format!(
+                "`{output}` (D = {}): nominal end ({:.3}, {:.3}); **Lie mean** of the samples ({:.3}, {:.3}); **Cartesian mean** of their positions ({:.3}, {:.3}) — it retreats inside the banana.",
+                params.diffusion, nominal.translation().x, nominal.translation().y, lie.translation().x, lie.translation().y, cartesian.x, cartesian.y
+            ));
+        }
         self.out.paths.push(PosePath {
             name: format!("{output}/nominal"),
             method: None,
@@ -1353,7 +1780,7 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             "trace of position covariance (m², body frame)"
         };
         let mut lines: Vec<Series> = Vec::new();
-        for node in self.out.nodes.iter().filter(|n| n.name == name) {
+        for (index, node) in self.nodes_named(name) {
             let step = node.step.unwrap_or(0) as i64;
             let mut values: Vec<(Method, f64)> = node
                 .estimates
@@ -1363,27 +1790,24 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
                     (e.result.method, block.clone().map(|i| cov[(i, i)]).sum())
                 })
                 .collect();
-            if let Some(p) = &node.particles
-                && let Ok(stats) = sample_statistics(p, Side::Right)
-            {
+            if let Some(stats) = self.mc_stats(index) {
                 values.push((
                     Method::MonteCarlo,
                     block.clone().map(|i| stats.cov[(i, i)]).sum(),
                 ));
             }
-            for (method, value) in values {
-                match lines.iter_mut().find(|l| l.method == Some(method)) {
-                    Some(line) => line.points.push((step, value)),
-                    None => lines.push(Series {
-                        quantity: quantity.to_owned(),
-                        method: Some(method),
-                        label: method.label().to_owned(),
-                        points: vec![(step, value)],
-                    }),
-                }
-            }
+            add_to_lines(&mut lines, quantity, step, values);
         }
         self.out.series.extend(lines);
+    }
+
+    /// The nodes (one per step) of the output `name`, with their indices.
+    fn nodes_named<'b>(&'b self, name: &'b str) -> impl Iterator<Item = (usize, &'b Node<G, N>)> {
+        self.out
+            .nodes
+            .iter()
+            .enumerate()
+            .filter(move |(_, n)| n.name == name)
     }
 
     /// Σ_ρxρx in the left (world) form per method and step: the along-track variance that
@@ -1394,29 +1818,22 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
             return;
         }
         let mut lines: Vec<Series> = Vec::new();
-        for node in self.out.nodes.iter().filter(|n| n.name == name) {
+        for (index, node) in self.nodes_named(name) {
             let step = node.step.unwrap_or(0) as i64;
             let mut values: Vec<(Method, f64)> = node
                 .estimates
                 .iter()
                 .map(|e| (e.result.method, e.result.pose.cov_left()[(0, 0)]))
                 .collect();
-            if let Some(p) = &node.particles
-                && let Ok(cov) = crate::sample::uncentred_covariance(p, &node.nominal, Side::Left)
-            {
+            if let Some(cov) = self.mc_uncentred_left(index) {
                 values.push((Method::MonteCarlo, cov[(0, 0)]));
             }
-            for (method, value) in values {
-                match lines.iter_mut().find(|l| l.method == Some(method)) {
-                    Some(line) => line.points.push((step, value)),
-                    None => lines.push(Series {
-                        quantity: "along-track variance Σ_ρxρx, left form (m²)".to_owned(),
-                        method: Some(method),
-                        label: method.label().to_owned(),
-                        points: vec![(step, value)],
-                    }),
-                }
-            }
+            add_to_lines(
+                &mut lines,
+                "along-track variance Σ_ρxρx, left form (m²)",
+                step,
+                values,
+            );
         }
         if let Some(last) = self.out.nodes.iter().rev().find(|n| n.name == name) {
             let summary: Vec<String> = lines
@@ -1438,14 +1855,14 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
 
     /// Adds each node's Monte Carlo estimate and every other estimate's error against it.
     fn errors_against_monte_carlo(&mut self) {
-        for node in &mut self.out.nodes {
-            let Some(particles) = &node.particles else {
-                continue;
-            };
+        let all_stats: Vec<Option<SampleStatistics<G, N>>> = (0..self.out.nodes.len())
+            .map(|i| self.mc_stats(i))
+            .collect();
+        for (node, stats) in self.out.nodes.iter_mut().zip(all_stats) {
             if node.role == Role::Fixed {
                 continue;
             }
-            let Ok(stats) = sample_statistics(particles, Side::Right) else {
+            let Some(stats) = stats else {
                 continue;
             };
             for e in &mut node.estimates {
@@ -1465,14 +1882,30 @@ impl<'a, G: EvalGroup<N>, const N: usize> Engine<'a, G, N> {
     }
 }
 
+/// Adds each method's value at `step` to its line of `quantity` (a new line per method).
+fn add_to_lines(lines: &mut Vec<Series>, quantity: &str, step: i64, values: Vec<(Method, f64)>) {
+    for (method, value) in values {
+        match lines.iter_mut().find(|l| l.method == Some(method)) {
+            Some(line) => line.points.push((step, value)),
+            None => lines.push(Series {
+                quantity: quantity.to_owned(),
+                method: Some(method),
+                label: method.label().to_owned(),
+                points: vec![(step, value)],
+            }),
+        }
+    }
+}
+
 /// `x ← f(rng, x)` over a slice, in parallel, deterministic per seed and family.
 fn fill_par_map<G: Copy + Send + Sync>(
     xs: &mut [G],
     seed: u64,
     family: u64,
+    first_chunk: u64,
     f: impl Fn(&mut rand_chacha::ChaCha8Rng, &G) -> G + Sync,
 ) {
-    fill_par(xs, seed, family, |rng, chunk| {
+    fill_par_from(xs, seed, family, first_chunk, |rng, chunk| {
         for x in chunk.iter_mut() {
             *x = f(rng, x);
         }

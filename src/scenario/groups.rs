@@ -89,6 +89,9 @@ pub struct DiffDriveParams {
     pub dt: f64,
     /// Monte Carlo samples (0: none).
     pub samples: usize,
+    /// Chunk index of the first sample (a block of a larger sample; see
+    /// [`EulerMaruyama::first_chunk`](crate::propagate::diff_drive::EulerMaruyama::first_chunk)).
+    pub first_chunk: u64,
     /// Seed.
     pub seed: u64,
 }
@@ -254,7 +257,8 @@ impl EvalGroup<3> for Se2 {
                 .collect();
             let (end_poses, trajectories) = if p.samples > 0 {
                 let settings = EulerMaruyama::new(p.dt, p.samples, p.seed)
-                    .with_trajectories(DIFF_DRIVE_TRAJECTORIES, 10);
+                    .with_trajectories(DIFF_DRIVE_TRAJECTORIES, 10)
+                    .starting_at_chunk(p.first_chunk);
                 let sde = robot.euler_maruyama(rates, p.duration, &settings)?;
                 (sde.end_poses, sde.trajectories)
             } else {

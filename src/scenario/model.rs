@@ -25,6 +25,9 @@ pub struct Meta {
     pub seed: u64,
     /// Monte Carlo sample count.
     pub samples: usize,
+    /// Monte Carlo particles simulated and held at once (= `samples` unless the sample was
+    /// split into blocks to bound memory; see `scenario::eval`).
+    pub block_samples: usize,
     /// Confidence (probability) of drawn regions.
     pub confidence: f64,
     /// Methods compared.

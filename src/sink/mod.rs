@@ -31,7 +31,10 @@ pub mod viewer;
 
 use std::path::PathBuf;
 
-pub use self::rerun::{LogOutcome, STEP_TIMELINE, blueprint_for, log_scene, log_scene_cancellable};
+pub use self::rerun::{
+    LogOutcome, STEP_TIMELINE, blueprint_for, log_part_cancellable, log_scene,
+    log_scene_cancellable,
+};
 pub use self::stream::{SinkGuard, open_stream, scene_to_rrd_bytes};
 pub use self::viewer::{NativeViewer, find_native_viewer, render_png};
 

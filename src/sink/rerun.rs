@@ -84,6 +84,47 @@ pub fn log_scene_cancellable(
             scene.description_markdown.as_str(),
         )],
     )?;
+    if let cancelled @ LogOutcome::Cancelled { .. } = log_items(rec, scene, cancel)? {
+        return Ok(cancelled);
+    }
+    for series in &scene.series {
+        log_series(rec, series)?;
+    }
+    Ok(LogOutcome::Complete)
+}
+
+/// Logs the items of a part scene (a later block of a large Monte Carlo sample, from
+/// [`crate::draw::particle_parts`]) after the main scene: validated, then its items in log
+/// order, nothing else (no name, view coordinates, description or series). `cancel` as in
+/// [`log_scene_cancellable`].
+///
+/// # Errors
+/// [`SinkError::Scene`] if the part is invalid (nothing is logged then), or an SDK error.
+///
+/// ```
+/// use std::sync::atomic::AtomicBool;
+/// use posecov::sink::{RecordingIds, Sink, log_part_cancellable, open_stream};
+/// let scene = posecov::scene::Scene::new("part", "");
+/// let (rec, guard) = open_stream(&Sink::Memory, &RecordingIds::for_scenario("doc", 0), &scene)?;
+/// log_part_cancellable(&rec, &scene, &AtomicBool::new(false))?;
+/// assert!(!guard.finish(rec)?.unwrap_or_default().is_empty());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn log_part_cancellable(
+    rec: &rr::RecordingStream,
+    part: &Scene,
+    cancel: &AtomicBool,
+) -> Result<LogOutcome, SinkError> {
+    part.validate()?;
+    log_items(rec, part, cancel)
+}
+
+/// Every item of `scene` in log order, stopping when `cancel` is raised.
+fn log_items(
+    rec: &rr::RecordingStream,
+    scene: &Scene,
+    cancel: &AtomicBool,
+) -> Result<LogOutcome, SinkError> {
     for item in scene.items_in_log_order() {
         if cancel.load(Ordering::Relaxed) {
             let next_step = match item.timing {
@@ -93,9 +134,6 @@ pub fn log_scene_cancellable(
             return Ok(LogOutcome::Cancelled { next_step });
         }
         log_item(rec, item)?;
-    }
-    for series in &scene.series {
-        log_series(rec, series)?;
     }
     Ok(LogOutcome::Complete)
 }
