@@ -128,8 +128,8 @@ fn part_of<G: SpecGroup<N>, const N: usize>(
     part: usize,
 ) -> Scene {
     let rotation_group = G::rotation_range().start == 0;
-    let mut p = painter(main);
-    p.scene = Scene::new(main.meta.title.clone(), String::new());
+    // A part is logged after the main scene: its items only, no description.
+    let mut p = painter(main, String::new());
     for node in block
         .nodes
         .iter()
@@ -266,8 +266,9 @@ impl Painter {
     }
 }
 
-/// The sizes of a scenario's drawing (from its nominal poses and paths) and an empty scene.
-fn painter<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Painter {
+/// The sizes of a scenario's drawing (from its nominal poses and paths) and an empty scene
+/// with that description.
+fn painter<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>, description: String) -> Painter {
     let rotation_group = G::rotation_range().start == 0;
     let extent = scene_extent(e);
     let axis_length = e.meta.draw.axis_length.unwrap_or(if rotation_group {
@@ -277,7 +278,7 @@ fn painter<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Painter {
     });
     let last_step = e.nodes.iter().filter_map(|n| n.step).max().unwrap_or(0);
     Painter {
-        scene: Scene::new(e.meta.title.clone(), description(e)),
+        scene: Scene::new(e.meta.title.clone(), description),
         confidence: e.meta.confidence,
         axis_length,
         extent,
@@ -288,7 +289,7 @@ fn painter<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Painter {
 
 fn build<G: SpecGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Scene {
     let rotation_group = G::rotation_range().start == 0;
-    let mut p = painter(e);
+    let mut p = painter(e, description(e));
     let extent = p.extent;
     p.scene.planar = match e.meta.draw.view {
         Some(View::Top) => true,

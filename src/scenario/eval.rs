@@ -390,10 +390,9 @@ impl<G: EvalGroup<N>, const N: usize> BlockedStats<G, N> {
             acc.iterations += 1;
             let step = acc.sum / n as f64;
             let norm = step.norm();
-            if !norm.is_finite() || acc.iterations >= LIE_MEAN_MAX_ITERATIONS {
-                acc.failed = norm >= LIE_MEAN_TOLERANCE || !norm.is_finite();
-            }
-            if !acc.failed && norm < LIE_MEAN_TOLERANCE {
+            if !norm.is_finite() {
+                acc.failed = true;
+            } else if norm < LIE_MEAN_TOLERANCE {
                 let centred = acc.outer - step * step.transpose() * n as f64;
                 acc.result = Some(SampleStatistics {
                     mean: retract(&acc.mean, &step, Side::Right),
@@ -402,7 +401,9 @@ impl<G: EvalGroup<N>, const N: usize> BlockedStats<G, N> {
                     count: n,
                     iterations: acc.iterations,
                 });
-            } else if !acc.failed {
+            } else if acc.iterations >= LIE_MEAN_MAX_ITERATIONS {
+                acc.failed = true; // as `lie_mean`'s NotConverged: no Monte Carlo estimate
+            } else {
                 acc.mean = retract(&acc.mean, &step, Side::Right);
             }
             acc.sum = Tangent::<N>::zeros();
