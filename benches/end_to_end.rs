@@ -1,6 +1,6 @@
 //! End to end on every bundled scenario, through the library path the CLI uses (BENCHMARKS.md):
-//! - `report`: parse + [`evaluate`] + the JSON records (`posecov report <scenario> --json`);
-//! - `save`: parse + [`evaluate`] + [`build_scene`] + [`scene_to_rrd_bytes`]
+//! - `report`: parse + lower + evaluate + the JSON records (`posecov report <scenario> --json`);
+//! - `save`: parse + lower + evaluate + draw + [`scene_to_rrd_bytes`]
 //!   (`posecov <scenario> --save x.rrd`, less the file write).
 //!
 //! Run: `cargo bench --bench end_to_end -- --warm-up-time 1 --measurement-time 3`
@@ -9,22 +9,20 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use posecov::draw::build_scene;
-use posecov::scenario::Scenario;
-use posecov::scenario::bundled::BUNDLED;
-use posecov::scenario::eval::{EvalOptions, evaluate};
+use posecov::app::{Overrides, evaluate, load_text, pipeline, resolve};
+use posecov::input::scenario::bundled::BUNDLED;
 use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
 
 fn report(name: &str, text: &str) -> String {
-    let scenario = Scenario::parse(text, name).expect("bundled scenario parses");
-    let evaluation = evaluate(&scenario, &EvalOptions::default()).expect("bundled scenario runs");
+    let loaded = load_text(text, name).expect("bundled scenario loads");
+    let settings = resolve(&loaded.input, &Overrides::default(), None).expect("settings");
+    let evaluation = evaluate(&loaded, &settings.eval).expect("bundled scenario runs");
     serde_json::to_string_pretty(&evaluation.records()).expect("records serialise")
 }
 
 fn save(name: &str, text: &str) -> Vec<u8> {
-    let scenario = Scenario::parse(text, name).expect("bundled scenario parses");
-    let evaluation = evaluate(&scenario, &EvalOptions::default()).expect("bundled scenario runs");
-    let scene = build_scene(&evaluation);
+    let loaded = load_text(text, name).expect("bundled scenario loads");
+    let (_, scene) = pipeline(&loaded, &Overrides::default(), None).expect("bundled scenario runs");
     scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario(name, 0)).expect("scene encodes")
 }
 

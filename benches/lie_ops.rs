@@ -2,6 +2,16 @@
 //! each ratio comes from one run on this (shared, noisy) machine. See BENCHMARKS.md.
 //!
 //! Run: `cargo bench --no-default-features --bench lie_ops -- --warm-up-time 1 --measurement-time 3`
+//! (append a filter such as `so3` or `'se2\.(exp|log)'` to run part of it; `-- --list` lists
+//! the ids).
+//!
+//! One benchmark body, [`lie_group_bench!`], is instantiated once per group (SO(2), SO(3),
+//! SE(2), SE(3)), the way manif's `benchmark/common_benchmark.h` instantiates one templated
+//! body per group. For every group it times, in this order, the criterion groups
+//! `<group>.exp`, `.log`, `.compose`, `.inverse`, `.act`, `.adj`, `.jr` and `.jr_inv`, each
+//! with `posecov` and `sophus_lie` first and then the group's nalgebra peers, which are the
+//! only per-group part of the body beyond the types, the input generators and the tangent
+//! permutation.
 //!
 //! Peers:
 //! - `sophus_lie` 0.15 (`Rotation2F64`, `Rotation3F64`, `Isometry2F64`, `Isometry3F64`). Its
@@ -18,12 +28,13 @@
 //! (seeded ChaCha8); criterion's time per iteration / [`BATCH`] is the time per operation.
 
 use std::hint::black_box;
+use std::ops::Index;
 
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, Criterion, Throughput, criterion_group, criterion_main};
 use nalgebra::{
-    Isometry2, Isometry3, Point2, Point3, Rotation2, Translation2, Translation3, UnitComplex,
-    UnitQuaternion, Vector1, Vector2, Vector3, Vector6,
+    Dim, Isometry2, Isometry3, Matrix, Point2, Point3, RawStorage, Rotation2, Translation2,
+    Translation3, UnitComplex, UnitQuaternion, Vector1, Vector2, Vector3, Vector6,
 };
 use posecov::lie::{LieGroup, Se2, Se3, So2, So3};
 use rand::{Rng, SeedableRng};
@@ -34,11 +45,14 @@ use sophus_lie::{Isometry2F64, Isometry3F64, Rotation2F64, Rotation3F64};
 /// Operations per timed iteration.
 const BATCH: usize = 1024;
 
-/// Seed of the input generator.
+/// Seed of the input generator (group i of so2, so3, se2, se3 uses `SEED + i`).
 const SEED: u64 = 0x5EED_2026;
 
-/// Tolerance of the setup's cross-checks between posecov and sophus.
+/// Tolerance of the setup's cross-checks between posecov and its peers.
 const AGREE: f64 = 1e-9;
+
+/// Inputs cross-checked between posecov and its peers before timing.
+const CHECKED: usize = 16;
 
 // ---------------------------------------------------------------------------------------------
 // Inputs.
@@ -75,6 +89,37 @@ fn random_angle(rng: &mut ChaCha8Rng) -> f64 {
     rng.random_range(-3.0..3.0)
 }
 
+/// SO(2) tangent θ.
+fn so2_tangent(rng: &mut ChaCha8Rng) -> Vector1<f64> {
+    Vector1::new(random_angle(rng))
+}
+
+/// SE(2) tangent [ρx, ρy, θ].
+fn se2_tangent(rng: &mut ChaCha8Rng) -> Vector3<f64> {
+    let t = random_translation2(rng);
+    Vector3::new(t.x, t.y, random_angle(rng))
+}
+
+/// SE(3) tangent [ρ; θ].
+fn se3_tangent(rng: &mut ChaCha8Rng) -> Vector6<f64> {
+    let (rho, theta) = (random_translation3(rng), random_rotation_vector(rng));
+    Vector6::new(rho.x, rho.y, rho.z, theta.x, theta.y, theta.z)
+}
+
+/// `(f(a), f(b))` for each pair of tangents: the two operands of a binary operation.
+fn pairs<T, X>(tau: &[T], tau_b: &[T], f: impl Fn(&T) -> X) -> Vec<(X, X)> {
+    tau.iter().zip(tau_b).map(|(a, b)| (f(a), f(b))).collect()
+}
+
+/// `(x, p)`: the first element of each pair, with the point it acts on.
+fn with_points<X: Copy, P>(pairs: &[(X, X)], points: impl IntoIterator<Item = P>) -> Vec<(X, P)> {
+    pairs
+        .iter()
+        .zip(points)
+        .map(|((x, _), p)| (*x, p))
+        .collect()
+}
+
 // ---------------------------------------------------------------------------------------------
 // Conversions between the two nalgebra versions and the two tangent orders.
 
@@ -100,20 +145,33 @@ fn se3_tangent_33(t: &Vector6<f64>) -> na33::Vector6<f64> {
     na33::Vector6::new(t[3], t[4], t[5], t[0], t[1], t[2])
 }
 
-/// Asserts that `ours(i, j)` ≈ `theirs(perm(i), perm(j))` for an n×m block, where `perm`
-/// maps a posecov tangent index to sophus' (identity for matrices of points).
-fn assert_agree(
+/// A posecov tangent index → sophus' (the identity for rotations, matrices and points).
+fn same(i: usize) -> usize {
+    i
+}
+
+/// posecov SE(2) [ρx, ρy, θ] index → sophus [θ, ρx, ρy] index.
+fn se2_perm(i: usize) -> usize {
+    (i + 1) % 3
+}
+
+/// posecov SE(3) [ρ; θ] index → sophus [θ; ρ] index.
+fn se3_perm(i: usize) -> usize {
+    (i + 3) % 6
+}
+
+/// Asserts that `ours[(i, j)]` ≈ `theirs[(perm_row(i), perm_col(j))]` for every entry of `ours`.
+fn assert_agree<R: Dim, C: Dim, S: RawStorage<f64, R, C>>(
     what: &str,
-    n: usize,
-    m: usize,
-    ours: impl Fn(usize, usize) -> f64,
-    theirs: impl Fn(usize, usize) -> f64,
-    perm_row: impl Fn(usize) -> usize,
-    perm_col: impl Fn(usize) -> usize,
+    ours: &Matrix<f64, R, C, S>,
+    theirs: &impl Index<(usize, usize), Output = f64>,
+    perm_row: fn(usize) -> usize,
+    perm_col: fn(usize) -> usize,
 ) {
+    let (n, m) = ours.shape();
     for i in 0..n {
         for j in 0..m {
-            let (a, b) = (ours(i, j), theirs(perm_row(i), perm_col(j)));
+            let (a, b) = (ours[(i, j)], theirs[(perm_row(i), perm_col(j))]);
             assert!(
                 (a - b).abs() <= AGREE * (1.0 + a.abs()),
                 "{what}: posecov ({i}, {j}) = {a} but peer = {b}"
@@ -122,12 +180,47 @@ fn assert_agree(
     }
 }
 
-fn same(i: usize) -> usize {
-    i
+// ---------------------------------------------------------------------------------------------
+// Timing.
+
+/// The operations timed for every group, in order; criterion group `<group>.<Op::id>`.
+#[derive(Clone, Copy, PartialEq)]
+enum Op {
+    Exp,
+    Log,
+    Compose,
+    Inverse,
+    Act,
+    Adj,
+    Jr,
+    JrInv,
 }
 
-// ---------------------------------------------------------------------------------------------
-// Timing helpers.
+impl Op {
+    const ALL: [Op; 8] = [
+        Op::Exp,
+        Op::Log,
+        Op::Compose,
+        Op::Inverse,
+        Op::Act,
+        Op::Adj,
+        Op::Jr,
+        Op::JrInv,
+    ];
+
+    fn id(self) -> &'static str {
+        match self {
+            Op::Exp => "exp",
+            Op::Log => "log",
+            Op::Compose => "compose",
+            Op::Inverse => "inverse",
+            Op::Act => "act",
+            Op::Adj => "adj",
+            Op::Jr => "jr",
+            Op::JrInv => "jr_inv",
+        }
+    }
+}
 
 fn group<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
     let mut g = c.benchmark_group(name);
@@ -147,697 +240,187 @@ fn unary<I, O>(g: &mut BenchmarkGroup<'_, WallTime>, id: &str, inputs: &[I], f: 
     });
 }
 
-// ---------------------------------------------------------------------------------------------
-// SO(2).
+/// Times posecov's `f` and then sophus_lie's `h`, the same operation on the same inputs.
+fn side_by_side<I, O, J, P>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    ours: &[I],
+    f: impl Fn(&I) -> O,
+    theirs: &[J],
+    h: impl Fn(&J) -> P,
+) {
+    unary(g, "posecov", ours, f);
+    unary(g, "sophus_lie", theirs, h);
+}
 
-fn so2(c: &mut Criterion) {
-    let mut rng = ChaCha8Rng::seed_from_u64(SEED);
-    let tau: Vec<Vector1<f64>> = (0..BATCH)
-        .map(|_| Vector1::new(random_angle(&mut rng)))
-        .collect();
-    let tau_b: Vec<Vector1<f64>> = (0..BATCH)
-        .map(|_| Vector1::new(random_angle(&mut rng)))
-        .collect();
-    let pts: Vec<Vector2<f64>> = (0..BATCH).map(|_| random_translation2(&mut rng)).collect();
+/// The benchmark body, instantiated once per group as `fn $name(c: &mut Criterion)`.
+///
+/// - `$name: $Ours vs $Theirs, seed $seed, perm $perm`: criterion group prefix and function
+///   name, the posecov and sophus_lie types, the input seed, and posecov tangent index →
+///   sophus tangent index.
+/// - `tangent gen => to_sophus, point gen => to_sophus`: generators of posecov tangents and
+///   points, and their conversions to sophus inputs (tangent permuted).
+/// - `nalgebra |tau, tau_b, ours, pts| { … }`: builds the nalgebra inputs from the two tangent
+///   operands, the posecov operand pairs and the points (slices, under the names given).
+/// - `check |k| …`: input `k` agrees with nalgebra (the sophus checks are common to all).
+/// - `Op { "id" on inputs, … => f; … }`: the nalgebra benchmarks of that operation, timed
+///   after `posecov` and `sophus_lie`, in the order listed (`f` applied to each input set).
+///
+/// The second form, `nalgebra isometry "id" Isometry2(Translation2, complex), Point2;`, is
+/// shorthand for the SE(n) peers: `IsometryN` compose, inverse and `transform_point`.
+macro_rules! lie_group_bench {
+    (
+        $name:ident: $Ours:ident vs $Theirs:ident, seed $seed:expr, perm $perm:expr;
+        tangent $tangent:expr => $s_tangent:expr, point $point:expr => $s_point:expr;
+        nalgebra |$tau:ident, $tau_b:ident, $ours:ident, $pts:ident| { $($setup:tt)* }
+        check |$k:ident| $check:expr;
+        $( $op:ident { $( $( $id:literal on $inputs:expr ),+ => $f:expr );+ $(;)? } )*
+    ) => {
+        fn $name(c: &mut Criterion) {
+            let mut rng = ChaCha8Rng::seed_from_u64($seed);
+            let tau: Vec<_> = (0..BATCH).map(|_| $tangent(&mut rng)).collect();
+            let tau_b: Vec<_> = (0..BATCH).map(|_| $tangent(&mut rng)).collect();
+            let pts: Vec<_> = (0..BATCH).map(|_| $point(&mut rng)).collect();
 
-    let ours: Vec<(So2, So2)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| (So2::exp(a), So2::exp(b)))
-        .collect();
-    let s_tau: Vec<na33::Vector1<f64>> = tau.iter().map(v1_33).collect();
-    let s_neg: Vec<na33::Vector1<f64>> = tau.iter().map(|t| v1_33(&-t)).collect();
-    let s_pts: Vec<na33::Vector2<f64>> = pts.iter().map(v2_33).collect();
-    let theirs: Vec<(Rotation2F64, Rotation2F64)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| (Rotation2F64::exp(v1_33(a)), Rotation2F64::exp(v1_33(b))))
-        .collect();
-    let uc: Vec<(UnitComplex<f64>, UnitComplex<f64>)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| (UnitComplex::new(a.x), UnitComplex::new(b.x)))
-        .collect();
-    let rot: Vec<(Rotation2<f64>, Rotation2<f64>)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| (Rotation2::new(a.x), Rotation2::new(b.x)))
-        .collect();
-    let angles: Vec<f64> = tau.iter().map(|t| t.x).collect();
+            let ours: Vec<($Ours, $Ours)> = pairs(&tau, &tau_b, $Ours::exp);
+            let theirs: Vec<($Theirs, $Theirs)> =
+                pairs(&tau, &tau_b, |t| $Theirs::exp($s_tangent(t)));
+            let s_tau: Vec<_> = tau.iter().map($s_tangent).collect();
+            let s_neg: Vec<_> = tau.iter().map(|t| $s_tangent(&-t)).collect();
+            let s_pts: Vec<_> = pts.iter().map($s_point).collect();
+            let act_ours = with_points(&ours, pts.iter().copied());
+            let act_theirs = with_points(&theirs, s_pts.iter().copied());
 
-    for k in 0..16 {
-        let (x, y) = (&ours[k].0, &ours[k].1);
-        let (sx, sy) = (&theirs[k].0, &theirs[k].1);
-        let m = x.to_matrix();
-        assert_agree(
-            "SO(2) exp",
-            2,
-            2,
-            |i, j| m[(i, j)],
-            |i, j| sx.matrix()[(i, j)],
-            same,
-            same,
-        );
-        assert_agree(
-            "SO(2) log",
-            1,
-            1,
-            |_, _| x.log().x,
-            |_, _| sx.log().x,
-            same,
-            same,
-        );
-        let c = x.compose(y).to_matrix();
-        let sc = sx.group_mul(*sy).matrix();
-        assert_agree(
-            "SO(2) compose",
-            2,
-            2,
-            |i, j| c[(i, j)],
-            |i, j| sc[(i, j)],
-            same,
-            same,
-        );
-        let a = x.act(&pts[k]);
-        let sa = sx.transform(s_pts[k]);
-        assert_agree("SO(2) act", 2, 1, |i, _| a[i], |i, _| sa[i], same, same);
-        assert!((uc[k].0 * pts[k] - a).norm() < AGREE);
-    }
+            let ($tau, $tau_b, $ours, $pts) = (&tau[..], &tau_b[..], &ours[..], &pts[..]);
+            $($setup)*
 
-    let mut g = group(c, "so2.exp");
-    unary(&mut g, "posecov", &tau, So2::exp);
-    unary(&mut g, "sophus_lie", &s_tau, |t| Rotation2F64::exp(*t));
-    unary(&mut g, "nalgebra_UnitComplex", &angles, |a| {
-        UnitComplex::new(*a)
-    });
-    unary(&mut g, "nalgebra_Rotation2", &angles, |a| {
-        Rotation2::new(*a)
-    });
-    g.finish();
+            for $k in 0..CHECKED {
+                let ((x, y), (sx, sy)) = (&ours[$k], &theirs[$k]);
+                let what = |op: &str| format!("{} {op}", stringify!($name));
+                assert_agree(&what("exp"), &x.to_matrix(), &sx.matrix(), same, same);
+                assert_agree(&what("log"), &x.log(), &sx.log(), $perm, same);
+                let (xy, sxy) = (x.compose(y), sx.group_mul(*sy));
+                assert_agree(&what("compose"), &xy.to_matrix(), &sxy.matrix(), same, same);
+                let (xi, sxi) = (x.inverse(), sx.inverse());
+                assert_agree(&what("inverse"), &xi.to_matrix(), &sxi.matrix(), same, same);
+                let (a, sa) = (x.act(&pts[$k]), sx.transform(s_pts[$k]));
+                assert_agree(&what("act"), &a, &sa, same, same);
+                assert_agree(&what("adj"), &x.adj(), &sx.adj(), $perm, $perm);
+                let (jr, sjr) = ($Ours::jr(&tau[$k]), $Theirs::left_jacobian(s_neg[$k]));
+                assert_agree(&what("jr"), &jr, &sjr, $perm, $perm);
+                let (ji, sji) = ($Ours::jr_inv(&tau[$k]), $Theirs::inv_left_jacobian(s_neg[$k]));
+                assert_agree(&what("jr_inv"), &ji, &sji, $perm, $perm);
+                assert!($check, "{}: nalgebra disagrees", what("check"));
+            }
 
-    let mut g = group(c, "so2.log");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.log());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.log());
-    unary(&mut g, "nalgebra_UnitComplex", &uc, |(x, _)| x.angle());
-    unary(&mut g, "nalgebra_Rotation2", &rot, |(x, _)| x.angle());
-    g.finish();
-
-    let mut g = group(c, "so2.compose");
-    unary(&mut g, "posecov", &ours, |(x, y)| x.compose(y));
-    unary(&mut g, "sophus_lie", &theirs, |(x, y)| x.group_mul(*y));
-    unary(&mut g, "nalgebra_UnitComplex", &uc, |(x, y)| x * y);
-    unary(&mut g, "nalgebra_Rotation2", &rot, |(x, y)| x * y);
-    g.finish();
-
-    let mut g = group(c, "so2.inverse");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.inverse());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.inverse());
-    unary(&mut g, "nalgebra_UnitComplex", &uc, |(x, _)| x.inverse());
-    unary(&mut g, "nalgebra_Rotation2", &rot, |(x, _)| x.inverse());
-    g.finish();
-
-    let act_ours: Vec<(So2, Vector2<f64>)> =
-        ours.iter().zip(&pts).map(|((x, _), p)| (*x, *p)).collect();
-    let act_theirs: Vec<(Rotation2F64, na33::Vector2<f64>)> = theirs
-        .iter()
-        .zip(&s_pts)
-        .map(|((x, _), p)| (*x, *p))
-        .collect();
-    let act_uc: Vec<(UnitComplex<f64>, Vector2<f64>)> =
-        uc.iter().zip(&pts).map(|((x, _), p)| (*x, *p)).collect();
-    let act_rot: Vec<(Rotation2<f64>, Vector2<f64>)> =
-        rot.iter().zip(&pts).map(|((x, _), p)| (*x, *p)).collect();
-    let mut g = group(c, "so2.act");
-    unary(&mut g, "posecov", &act_ours, |(x, p)| x.act(p));
-    unary(&mut g, "sophus_lie", &act_theirs, |(x, p)| x.transform(*p));
-    unary(&mut g, "nalgebra_UnitComplex", &act_uc, |(x, p)| x * p);
-    unary(&mut g, "nalgebra_Rotation2", &act_rot, |(x, p)| x * p);
-    g.finish();
-
-    let mut g = group(c, "so2.adj");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.adj());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.adj());
-    g.finish();
-
-    let mut g = group(c, "so2.jr");
-    unary(&mut g, "posecov", &tau, So2::jr);
-    unary(&mut g, "sophus_lie", &s_neg, |t| {
-        Rotation2F64::left_jacobian(*t)
-    });
-    g.finish();
-
-    let mut g = group(c, "so2.jr_inv");
-    unary(&mut g, "posecov", &tau, So2::jr_inv);
-    unary(&mut g, "sophus_lie", &s_neg, |t| {
-        Rotation2F64::inv_left_jacobian(*t)
-    });
-    g.finish();
+            for op in Op::ALL {
+                let mut bench = group(c, &format!("{}.{}", stringify!($name), op.id()));
+                let g = &mut bench;
+                match op {
+                    Op::Exp => side_by_side(g, &tau, $Ours::exp, &s_tau, |t| $Theirs::exp(*t)),
+                    Op::Log => side_by_side(g, &ours, |(x, _)| x.log(), &theirs, |(x, _)| x.log()),
+                    Op::Compose => side_by_side(
+                        g, &ours, |(x, y)| x.compose(y), &theirs, |(x, y)| x.group_mul(*y),
+                    ),
+                    Op::Inverse => side_by_side(
+                        g, &ours, |(x, _)| x.inverse(), &theirs, |(x, _)| x.inverse(),
+                    ),
+                    Op::Act => side_by_side(
+                        g, &act_ours, |(x, p)| x.act(p), &act_theirs, |(x, p)| x.transform(*p),
+                    ),
+                    Op::Adj => side_by_side(g, &ours, |(x, _)| x.adj(), &theirs, |(x, _)| x.adj()),
+                    Op::Jr => side_by_side(
+                        g, &tau, $Ours::jr, &s_neg, |t| $Theirs::left_jacobian(*t),
+                    ),
+                    Op::JrInv => side_by_side(
+                        g, &tau, $Ours::jr_inv, &s_neg, |t| $Theirs::inv_left_jacobian(*t),
+                    ),
+                }
+                $( if op == Op::$op { $( $( unary(g, $id, $inputs, $f); )+ )+ } )*
+                bench.finish();
+            }
+        }
+    };
+    (
+        $name:ident: $Ours:ident vs $Theirs:ident, seed $seed:expr, perm $perm:expr;
+        tangent $tangent:expr => $s_tangent:expr, point $point:expr => $s_point:expr;
+        nalgebra isometry $id:literal $Iso:ident($Translation:ident, $rotation:ident), $Point:ident;
+    ) => {
+        lie_group_bench! {
+            $name: $Ours vs $Theirs, seed $seed, perm $perm;
+            tangent $tangent => $s_tangent, point $point => $s_point;
+            nalgebra |_tau, _tau_b, ours, pts| {
+                let iso = |x: &$Ours| {
+                    let rotation = *x.rotation().$rotation();
+                    $Iso::from_parts($Translation::from(*x.translation()), rotation)
+                };
+                let na: Vec<($Iso<f64>, $Iso<f64>)> =
+                    ours.iter().map(|(x, y)| (iso(x), iso(y))).collect();
+                let act_na = with_points(&na, pts.iter().map(|p| $Point::from(*p)));
+            }
+            check |k| {
+                let p = na[k].0.transform_point(&$Point::from(pts[k])).coords;
+                (p - ours[k].0.act(&pts[k])).norm() < AGREE
+            };
+            Compose { $id on &na => |(x, y)| x * y }
+            Inverse { $id on &na => |(x, _)| x.inverse() }
+            Act { $id on &act_na => |(x, p)| x.transform_point(p) }
+        }
+    };
 }
 
 // ---------------------------------------------------------------------------------------------
-// SO(3).
+// The groups: types, inputs and nalgebra peers.
 
-fn so3(c: &mut Criterion) {
-    let mut rng = ChaCha8Rng::seed_from_u64(SEED + 1);
-    let tau: Vec<Vector3<f64>> = (0..BATCH)
-        .map(|_| random_rotation_vector(&mut rng))
-        .collect();
-    let tau_b: Vec<Vector3<f64>> = (0..BATCH)
-        .map(|_| random_rotation_vector(&mut rng))
-        .collect();
-    let pts: Vec<Vector3<f64>> = (0..BATCH).map(|_| random_translation3(&mut rng)).collect();
-
-    let ours: Vec<(So3, So3)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| (So3::exp(a), So3::exp(b)))
-        .collect();
-    let s_tau: Vec<na33::Vector3<f64>> = tau.iter().map(v3_33).collect();
-    let s_neg: Vec<na33::Vector3<f64>> = tau.iter().map(|t| v3_33(&-t)).collect();
-    let s_pts: Vec<na33::Vector3<f64>> = pts.iter().map(v3_33).collect();
-    let theirs: Vec<(Rotation3F64, Rotation3F64)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| (Rotation3F64::exp(v3_33(a)), Rotation3F64::exp(v3_33(b))))
-        .collect();
-    let uq: Vec<(UnitQuaternion<f64>, UnitQuaternion<f64>)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| {
-            (
-                UnitQuaternion::from_scaled_axis(*a),
-                UnitQuaternion::from_scaled_axis(*b),
-            )
-        })
-        .collect();
-
-    for k in 0..16 {
-        let (x, y) = (&ours[k].0, &ours[k].1);
-        let (sx, sy) = (&theirs[k].0, &theirs[k].1);
-        let m = x.to_matrix();
-        assert_agree(
-            "SO(3) exp",
-            3,
-            3,
-            |i, j| m[(i, j)],
-            |i, j| sx.matrix()[(i, j)],
-            same,
-            same,
-        );
-        let (l, sl) = (x.log(), sx.log());
-        assert_agree("SO(3) log", 3, 1, |i, _| l[i], |i, _| sl[i], same, same);
-        assert!((uq[k].0.scaled_axis() - l).norm() < AGREE);
-        let cm = x.compose(y).to_matrix();
-        let sc = sx.group_mul(*sy).matrix();
-        assert_agree(
-            "SO(3) compose",
-            3,
-            3,
-            |i, j| cm[(i, j)],
-            |i, j| sc[(i, j)],
-            same,
-            same,
-        );
-        let inv = x.inverse().to_matrix();
-        let sinv = sx.inverse().matrix();
-        assert_agree(
-            "SO(3) inverse",
-            3,
-            3,
-            |i, j| inv[(i, j)],
-            |i, j| sinv[(i, j)],
-            same,
-            same,
-        );
-        let a = x.act(&pts[k]);
-        let sa = sx.transform(s_pts[k]);
-        assert_agree("SO(3) act", 3, 1, |i, _| a[i], |i, _| sa[i], same, same);
-        let ad = x.adj();
-        let sad = sx.adj();
-        assert_agree(
-            "SO(3) adj",
-            3,
-            3,
-            |i, j| ad[(i, j)],
-            |i, j| sad[(i, j)],
-            same,
-            same,
-        );
-        let jr = So3::jr(&tau[k]);
-        let sjr = Rotation3F64::left_jacobian(s_neg[k]);
-        assert_agree(
-            "SO(3) jr",
-            3,
-            3,
-            |i, j| jr[(i, j)],
-            |i, j| sjr[(i, j)],
-            same,
-            same,
-        );
-        let ji = So3::jr_inv(&tau[k]);
-        let sji = Rotation3F64::inv_left_jacobian(s_neg[k]);
-        assert_agree(
-            "SO(3) jr_inv",
-            3,
-            3,
-            |i, j| ji[(i, j)],
-            |i, j| sji[(i, j)],
-            same,
-            same,
-        );
+lie_group_bench! {
+    so2: So2 vs Rotation2F64, seed SEED, perm same;
+    tangent so2_tangent => v1_33, point random_translation2 => v2_33;
+    nalgebra |tau, tau_b, ours, pts| {
+        let angles: Vec<f64> = tau.iter().map(|t| t.x).collect();
+        let uc = pairs(tau, tau_b, |t| UnitComplex::new(t.x));
+        let rot = pairs(tau, tau_b, |t| Rotation2::new(t.x));
+        let act_uc = with_points(&uc, pts.iter().copied());
+        let act_rot = with_points(&rot, pts.iter().copied());
     }
-
-    let mut g = group(c, "so3.exp");
-    unary(&mut g, "posecov", &tau, So3::exp);
-    unary(&mut g, "sophus_lie", &s_tau, |t| Rotation3F64::exp(*t));
-    unary(&mut g, "nalgebra_from_scaled_axis", &tau, |t| {
-        UnitQuaternion::from_scaled_axis(*t)
-    });
-    g.finish();
-
-    let mut g = group(c, "so3.log");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.log());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.log());
-    unary(&mut g, "nalgebra_scaled_axis", &uq, |(x, _)| {
-        x.scaled_axis()
-    });
-    unary(&mut g, "nalgebra_ln", &uq, |(x, _)| x.ln());
-    g.finish();
-
-    let mut g = group(c, "so3.compose");
-    unary(&mut g, "posecov", &ours, |(x, y)| x.compose(y));
-    unary(&mut g, "sophus_lie", &theirs, |(x, y)| x.group_mul(*y));
-    unary(&mut g, "nalgebra_UnitQuaternion", &uq, |(x, y)| x * y);
-    g.finish();
-
-    let mut g = group(c, "so3.inverse");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.inverse());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.inverse());
-    unary(&mut g, "nalgebra_UnitQuaternion", &uq, |(x, _)| x.inverse());
-    g.finish();
-
-    let act_ours: Vec<(So3, Vector3<f64>)> =
-        ours.iter().zip(&pts).map(|((x, _), p)| (*x, *p)).collect();
-    let act_theirs: Vec<(Rotation3F64, na33::Vector3<f64>)> = theirs
-        .iter()
-        .zip(&s_pts)
-        .map(|((x, _), p)| (*x, *p))
-        .collect();
-    let act_uq: Vec<(UnitQuaternion<f64>, Vector3<f64>)> =
-        uq.iter().zip(&pts).map(|((x, _), p)| (*x, *p)).collect();
-    let mut g = group(c, "so3.act");
-    unary(&mut g, "posecov", &act_ours, |(x, p)| x.act(p));
-    unary(&mut g, "sophus_lie", &act_theirs, |(x, p)| x.transform(*p));
-    unary(&mut g, "nalgebra_UnitQuaternion", &act_uq, |(x, p)| x * p);
-    g.finish();
-
-    let mut g = group(c, "so3.adj");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.adj());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.adj());
-    unary(&mut g, "nalgebra_to_rotation_matrix", &uq, |(x, _)| {
-        x.to_rotation_matrix()
-    });
-    g.finish();
-
-    let mut g = group(c, "so3.jr");
-    unary(&mut g, "posecov", &tau, So3::jr);
-    unary(&mut g, "sophus_lie", &s_neg, |t| {
-        Rotation3F64::left_jacobian(*t)
-    });
-    g.finish();
-
-    let mut g = group(c, "so3.jr_inv");
-    unary(&mut g, "posecov", &tau, So3::jr_inv);
-    unary(&mut g, "sophus_lie", &s_neg, |t| {
-        Rotation3F64::inv_left_jacobian(*t)
-    });
-    g.finish();
-}
-
-// ---------------------------------------------------------------------------------------------
-// SE(2).
-
-fn se2_perm(i: usize) -> usize {
-    // posecov [ρx, ρy, θ] index → sophus [θ, ρx, ρy] index.
-    (i + 1) % 3
-}
-
-fn se2(c: &mut Criterion) {
-    let mut rng = ChaCha8Rng::seed_from_u64(SEED + 2);
-    let tangent = |rng: &mut ChaCha8Rng| {
-        let t = random_translation2(rng);
-        Vector3::new(t.x, t.y, random_angle(rng))
-    };
-    let tau: Vec<Vector3<f64>> = (0..BATCH).map(|_| tangent(&mut rng)).collect();
-    let tau_b: Vec<Vector3<f64>> = (0..BATCH).map(|_| tangent(&mut rng)).collect();
-    let pts: Vec<Vector2<f64>> = (0..BATCH).map(|_| random_translation2(&mut rng)).collect();
-
-    let ours: Vec<(Se2, Se2)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| (Se2::exp(a), Se2::exp(b)))
-        .collect();
-    let s_tau: Vec<na33::Vector3<f64>> = tau.iter().map(se2_tangent_33).collect();
-    let s_neg: Vec<na33::Vector3<f64>> = tau.iter().map(|t| se2_tangent_33(&-t)).collect();
-    let s_pts: Vec<na33::Vector2<f64>> = pts.iter().map(v2_33).collect();
-    let theirs: Vec<(Isometry2F64, Isometry2F64)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| {
-            (
-                Isometry2F64::exp(se2_tangent_33(a)),
-                Isometry2F64::exp(se2_tangent_33(b)),
-            )
-        })
-        .collect();
-    let iso = |x: &Se2| {
-        Isometry2::from_parts(
-            Translation2::from(*x.translation()),
-            *x.rotation().complex(),
-        )
-    };
-    let na: Vec<(Isometry2<f64>, Isometry2<f64>)> =
-        ours.iter().map(|(x, y)| (iso(x), iso(y))).collect();
-
-    for k in 0..16 {
-        let (x, y) = (&ours[k].0, &ours[k].1);
-        let (sx, sy) = (&theirs[k].0, &theirs[k].1);
-        let m = x.to_matrix();
-        assert_agree(
-            "SE(2) exp",
-            3,
-            3,
-            |i, j| m[(i, j)],
-            |i, j| sx.matrix()[(i, j)],
-            same,
-            same,
-        );
-        let (l, sl) = (x.log(), sx.log());
-        assert_agree("SE(2) log", 3, 1, |i, _| l[i], |i, _| sl[i], se2_perm, same);
-        let cm = x.compose(y).to_matrix();
-        let sc = sx.group_mul(*sy).matrix();
-        assert_agree(
-            "SE(2) compose",
-            3,
-            3,
-            |i, j| cm[(i, j)],
-            |i, j| sc[(i, j)],
-            same,
-            same,
-        );
-        let inv = x.inverse().to_matrix();
-        let sinv = sx.inverse().matrix();
-        assert_agree(
-            "SE(2) inverse",
-            3,
-            3,
-            |i, j| inv[(i, j)],
-            |i, j| sinv[(i, j)],
-            same,
-            same,
-        );
-        let a = x.act(&pts[k]);
-        let sa = sx.transform(s_pts[k]);
-        assert_agree("SE(2) act", 2, 1, |i, _| a[i], |i, _| sa[i], same, same);
-        assert!((na[k].0.transform_point(&Point2::from(pts[k])).coords - a).norm() < AGREE);
-        let ad = x.adj();
-        let sad = sx.adj();
-        assert_agree(
-            "SE(2) adj",
-            3,
-            3,
-            |i, j| ad[(i, j)],
-            |i, j| sad[(i, j)],
-            se2_perm,
-            se2_perm,
-        );
-        let jr = Se2::jr(&tau[k]);
-        let sjr = Isometry2F64::left_jacobian(s_neg[k]);
-        assert_agree(
-            "SE(2) jr",
-            3,
-            3,
-            |i, j| jr[(i, j)],
-            |i, j| sjr[(i, j)],
-            se2_perm,
-            se2_perm,
-        );
-        let ji = Se2::jr_inv(&tau[k]);
-        let sji = Isometry2F64::inv_left_jacobian(s_neg[k]);
-        assert_agree(
-            "SE(2) jr_inv",
-            3,
-            3,
-            |i, j| ji[(i, j)],
-            |i, j| sji[(i, j)],
-            se2_perm,
-            se2_perm,
-        );
+    check |k| (uc[k].0 * pts[k] - ours[k].0.act(&pts[k])).norm() < AGREE;
+    Exp {
+        "nalgebra_UnitComplex" on &angles => |a| UnitComplex::new(*a);
+        "nalgebra_Rotation2" on &angles => |a| Rotation2::new(*a);
     }
-
-    let mut g = group(c, "se2.exp");
-    unary(&mut g, "posecov", &tau, Se2::exp);
-    unary(&mut g, "sophus_lie", &s_tau, |t| Isometry2F64::exp(*t));
-    g.finish();
-
-    let mut g = group(c, "se2.log");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.log());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.log());
-    g.finish();
-
-    let mut g = group(c, "se2.compose");
-    unary(&mut g, "posecov", &ours, |(x, y)| x.compose(y));
-    unary(&mut g, "sophus_lie", &theirs, |(x, y)| x.group_mul(*y));
-    unary(&mut g, "nalgebra_Isometry2", &na, |(x, y)| x * y);
-    g.finish();
-
-    let mut g = group(c, "se2.inverse");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.inverse());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.inverse());
-    unary(&mut g, "nalgebra_Isometry2", &na, |(x, _)| x.inverse());
-    g.finish();
-
-    let act_ours: Vec<(Se2, Vector2<f64>)> =
-        ours.iter().zip(&pts).map(|((x, _), p)| (*x, *p)).collect();
-    let act_theirs: Vec<(Isometry2F64, na33::Vector2<f64>)> = theirs
-        .iter()
-        .zip(&s_pts)
-        .map(|((x, _), p)| (*x, *p))
-        .collect();
-    let act_na: Vec<(Isometry2<f64>, Point2<f64>)> = na
-        .iter()
-        .zip(&pts)
-        .map(|((x, _), p)| (*x, Point2::from(*p)))
-        .collect();
-    let mut g = group(c, "se2.act");
-    unary(&mut g, "posecov", &act_ours, |(x, p)| x.act(p));
-    unary(&mut g, "sophus_lie", &act_theirs, |(x, p)| x.transform(*p));
-    unary(&mut g, "nalgebra_Isometry2", &act_na, |(x, p)| {
-        x.transform_point(p)
-    });
-    g.finish();
-
-    let mut g = group(c, "se2.adj");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.adj());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.adj());
-    g.finish();
-
-    let mut g = group(c, "se2.jr");
-    unary(&mut g, "posecov", &tau, Se2::jr);
-    unary(&mut g, "sophus_lie", &s_neg, |t| {
-        Isometry2F64::left_jacobian(*t)
-    });
-    g.finish();
-
-    let mut g = group(c, "se2.jr_inv");
-    unary(&mut g, "posecov", &tau, Se2::jr_inv);
-    unary(&mut g, "sophus_lie", &s_neg, |t| {
-        Isometry2F64::inv_left_jacobian(*t)
-    });
-    g.finish();
+    Log { "nalgebra_UnitComplex" on &uc, "nalgebra_Rotation2" on &rot => |(x, _)| x.angle() }
+    Compose { "nalgebra_UnitComplex" on &uc, "nalgebra_Rotation2" on &rot => |(x, y)| x * y }
+    Inverse { "nalgebra_UnitComplex" on &uc, "nalgebra_Rotation2" on &rot => |(x, _)| x.inverse() }
+    Act { "nalgebra_UnitComplex" on &act_uc, "nalgebra_Rotation2" on &act_rot => |(x, p)| x * p }
 }
 
-// ---------------------------------------------------------------------------------------------
-// SE(3).
-
-fn se3_perm(i: usize) -> usize {
-    // posecov [ρ; θ] index → sophus [θ; ρ] index.
-    (i + 3) % 6
-}
-
-fn se3(c: &mut Criterion) {
-    let mut rng = ChaCha8Rng::seed_from_u64(SEED + 3);
-    let tangent = |rng: &mut ChaCha8Rng| {
-        let (rho, theta) = (random_translation3(rng), random_rotation_vector(rng));
-        Vector6::new(rho.x, rho.y, rho.z, theta.x, theta.y, theta.z)
-    };
-    let tau: Vec<Vector6<f64>> = (0..BATCH).map(|_| tangent(&mut rng)).collect();
-    let tau_b: Vec<Vector6<f64>> = (0..BATCH).map(|_| tangent(&mut rng)).collect();
-    let pts: Vec<Vector3<f64>> = (0..BATCH).map(|_| random_translation3(&mut rng)).collect();
-
-    let ours: Vec<(Se3, Se3)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| (Se3::exp(a), Se3::exp(b)))
-        .collect();
-    let s_tau: Vec<na33::Vector6<f64>> = tau.iter().map(se3_tangent_33).collect();
-    let s_neg: Vec<na33::Vector6<f64>> = tau.iter().map(|t| se3_tangent_33(&-t)).collect();
-    let s_pts: Vec<na33::Vector3<f64>> = pts.iter().map(v3_33).collect();
-    let theirs: Vec<(Isometry3F64, Isometry3F64)> = tau
-        .iter()
-        .zip(&tau_b)
-        .map(|(a, b)| {
-            (
-                Isometry3F64::exp(se3_tangent_33(a)),
-                Isometry3F64::exp(se3_tangent_33(b)),
-            )
-        })
-        .collect();
-    let iso = |x: &Se3| {
-        Isometry3::from_parts(
-            Translation3::from(*x.translation()),
-            *x.rotation().quaternion(),
-        )
-    };
-    let na: Vec<(Isometry3<f64>, Isometry3<f64>)> =
-        ours.iter().map(|(x, y)| (iso(x), iso(y))).collect();
-
-    for k in 0..16 {
-        let (x, y) = (&ours[k].0, &ours[k].1);
-        let (sx, sy) = (&theirs[k].0, &theirs[k].1);
-        let m = x.to_matrix();
-        assert_agree(
-            "SE(3) exp",
-            4,
-            4,
-            |i, j| m[(i, j)],
-            |i, j| sx.matrix()[(i, j)],
-            same,
-            same,
-        );
-        let (l, sl) = (x.log(), sx.log());
-        assert_agree("SE(3) log", 6, 1, |i, _| l[i], |i, _| sl[i], se3_perm, same);
-        let cm = x.compose(y).to_matrix();
-        let sc = sx.group_mul(*sy).matrix();
-        assert_agree(
-            "SE(3) compose",
-            4,
-            4,
-            |i, j| cm[(i, j)],
-            |i, j| sc[(i, j)],
-            same,
-            same,
-        );
-        let inv = x.inverse().to_matrix();
-        let sinv = sx.inverse().matrix();
-        assert_agree(
-            "SE(3) inverse",
-            4,
-            4,
-            |i, j| inv[(i, j)],
-            |i, j| sinv[(i, j)],
-            same,
-            same,
-        );
-        let a = x.act(&pts[k]);
-        let sa = sx.transform(s_pts[k]);
-        assert_agree("SE(3) act", 3, 1, |i, _| a[i], |i, _| sa[i], same, same);
-        assert!((na[k].0.transform_point(&Point3::from(pts[k])).coords - a).norm() < AGREE);
-        let ad = x.adj();
-        let sad = sx.adj();
-        assert_agree(
-            "SE(3) adj",
-            6,
-            6,
-            |i, j| ad[(i, j)],
-            |i, j| sad[(i, j)],
-            se3_perm,
-            se3_perm,
-        );
-        let jr = Se3::jr(&tau[k]);
-        let sjr = Isometry3F64::left_jacobian(s_neg[k]);
-        assert_agree(
-            "SE(3) jr",
-            6,
-            6,
-            |i, j| jr[(i, j)],
-            |i, j| sjr[(i, j)],
-            se3_perm,
-            se3_perm,
-        );
-        let ji = Se3::jr_inv(&tau[k]);
-        let sji = Isometry3F64::inv_left_jacobian(s_neg[k]);
-        assert_agree(
-            "SE(3) jr_inv",
-            6,
-            6,
-            |i, j| ji[(i, j)],
-            |i, j| sji[(i, j)],
-            se3_perm,
-            se3_perm,
-        );
+lie_group_bench! {
+    so3: So3 vs Rotation3F64, seed SEED + 1, perm same;
+    tangent random_rotation_vector => v3_33, point random_translation3 => v3_33;
+    nalgebra |tau, tau_b, ours, pts| {
+        let uq = pairs(tau, tau_b, |t| UnitQuaternion::from_scaled_axis(*t));
+        let act_uq = with_points(&uq, pts.iter().copied());
     }
+    check |k| (uq[k].0.scaled_axis() - ours[k].0.log()).norm() < AGREE;
+    Exp { "nalgebra_from_scaled_axis" on tau => |t| UnitQuaternion::from_scaled_axis(*t) }
+    Log {
+        "nalgebra_scaled_axis" on &uq => |(x, _)| x.scaled_axis();
+        "nalgebra_ln" on &uq => |(x, _)| x.ln();
+    }
+    Compose { "nalgebra_UnitQuaternion" on &uq => |(x, y)| x * y }
+    Inverse { "nalgebra_UnitQuaternion" on &uq => |(x, _)| x.inverse() }
+    Act { "nalgebra_UnitQuaternion" on &act_uq => |(x, p)| x * p }
+    Adj { "nalgebra_to_rotation_matrix" on &uq => |(x, _)| x.to_rotation_matrix() }
+}
 
-    let mut g = group(c, "se3.exp");
-    unary(&mut g, "posecov", &tau, Se3::exp);
-    unary(&mut g, "sophus_lie", &s_tau, |t| Isometry3F64::exp(*t));
-    g.finish();
+lie_group_bench! {
+    se2: Se2 vs Isometry2F64, seed SEED + 2, perm se2_perm;
+    tangent se2_tangent => se2_tangent_33, point random_translation2 => v2_33;
+    nalgebra isometry "nalgebra_Isometry2" Isometry2(Translation2, complex), Point2;
+}
 
-    let mut g = group(c, "se3.log");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.log());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.log());
-    g.finish();
-
-    let mut g = group(c, "se3.compose");
-    unary(&mut g, "posecov", &ours, |(x, y)| x.compose(y));
-    unary(&mut g, "sophus_lie", &theirs, |(x, y)| x.group_mul(*y));
-    unary(&mut g, "nalgebra_Isometry3", &na, |(x, y)| x * y);
-    g.finish();
-
-    let mut g = group(c, "se3.inverse");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.inverse());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.inverse());
-    unary(&mut g, "nalgebra_Isometry3", &na, |(x, _)| x.inverse());
-    g.finish();
-
-    let act_ours: Vec<(Se3, Vector3<f64>)> =
-        ours.iter().zip(&pts).map(|((x, _), p)| (*x, *p)).collect();
-    let act_theirs: Vec<(Isometry3F64, na33::Vector3<f64>)> = theirs
-        .iter()
-        .zip(&s_pts)
-        .map(|((x, _), p)| (*x, *p))
-        .collect();
-    let act_na: Vec<(Isometry3<f64>, Point3<f64>)> = na
-        .iter()
-        .zip(&pts)
-        .map(|((x, _), p)| (*x, Point3::from(*p)))
-        .collect();
-    let mut g = group(c, "se3.act");
-    unary(&mut g, "posecov", &act_ours, |(x, p)| x.act(p));
-    unary(&mut g, "sophus_lie", &act_theirs, |(x, p)| x.transform(*p));
-    unary(&mut g, "nalgebra_Isometry3", &act_na, |(x, p)| {
-        x.transform_point(p)
-    });
-    g.finish();
-
-    let mut g = group(c, "se3.adj");
-    unary(&mut g, "posecov", &ours, |(x, _)| x.adj());
-    unary(&mut g, "sophus_lie", &theirs, |(x, _)| x.adj());
-    g.finish();
-
-    let mut g = group(c, "se3.jr");
-    unary(&mut g, "posecov", &tau, Se3::jr);
-    unary(&mut g, "sophus_lie", &s_neg, |t| {
-        Isometry3F64::left_jacobian(*t)
-    });
-    g.finish();
-
-    let mut g = group(c, "se3.jr_inv");
-    unary(&mut g, "posecov", &tau, Se3::jr_inv);
-    unary(&mut g, "sophus_lie", &s_neg, |t| {
-        Isometry3F64::inv_left_jacobian(*t)
-    });
-    g.finish();
+lie_group_bench! {
+    se3: Se3 vs Isometry3F64, seed SEED + 3, perm se3_perm;
+    tangent se3_tangent => se3_tangent_33, point random_translation3 => v3_33;
+    nalgebra isometry "nalgebra_Isometry3" Isometry3(Translation3, quaternion), Point3;
 }
 
 criterion_group!(benches, so2, so3, se2, se3);

@@ -32,7 +32,7 @@ use crate::lie::{LieGroup, Se2, Se3, So3, TangentMatrix};
 use crate::uncertain::{Side, UncertainPose, validate_covariance};
 
 // --------------------------------------------------------------------------------------------
-// ROS PoseWithCovariance (CONVENTIONS §6).
+// ROS PoseWithCovariance (docs/CONVENTIONS.md §6).
 
 /// Number of entries of a ROS `PoseWithCovariance.covariance` (6 × 6, row-major).
 pub const ROS_COVARIANCE_LEN: usize = 36;
@@ -41,8 +41,10 @@ pub const ROS_COVARIANCE_LEN: usize = 36;
 /// position, orientation as a quaternion in ROS order (x, y, z, w), and 36 row-major covariance
 /// entries in the order (x, y, z, rotX, rotY, rotZ).
 ///
-/// Meaning (CONVENTIONS §6): the position error is additive in the **parent** frame's axes,
+/// Meaning ([CONVENTIONS §6]): the position error is additive in the **parent** frame's axes,
 /// the rotation error is local: p̃ = p + δp, R̃ = R · Exp(δθ).
+///
+/// [CONVENTIONS §6]: crate::conventions#6-ros-posewithcovariance
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RosPoseWithCovariance {
     /// `pose.position` (x, y, z) in the parent frame.
@@ -67,6 +69,26 @@ pub fn ros_error_jacobian(rotation: &So3) -> Matrix6<f64> {
     b.fixed_view_mut::<3, 3>(0, 0)
         .copy_from(&rotation.to_matrix());
     b
+}
+
+/// A ROS covariance (position error in the parent's axes, rotation error local) in posecov's
+/// right form at a pose with rotation R: Σ_right = B⁻¹ Σ_ros B⁻ᵀ, B = [`ros_error_jacobian`]
+/// (first order; [CONVENTIONS §6]). The one conversion every ROS input
+/// uses.
+///
+/// ```
+/// use posecov::{interop::ros_cov_to_right, lie::So3};
+/// use nalgebra::Matrix6;
+/// let yaw90 = So3::from_rpy(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+/// let mut ros = Matrix6::zeros();
+/// ros[(1, 1)] = 0.01; // parent y
+/// assert!((ros_cov_to_right(&ros, &yaw90)[(0, 0)] - 0.01).abs() < 1e-15); // body x
+/// ```
+///
+/// [CONVENTIONS §6]: crate::conventions#6-ros-posewithcovariance
+pub fn ros_cov_to_right(cov_ros: &Matrix6<f64>, rotation: &So3) -> Matrix6<f64> {
+    let b_inv = ros_error_jacobian(&rotation.inverse());
+    b_inv * cov_ros * b_inv.transpose()
 }
 
 impl RosPoseWithCovariance {
@@ -95,11 +117,10 @@ impl RosPoseWithCovariance {
         }
         let cov_ros = Matrix6::from_row_slice(&self.covariance);
         let cov_ros = validate_covariance("PoseWithCovariance.covariance", &cov_ros)?;
-        let b_inv = ros_error_jacobian(&rotation.inverse());
         let mean = Se3::from_parts(Vector3::from(self.position), rotation);
         Ok(UncertainPose::new_unchecked(
             mean,
-            b_inv * cov_ros * b_inv.transpose(),
+            ros_cov_to_right(&cov_ros, &rotation),
             Side::Right,
         ))
     }
@@ -130,7 +151,7 @@ impl RosPoseWithCovariance {
 }
 
 // --------------------------------------------------------------------------------------------
-// Rotation-first tangent orders (CONVENTIONS §2).
+// Rotation-first tangent orders (docs/CONVENTIONS.md §2).
 
 /// A library or text whose SE(3) tangent puts the rotation first, [θ; ρ].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -162,22 +183,26 @@ impl RotationFirstSource {
     }
 }
 
-/// The permutation P with [θ; ρ] = P [ρ; θ] (a swap of the two 3-blocks; P = Pᵀ = P⁻¹).
+/// The permutation P with v_rotation_first = P v_translation_first for any group: the
+/// rotation coordinates first, then the translation ([θ; ρ] = P [ρ; θ]). For SE(3) a swap of
+/// the two 3-blocks (P = Pᵀ = P⁻¹); for rotation groups the identity.
 ///
 /// ```
 /// use posecov::interop::rotation_first_permutation;
-/// use nalgebra::{Matrix6, Vector6};
-/// let p = rotation_first_permutation();
+/// use posecov::lie::{Se2, Se3};
+/// use nalgebra::{Matrix6, Vector3, Vector6};
+/// let p = rotation_first_permutation::<Se3, 6>();
 /// assert_eq!(p * Vector6::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0), Vector6::new(4.0, 5.0, 6.0, 1.0, 2.0, 3.0));
 /// assert_eq!(p * p, Matrix6::identity());
+/// assert_eq!(rotation_first_permutation::<Se2, 3>() * Vector3::new(1.0, 2.0, 3.0), Vector3::new(3.0, 1.0, 2.0));
 /// ```
-pub fn rotation_first_permutation() -> Matrix6<f64> {
-    let mut p = Matrix6::zeros();
-    p.fixed_view_mut::<3, 3>(0, 3)
-        .copy_from(&Matrix3::identity());
-    p.fixed_view_mut::<3, 3>(3, 0)
-        .copy_from(&Matrix3::identity());
-    p
+pub fn rotation_first_permutation<G: LieGroup<N>, const N: usize>() -> TangentMatrix<N> {
+    let rot = G::rotation_range();
+    let order: Vec<usize> = rot
+        .clone()
+        .chain((0..N).filter(|i| !rot.contains(i)))
+        .collect();
+    TangentMatrix::<N>::from_fn(|r, c| if order[r] == c { 1.0 } else { 0.0 })
 }
 
 /// A translation-first covariance in rotation-first order: Σ' = P Σ Pᵀ (exact).
@@ -189,7 +214,7 @@ pub fn rotation_first_permutation() -> Matrix6<f64> {
 /// assert_eq!(cov_to_rotation_first(&s)[(0, 0)], 4.0);
 /// ```
 pub fn cov_to_rotation_first(cov: &Matrix6<f64>) -> Matrix6<f64> {
-    let p = rotation_first_permutation();
+    let p = rotation_first_permutation::<Se3, 6>();
     p * cov * p.transpose()
 }
 
@@ -202,7 +227,7 @@ pub fn cov_to_rotation_first(cov: &Matrix6<f64>) -> Matrix6<f64> {
 /// assert_eq!(cov_from_rotation_first(&cov_to_rotation_first(&s)), s);
 /// ```
 pub fn cov_from_rotation_first(cov: &Matrix6<f64>) -> Matrix6<f64> {
-    let p = rotation_first_permutation();
+    let p = rotation_first_permutation::<Se3, 6>();
     p.transpose() * cov * p
 }
 

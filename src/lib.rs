@@ -58,17 +58,26 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod app;
 pub mod convert;
 pub mod draw;
 pub mod error;
+pub mod eval;
+pub mod input;
 pub mod interop;
 pub mod lie;
+pub mod plan;
 pub mod propagate;
 pub mod sample;
-pub mod scenario;
 pub mod scene;
 #[cfg(feature = "viewer")]
 pub mod sink;
 pub mod uncertain;
+
+#[doc = include_str!("../docs/CONVENTIONS.md")]
+pub mod conventions {}
+
+#[doc = include_str!("../docs/REFERENCE_CASES.md")]
+pub mod reference_cases {}
 
 pub use error::{Error, Result};

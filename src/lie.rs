@@ -26,8 +26,10 @@
 //! ```
 
 use std::fmt::{Debug, Display};
+use std::ops::Range;
 
 use nalgebra::{SMatrix, SVector};
+use serde::{Deserialize, Serialize};
 
 pub mod se2;
 pub mod se3;
@@ -78,6 +80,109 @@ pub struct ActJacobians<G, P> {
     pub wrt_point: P,
 }
 
+/// Which of the four groups an element belongs to: the facts code outside the group files may
+/// need (degrees of freedom, where the rotation sits in the tangent, whether it is planar),
+/// in one place instead of guessed from `N`.
+///
+/// ```
+/// use posecov::lie::{GroupKind, LieGroup, Se2, Se3};
+/// assert_eq!(Se3::KIND, GroupKind::Se3);
+/// assert_eq!(GroupKind::Se3.rotation_range(), 3..6);
+/// assert!(Se2::KIND.is_planar() && !Se2::KIND.is_rotation_only());
+/// assert_eq!(GroupKind::Se2.position_dims(), 2);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GroupKind {
+    /// Planar rotations, tangent \[θ\].
+    So2,
+    /// Planar poses, tangent [ρx, ρy, θ].
+    Se2,
+    /// 3D rotations, tangent θ ∈ ℝ³.
+    So3,
+    /// 3D poses, tangent [ρ; θ].
+    Se3,
+}
+
+impl GroupKind {
+    /// Degrees of freedom N: 1, 3, 3, 6.
+    ///
+    /// ```
+    /// assert_eq!(posecov::lie::GroupKind::So2.dof(), 1);
+    /// ```
+    pub fn dof(self) -> usize {
+        match self {
+            GroupKind::So2 => 1,
+            GroupKind::Se2 | GroupKind::So3 => 3,
+            GroupKind::Se3 => 6,
+        }
+    }
+
+    /// The index range of the rotation part of the tangent (translation first, [ρ; θ]).
+    ///
+    /// ```
+    /// assert_eq!(posecov::lie::GroupKind::Se2.rotation_range(), 2..3);
+    /// ```
+    pub fn rotation_range(self) -> Range<usize> {
+        match self {
+            GroupKind::So2 => 0..1,
+            GroupKind::Se2 => 2..3,
+            GroupKind::So3 => 0..3,
+            GroupKind::Se3 => 3..6,
+        }
+    }
+
+    /// Dimensions of the position part of the tangent (0 for rotation groups).
+    ///
+    /// ```
+    /// assert_eq!(posecov::lie::GroupKind::So3.position_dims(), 0);
+    /// ```
+    pub fn position_dims(self) -> usize {
+        self.rotation_range().start
+    }
+
+    /// Dimension of the space the group acts on (2 or 3).
+    ///
+    /// ```
+    /// assert_eq!(posecov::lie::GroupKind::So2.space_dims(), 2);
+    /// ```
+    pub fn space_dims(self) -> usize {
+        if self.is_planar() { 2 } else { 3 }
+    }
+
+    /// A rotation group (no translation): SO(2), SO(3).
+    ///
+    /// ```
+    /// assert!(posecov::lie::GroupKind::So2.is_rotation_only());
+    /// ```
+    pub fn is_rotation_only(self) -> bool {
+        matches!(self, GroupKind::So2 | GroupKind::So3)
+    }
+
+    /// A planar group: SO(2), SE(2).
+    ///
+    /// ```
+    /// assert!(posecov::lie::GroupKind::Se2.is_planar());
+    /// ```
+    pub fn is_planar(self) -> bool {
+        matches!(self, GroupKind::So2 | GroupKind::Se2)
+    }
+
+    /// Display name, "SE(3)" etc.
+    ///
+    /// ```
+    /// assert_eq!(posecov::lie::GroupKind::Se3.name(), "SE(3)");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            GroupKind::So2 => "SO(2)",
+            GroupKind::Se2 => "SE(2)",
+            GroupKind::So3 => "SO(3)",
+            GroupKind::Se3 => "SE(3)",
+        }
+    }
+}
+
 /// A matrix Lie group of rigid motion with N degrees of freedom.
 ///
 /// Implementors supply the closed forms; the trait supplies every operation that is the same
@@ -99,6 +204,8 @@ pub trait LieGroup<const N: usize>:
 
     /// Short name used in messages and reports ("SO(3)", …).
     const NAME: &'static str;
+    /// Which group this is ([`GroupKind`]: DOF, rotation range, planar or not).
+    const KIND: GroupKind;
 
     // ----------------------------------------------------------------------------------------
     // Closed forms each group provides.
@@ -136,6 +243,19 @@ pub trait LieGroup<const N: usize>:
     fn rotate(&self, direction: &Self::Point) -> Self::Point;
     /// The group element as a matrix (rotation matrix, or homogeneous transform).
     fn to_matrix(&self) -> Self::Matrix;
+    /// The element as a 3D pose, for drawing: planar groups at z = 0 rotating about z,
+    /// rotation groups at the origin.
+    fn to_se3(&self) -> Se3;
+
+    /// The index range of the rotation part of the tangent, `Self::KIND.rotation_range()`.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se3};
+    /// assert_eq!(Se3::rotation_range(), 3..6);
+    /// ```
+    fn rotation_range() -> Range<usize> {
+        Self::KIND.rotation_range()
+    }
 
     // ----------------------------------------------------------------------------------------
     // Operations written once for every group.

@@ -1,4 +1,4 @@
-//! Sampling uncertain poses and the statistics of sample sets (CONVENTIONS §8).
+//! Sampling uncertain poses and the statistics of sample sets ([CONVENTIONS §8]).
 //!
 //! # Drawing
 //! A [`Sampler`] holds μ, a square root L of Σ (L Lᵀ = Σ) and the side; a draw is
@@ -34,6 +34,8 @@
 //! assert!(stats.mean.is_approx(pose.mean(), 0.01));
 //! assert!((stats.cov[(0, 0)] / 0.01 - 1.0).abs() < 0.05);
 //! ```
+//!
+//! [CONVENTIONS §8]: crate::conventions#8-sample-statistics
 
 use std::fmt::{Debug, Display};
 
@@ -51,10 +53,14 @@ use crate::uncertain::{Side, UncertainPose, try_inverse_covariance};
 /// [seeding scheme](self#seeding-scheme-identical-results-whatever-the-thread-count)).
 pub const CHUNK_SIZE: usize = 1024;
 
-/// The Lie mean stops when the norm of its last tangent update is below this (CONVENTIONS §8).
+/// The Lie mean stops when the norm of its last tangent update is below this ([CONVENTIONS §8]).
+///
+/// [CONVENTIONS §8]: crate::conventions#8-sample-statistics
 pub const LIE_MEAN_TOLERANCE: f64 = 1e-10;
 
-/// The Lie mean gives up after this many iterations (CONVENTIONS §8).
+/// The Lie mean gives up after this many iterations ([CONVENTIONS §8]).
+///
+/// [CONVENTIONS §8]: crate::conventions#8-sample-statistics
 pub const LIE_MEAN_MAX_ITERATIONS: usize = 100;
 
 /// Golden-ratio increment that separates the seeds of random families.
@@ -427,55 +433,243 @@ fn check_count(what: &'static str, got: usize, needed: usize) -> Result<()> {
     Ok(())
 }
 
-/// Σᵢ wᵢ ξᵢ of the tangents about `mean`, in chunks added in chunk order (deterministic).
-fn weighted_tangent_sum<G: LieGroup<N>, const N: usize>(
-    points: &[G],
-    weights: Option<&[f64]>,
-    mean: &G,
-    side: Side,
-) -> Tangent<N> {
-    let chunk_sums: Vec<Tangent<N>> = points
-        .par_chunks(CHUNK_SIZE)
-        .enumerate()
-        .map(|(c, chunk)| {
-            chunk
-                .iter()
-                .enumerate()
-                .fold(Tangent::<N>::zeros(), |acc, (i, x)| {
-                    let w = weights.map_or(1.0, |w| w[c * CHUNK_SIZE + i]);
-                    acc + tangent_about(x, mean, side) * w
-                })
-        })
-        .collect();
-    chunk_sums.iter().sum()
-}
-
-/// The first two tangent moments of `samples` about `about`: (Σᵢ ξᵢ, Σᵢ ξᵢ ξᵢᵀ) with
-/// ξᵢ = Log(about⁻¹ Xᵢ) (right) or Log(Xᵢ about⁻¹) (left), summed in chunk order
-/// (deterministic). Summed over the blocks of a sample too large to hold, they give one
-/// iteration of the Lie mean and the covariance about `about` (see `scenario::eval`).
+/// The first two tangent moments of `samples` about `about`, weighted:
+/// (Σᵢ wᵢ ξᵢ, Σᵢ wᵢ ξᵢ ξᵢᵀ) with ξᵢ = Log(about⁻¹ Xᵢ) (right) or Log(Xᵢ about⁻¹) (left), one
+/// Log per sample, summed in chunk order (deterministic whatever the thread count).
+/// `weights = None` means wᵢ = 1. Summed over the blocks of a sample too large to hold, they
+/// give one iteration of the Lie mean and the covariance about `about`
+/// ([`LieMeanAccumulator`]).
 ///
 /// ```
 /// use posecov::lie::{LieGroup, So2};
 /// use posecov::sample::tangent_moments;
 /// use posecov::uncertain::Side;
-/// let (sum, outer) = tangent_moments(&[So2::from_angle(0.1), So2::from_angle(0.3)], &So2::identity(), Side::Right);
+/// let (sum, outer) = tangent_moments(&[So2::from_angle(0.1), So2::from_angle(0.3)], None, &So2::identity(), Side::Right);
 /// assert!((sum[0] - 0.4).abs() < 1e-15 && (outer[(0, 0)] - 0.1).abs() < 1e-15);
 /// ```
 pub fn tangent_moments<G: LieGroup<N>, const N: usize>(
     samples: &[G],
+    weights: Option<&[f64]>,
     about: &G,
     side: Side,
 ) -> (Tangent<N>, TangentMatrix<N>) {
-    (
-        weighted_tangent_sum(samples, None, about, side),
-        weighted_outer_sum(samples, None, about, side),
-    )
+    let chunk_sums: Vec<(Tangent<N>, TangentMatrix<N>)> = samples
+        .par_chunks(CHUNK_SIZE)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut sum = Tangent::<N>::zeros();
+            let mut outer = TangentMatrix::<N>::zeros();
+            for (i, x) in chunk.iter().enumerate() {
+                let w = weights.map_or(1.0, |w| w[c * CHUNK_SIZE + i]);
+                let xi = tangent_about(x, about, side);
+                sum += xi * w;
+                outer.ger(w, &xi, &xi, 1.0);
+            }
+            (sum, outer)
+        })
+        .collect();
+    let (sum, outer) = chunk_sums.iter().fold(
+        (Tangent::<N>::zeros(), TangentMatrix::<N>::zeros()),
+        |(s, o), (cs, co)| (s + cs, o + co),
+    );
+    (sum, (outer + outer.transpose()) * 0.5)
+}
+
+/// Where a [`LieMeanAccumulator`] stands after a pass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MeanPass {
+    /// Another pass over the data is needed.
+    Continue,
+    /// Converged: [`LieMeanAccumulator::statistics`] has the result.
+    Converged,
+    /// Failed (non-finite step, or no convergence within [`LIE_MEAN_MAX_ITERATIONS`]).
+    Failed,
+}
+
+/// The iterative Lie mean and the covariance about it, over data seen in passes: the one Lie
+/// mean of the crate. Each pass [`add`](Self::add)s every sample (in one call, or block by
+/// block for a sample too large to hold), then [`finish_pass`](Self::finish_pass) takes one
+/// step μ ← μ ⊕ s, s = Σ wᵢ ξᵢ / Σ wᵢ (right: μ Exp(s); left: Exp(s) μ), until
+/// ‖s‖ < [`LIE_MEAN_TOLERANCE`] ([CONVENTIONS §8]). On convergence the
+/// covariance is the converged pass's Σ wᵢ ξᵢξᵢᵀ − W s sᵀ, divided by W − 1 for equal weights
+/// (the unbiased sample covariance) — the ξᵢ are about the last μ, within 1e-10 of the final
+/// one.
+///
+/// ```
+/// use posecov::lie::{LieGroup, So2};
+/// use posecov::sample::{LieMeanAccumulator, MeanPass};
+/// use posecov::uncertain::Side;
+/// let pts = [So2::from_angle(0.1), So2::from_angle(0.3)];
+/// let mut acc = LieMeanAccumulator::new(pts[0], Side::Right);
+/// let mut pass = MeanPass::Continue;
+/// while pass == MeanPass::Continue {
+///     acc.add(&pts[..1], None); // block by block
+///     acc.add(&pts[1..], None);
+///     pass = acc.finish_pass();
+/// }
+/// let stats = acc.statistics().unwrap();
+/// assert!((stats.mean.angle() - 0.2).abs() < 1e-12 && (stats.cov[(0, 0)] - 0.02).abs() < 1e-12);
+/// ```
+///
+/// [CONVENTIONS §8]: crate::conventions#8-sample-statistics
+#[derive(Clone, Debug)]
+pub struct LieMeanAccumulator<G: LieGroup<N>, const N: usize> {
+    mean: G,
+    side: Side,
+    sum: Tangent<N>,
+    outer: TangentMatrix<N>,
+    weight: f64,
+    count: usize,
+    weighted: bool,
+    iterations: usize,
+    last_step: f64,
+    state: MeanPass,
+    cov: Option<TangentMatrix<N>>,
+}
+
+impl<G: LieGroup<N>, const N: usize> LieMeanAccumulator<G, N> {
+    /// Starts the iteration at `initial`, tangents on `side`.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// let acc = posecov::sample::LieMeanAccumulator::new(So2::identity(), posecov::uncertain::Side::Left);
+    /// assert!(acc.is_iterating());
+    /// ```
+    pub fn new(initial: G, side: Side) -> Self {
+        Self {
+            mean: initial,
+            side,
+            sum: Tangent::<N>::zeros(),
+            outer: TangentMatrix::<N>::zeros(),
+            weight: 0.0,
+            count: 0,
+            weighted: false,
+            iterations: 0,
+            last_step: f64::INFINITY,
+            state: MeanPass::Continue,
+            cov: None,
+        }
+    }
+
+    /// Whether more passes are needed.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// let acc = posecov::sample::LieMeanAccumulator::new(So2::identity(), posecov::uncertain::Side::Right);
+    /// assert!(acc.is_iterating());
+    /// ```
+    pub fn is_iterating(&self) -> bool {
+        self.state == MeanPass::Continue
+    }
+
+    /// Adds samples (with weights, or 1 each) to the current pass; nothing once finished.
+    /// Weights must have the samples' length (checked by the callers that take them).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// let mut acc = posecov::sample::LieMeanAccumulator::new(So2::identity(), posecov::uncertain::Side::Right);
+    /// acc.add(&[So2::from_angle(0.5)], Some(&[2.0]));
+    /// ```
+    pub fn add(&mut self, samples: &[G], weights: Option<&[f64]>) {
+        if !self.is_iterating() {
+            return;
+        }
+        let (sum, outer) = tangent_moments(samples, weights, &self.mean, self.side);
+        self.sum += sum;
+        self.outer += outer;
+        self.weight += weights.map_or(samples.len() as f64, |w| w.iter().sum());
+        self.count += samples.len();
+        self.weighted |= weights.is_some();
+    }
+
+    /// Ends a pass: one step of the mean, or convergence, or failure.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::sample::{LieMeanAccumulator, MeanPass};
+    /// let mut acc = LieMeanAccumulator::new(So2::identity(), posecov::uncertain::Side::Right);
+    /// assert_eq!(acc.finish_pass(), MeanPass::Failed); // no samples
+    /// ```
+    pub fn finish_pass(&mut self) -> MeanPass {
+        if !self.is_iterating() {
+            return self.state;
+        }
+        self.iterations += 1;
+        let step = self.sum / self.weight;
+        self.last_step = step.norm();
+        if !(self.last_step.is_finite() && self.weight.is_finite() && self.weight != 0.0) {
+            self.state = MeanPass::Failed;
+        } else if self.last_step < LIE_MEAN_TOLERANCE {
+            let centred = self.outer - step * step.transpose() * self.weight;
+            let divisor = if self.weighted {
+                1.0
+            } else {
+                self.weight - 1.0
+            };
+            self.cov = Some((centred + centred.transpose()) * (0.5 / divisor));
+            self.state = MeanPass::Converged;
+        } else if self.iterations >= LIE_MEAN_MAX_ITERATIONS {
+            self.state = MeanPass::Failed;
+        }
+        if self.last_step.is_finite() {
+            self.mean = retract(&self.mean, &step, self.side);
+        }
+        if self.is_iterating() {
+            self.sum = Tangent::<N>::zeros();
+            self.outer = TangentMatrix::<N>::zeros();
+            self.weight = 0.0;
+            self.count = 0;
+        }
+        self.state
+    }
+
+    /// The converged mean, or why there is none ([`MeanError::NotConverged`] with the last
+    /// estimate).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// let acc = posecov::sample::LieMeanAccumulator::new(So2::identity(), posecov::uncertain::Side::Right);
+    /// assert!(acc.mean().is_err()); // no pass finished
+    /// ```
+    pub fn mean(&self) -> Result<LieMean<G>, MeanError<G>> {
+        match self.state {
+            MeanPass::Converged => Ok(LieMean {
+                mean: self.mean,
+                iterations: self.iterations,
+                last_step: self.last_step,
+            }),
+            _ => Err(MeanError::NotConverged {
+                last_estimate: self.mean,
+                iterations: self.iterations,
+                last_step: self.last_step,
+                tolerance: LIE_MEAN_TOLERANCE,
+            }),
+        }
+    }
+
+    /// The Lie mean and the covariance about it (1/(N−1) for equal weights, Σ wᵢ ξᵢξᵢᵀ for
+    /// weights), once converged.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// let acc = posecov::sample::LieMeanAccumulator::new(So2::identity(), posecov::uncertain::Side::Right);
+    /// assert!(acc.statistics().is_err());
+    /// ```
+    pub fn statistics(&self) -> Result<SampleStatistics<G, N>, MeanError<G>> {
+        let mean = self.mean()?;
+        Ok(SampleStatistics {
+            mean: mean.mean,
+            cov: self.cov.unwrap_or_else(TangentMatrix::<N>::zeros),
+            side: self.side,
+            count: self.count,
+            iterations: mean.iterations,
+        })
+    }
 }
 
 /// The Lie (Fréchet / Karcher) mean of weighted points from the initial guess `initial`:
 /// μ ← μ · Exp(Σ wᵢ Log(μ⁻¹ Xᵢ) / Σ wᵢ) (right), μ ← Exp(Σ wᵢ Log(Xᵢ μ⁻¹) / Σ wᵢ) · μ (left),
-/// until ‖step‖ < [`LIE_MEAN_TOLERANCE`] (CONVENTIONS §8; unscented weights may be negative
+/// until ‖step‖ < [`LIE_MEAN_TOLERANCE`] ([CONVENTIONS §8]; unscented weights may be negative
 /// as long as their sum is not 0). `weights = None` means equal weights.
 ///
 /// Errors: [`Error::TooFewSamples`] for no points, [`Error::WrongLength`] for a weight vector
@@ -490,6 +684,8 @@ pub fn tangent_moments<G: LieGroup<N>, const N: usize>(
 /// let m = weighted_lie_mean(&pts, Some(&[2.0, 1.0]), &pts[0], Side::Right).unwrap();
 /// assert!((m.mean.angle() - 0.2).abs() < 1e-12);
 /// ```
+///
+/// [CONVENTIONS §8]: crate::conventions#8-sample-statistics
 pub fn weighted_lie_mean<G: LieGroup<N>, const N: usize>(
     points: &[G],
     weights: Option<&[f64]>,
@@ -517,32 +713,15 @@ pub fn weighted_lie_mean<G: LieGroup<N>, const N: usize>(
         }
         .into());
     }
-    let mut mean = *initial;
-    let mut last_step = f64::INFINITY;
-    for iterations in 1..=LIE_MEAN_MAX_ITERATIONS {
-        let step = weighted_tangent_sum(points, weights, &mean, side) / total;
-        last_step = step.norm();
-        if !last_step.is_finite() {
-            break;
-        }
-        mean = retract(&mean, &step, side);
-        if last_step < LIE_MEAN_TOLERANCE {
-            return Ok(LieMean {
-                mean,
-                iterations,
-                last_step,
-            });
-        }
+    let mut acc = LieMeanAccumulator::new(*initial, side);
+    while acc.is_iterating() {
+        acc.add(points, weights);
+        acc.finish_pass();
     }
-    Err(MeanError::NotConverged {
-        last_estimate: mean,
-        iterations: LIE_MEAN_MAX_ITERATIONS,
-        last_step,
-        tolerance: LIE_MEAN_TOLERANCE,
-    })
+    acc.mean()
 }
 
-/// The iterative Lie mean of samples (CONVENTIONS §8), starting from the first sample; see
+/// The iterative Lie mean of samples ([CONVENTIONS §8]), starting from the first sample; see
 /// [`weighted_lie_mean`] for the iteration, the errors and the left-side form.
 ///
 /// ```
@@ -553,6 +732,8 @@ pub fn weighted_lie_mean<G: LieGroup<N>, const N: usize>(
 /// assert!(lie_mean(&pts, Side::Right).unwrap().mean.theta().abs() < 1e-12);
 /// assert!(matches!(lie_mean::<Se2, 3>(&[], Side::Right), Err(MeanError::Invalid(_))));
 /// ```
+///
+/// [CONVENTIONS §8]: crate::conventions#8-sample-statistics
 pub fn lie_mean<G: LieGroup<N>, const N: usize>(
     samples: &[G],
     side: Side,
@@ -563,30 +744,6 @@ pub fn lie_mean<G: LieGroup<N>, const N: usize>(
         got: 0,
     })?;
     weighted_lie_mean(samples, None, first, side)
-}
-
-/// Σᵢ wᵢ ξᵢ ξᵢᵀ of the tangents about `mean`, in chunks added in chunk order (deterministic).
-fn weighted_outer_sum<G: LieGroup<N>, const N: usize>(
-    points: &[G],
-    weights: Option<&[f64]>,
-    mean: &G,
-    side: Side,
-) -> TangentMatrix<N> {
-    let chunk_sums: Vec<TangentMatrix<N>> = points
-        .par_chunks(CHUNK_SIZE)
-        .enumerate()
-        .map(|(c, chunk)| {
-            let mut acc = TangentMatrix::<N>::zeros();
-            for (i, x) in chunk.iter().enumerate() {
-                let w = weights.map_or(1.0, |w| w[c * CHUNK_SIZE + i]);
-                let xi = tangent_about(x, mean, side);
-                acc.ger(w, &xi, &xi, 1.0);
-            }
-            acc
-        })
-        .collect();
-    let sum: TangentMatrix<N> = chunk_sums.iter().sum();
-    (sum + sum.transpose()) * 0.5
 }
 
 /// Weighted second moment Σᵢ wᵢ ξᵢ ξᵢᵀ about `mean` on `side` (ξ from [`tangent_about`]); the
@@ -615,7 +772,7 @@ pub fn weighted_covariance<G: LieGroup<N>, const N: usize>(
             got: weights.len(),
         });
     }
-    Ok(weighted_outer_sum(points, Some(weights), mean, side))
+    Ok(tangent_moments(points, Some(weights), mean, side).1)
 }
 
 /// The uncentred covariance E\[ξξᵀ\] ≈ 1/N Σ ξᵢ ξᵢᵀ of samples about a *given* mean (e.g. the
@@ -637,7 +794,7 @@ pub fn uncentred_covariance<G: LieGroup<N>, const N: usize>(
     side: Side,
 ) -> Result<TangentMatrix<N>> {
     check_count("uncentred covariance", samples.len(), 1)?;
-    Ok(weighted_outer_sum(samples, None, about, side) / samples.len() as f64)
+    Ok(tangent_moments(samples, None, about, side).1 / samples.len() as f64)
 }
 
 /// The centred sample covariance 1/(N−1) Σ ξᵢ ξᵢᵀ about the sample's own Lie mean `mean`
@@ -659,7 +816,7 @@ pub fn centred_covariance<G: LieGroup<N>, const N: usize>(
     side: Side,
 ) -> Result<TangentMatrix<N>> {
     check_count("centred covariance", samples.len(), 2)?;
-    Ok(weighted_outer_sum(samples, None, mean, side) / (samples.len() - 1) as f64)
+    Ok(tangent_moments(samples, None, mean, side).1 / (samples.len() - 1) as f64)
 }
 
 /// Sample statistics: the Lie mean and the centred 1/(N−1) covariance about it.
@@ -693,7 +850,7 @@ impl<G: LieGroup<N>, const N: usize> SampleStatistics<G, N> {
 }
 
 /// The Lie mean ([`lie_mean`]) and centred covariance ([`centred_covariance`]) of samples,
-/// on `side` (CONVENTIONS §8). Errors: [`Error::TooFewSamples`] below 2 samples,
+/// on `side` ([CONVENTIONS §8]). Errors: [`Error::TooFewSamples`] below 2 samples,
 /// [`MeanError::NotConverged`].
 ///
 /// ```
@@ -702,19 +859,19 @@ impl<G: LieGroup<N>, const N: usize> SampleStatistics<G, N> {
 /// use posecov::uncertain::Side;
 /// assert!(sample_statistics(&[So3::identity()], Side::Left).is_err()); // one sample
 /// ```
+///
+/// [CONVENTIONS §8]: crate::conventions#8-sample-statistics
 pub fn sample_statistics<G: LieGroup<N>, const N: usize>(
     samples: &[G],
     side: Side,
 ) -> Result<SampleStatistics<G, N>, MeanError<G>> {
     check_count("sample statistics", samples.len(), 2)?;
-    let mean = lie_mean(samples, side)?;
-    Ok(SampleStatistics {
-        mean: mean.mean,
-        cov: centred_covariance(samples, &mean.mean, side)?,
-        side,
-        count: samples.len(),
-        iterations: mean.iterations,
-    })
+    let mut acc = LieMeanAccumulator::new(samples[0], side);
+    while acc.is_iterating() {
+        acc.add(samples, None);
+        acc.finish_pass();
+    }
+    acc.statistics()
 }
 
 /// Normalised estimation error squared of samples against a claimed distribution.

@@ -425,7 +425,7 @@ pub fn try_inverse_covariance<const N: usize>(
 }
 
 // --------------------------------------------------------------------------------------------
-// Confidence regions (CONVENTIONS §7): χ² with d degrees of freedom.
+// Confidence regions (docs/CONVENTIONS.md §7): χ² with d degrees of freedom.
 
 fn chi_squared(dof: usize) -> Result<ChiSquared> {
     if dof == 0 {
@@ -443,7 +443,7 @@ fn chi_squared(dof: usize) -> Result<ChiSquared> {
 }
 
 /// The Mahalanobis radius r of the p-probability region of a d-dimensional Gaussian:
-/// P(εᵀ Σ⁻¹ ε ≤ r²) = p, i.e. r = √(χ²_d quantile(p)) (CONVENTIONS §7). d = 3 for an SE(3)
+/// P(εᵀ Σ⁻¹ ε ≤ r²) = p, i.e. r = √(χ²_d quantile(p)) ([CONVENTIONS §7]). d = 3 for an SE(3)
 /// position marginal, 2 for SE(2), 6 / 3 for the full pose. Errors: p ∉ (0, 1), d = 0.
 ///
 /// ```
@@ -453,6 +453,8 @@ fn chi_squared(dof: usize) -> Result<ChiSquared> {
 /// assert!((chi2_radius(0.6827, 3).unwrap() - 1.878).abs() < 1e-3);
 /// assert!(chi2_radius(1.0, 3).is_err());
 /// ```
+///
+/// [CONVENTIONS §7]: crate::conventions#7-drawing-uncertainty
 pub fn chi2_radius(probability: f64, dof: usize) -> Result<f64> {
     if !(probability > 0.0 && probability < 1.0) {
         return Err(Error::OutOfRange {
@@ -509,7 +511,7 @@ pub fn sigma_radius(k: f64, dof: usize) -> Result<f64> {
 }
 
 // --------------------------------------------------------------------------------------------
-// Marginals (CONVENTIONS §7), first order in the position, exact in the rotation.
+// Marginals (docs/CONVENTIONS.md §7), first order in the position, exact in the rotation.
 
 /// R Σ Rᵀ.
 fn rotate_cov<const D: usize>(
@@ -518,6 +520,32 @@ fn rotate_cov<const D: usize>(
 ) -> SMatrix<f64, D, D> {
     let out = r * cov * r.transpose();
     (out + out.transpose()) * 0.5
+}
+
+impl<G: LieGroup<N>, const N: usize> UncertainPose<G, N> {
+    /// Position covariance in the **world** axes, first order, lifted into 3D for any group:
+    /// R Σ_ρρ Rᵀ from the right form (planar groups: z row and column zero; rotation groups:
+    /// `None`, they have no position). The one world-position covariance of the crate; the
+    /// per-group [`position_cov_in_world`](UncertainPose::position_cov_in_world) are views of it.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2, So3};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let yaw90 = Se2::from_xy_theta(5.0, 0.0, std::f64::consts::FRAC_PI_2);
+    /// let p = UncertainPose::try_from_std_devs(yaw90, [0.1, 0.0, 0.0], Side::Right).unwrap();
+    /// let c = p.position_cov_in_world_3d().unwrap();
+    /// assert!((c[(1, 1)] - 0.01).abs() < 1e-15 && c[(2, 2)] == 0.0); // body x is world y
+    /// assert!(UncertainPose::certain(So3::identity()).position_cov_in_world_3d().is_none());
+    /// ```
+    pub fn position_cov_in_world_3d(&self) -> Option<Matrix3<f64>> {
+        let d = G::KIND.position_dims();
+        if d == 0 {
+            return None;
+        }
+        let cov = self.cov_right();
+        let block = Matrix3::from_fn(|r, c| if r < d && c < d { cov[(r, c)] } else { 0.0 });
+        Some(rotate_cov(&self.mean.to_se3().rotation().to_matrix(), &block))
+    }
 }
 
 impl UncertainPose<Se3, 6> {
@@ -547,7 +575,7 @@ impl UncertainPose<Se3, 6> {
     }
 
     /// Position covariance in the **world** axes, first order: R Σ_ρρ Rᵀ from the right form
-    /// (CONVENTIONS §7). Note: this is *not* the ρρ block of the left form unless t = 0 — a
+    /// ([CONVENTIONS §7]). Note: this is *not* the ρρ block of the left form unless t = 0 — a
     /// left perturbation moves the position by ρ + θ × t.
     ///
     /// ```
@@ -558,11 +586,11 @@ impl UncertainPose<Se3, 6> {
     /// // body x is world y
     /// assert!((p.position_cov_in_world()[(1, 1)] - 0.01).abs() < 1e-15);
     /// ```
+    ///
+    /// [CONVENTIONS §7]: crate::conventions#7-drawing-uncertainty
     pub fn position_cov_in_world(&self) -> Matrix3<f64> {
-        rotate_cov(
-            &self.mean.rotation().to_matrix(),
-            &self.position_cov_in_body(),
-        )
+        self.position_cov_in_world_3d()
+            .unwrap_or_else(Matrix3::zeros)
     }
 
     /// Rotation covariance in the body frame: the θθ block of the right-form Σ (exact: the
@@ -639,7 +667,7 @@ impl UncertainPose<Se2, 3> {
     }
 
     /// Position covariance in the **world** axes, first order: R Σ_ρρ Rᵀ from the right form
-    /// (CONVENTIONS §7; the left form's ρρ block differs unless t = 0).
+    /// ([CONVENTIONS §7]; the left form's ρρ block differs unless t = 0).
     ///
     /// ```
     /// use posecov::lie::Se2;
@@ -648,11 +676,11 @@ impl UncertainPose<Se2, 3> {
     /// let p = UncertainPose::try_from_std_devs(x, [0.1, 0.0, 0.0], Side::Right).unwrap();
     /// assert!((p.position_cov_in_world()[(1, 1)] - 0.01).abs() < 1e-15);
     /// ```
+    ///
+    /// [CONVENTIONS §7]: crate::conventions#7-drawing-uncertainty
     pub fn position_cov_in_world(&self) -> Matrix2<f64> {
-        rotate_cov(
-            &self.mean.rotation().to_matrix(),
-            &self.position_cov_in_body(),
-        )
+        self.position_cov_in_world_3d()
+            .map_or_else(Matrix2::zeros, |c| c.fixed_view::<2, 2>(0, 0).into_owned())
     }
 
     /// Heading variance σ_θ² (the same in body and world frames: SO(2) is commutative; exact).

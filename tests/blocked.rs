@@ -1,11 +1,10 @@
 //! Blocked Monte Carlo (bounded memory for large samples): a sample split into blocks gives
 //! the particles and the statistics of the same sample evaluated in one block.
 
-use posecov::draw::{build_scene, particle_parts};
+use posecov::app::{Loaded, Overrides, Settings, load, load_text, resolve};
+use posecov::draw::{particle_part, scene as build_scene};
+use posecov::eval::{AnyEvaluation, Finding, evaluate_block};
 use posecov::propagate::ResultRecord;
-use posecov::scenario::eval::{EvalOptions, evaluate, evaluate_block};
-use posecov::scenario::model::AnyEvaluation;
-use posecov::scenario::{Scenario, ScenarioError};
 use posecov::scene::ItemKind;
 use posecov::uncertain::Method;
 
@@ -60,28 +59,46 @@ inputs = ["world_from_a", "world_from_b"]
 output = "fused"
 "#;
 
-fn options(samples: u64, block: Option<usize>) -> EvalOptions {
-    EvalOptions {
+/// A scenario with the settings of `samples` (in blocks of `block`).
+struct Case {
+    loaded: Loaded,
+    settings: Settings,
+}
+
+fn options(samples: u64, block: Option<usize>) -> Overrides {
+    Overrides {
         samples: Some(samples),
-        block_samples: block,
+        block_samples: block.map(|b| b as u64),
         ..Default::default()
     }
 }
 
-fn scenario(name: &str) -> Scenario {
+fn scenario(name: &str) -> Loaded {
     if name == "operations" {
-        return Scenario::parse(OPERATIONS, "operations.toml").expect("parses");
+        return load_text(OPERATIONS, "operations.toml").expect("parses");
     }
-    Scenario::load_any(name).expect("bundled")
+    load(name).expect("bundled")
 }
 
-fn notes(e: &AnyEvaluation) -> &[String] {
-    match e {
-        AnyEvaluation::So2(e) => &e.notes,
-        AnyEvaluation::Se2(e) => &e.notes,
-        AnyEvaluation::So3(e) => &e.notes,
-        AnyEvaluation::Se3(e) => &e.notes,
+fn case(loaded: &Loaded, overrides: &Overrides) -> Case {
+    let settings = resolve(&loaded.input, overrides, None).expect("settings");
+    Case {
+        loaded: loaded.clone(),
+        settings,
     }
+}
+
+fn evaluate(loaded: &Loaded, overrides: &Overrides) -> Result<AnyEvaluation, posecov::app::AppError> {
+    let c = case(loaded, overrides);
+    posecov::app::evaluate(&c.loaded, &c.settings.eval)
+}
+
+fn draw(loaded: &Loaded, e: &AnyEvaluation) -> posecov::scene::Scene {
+    build_scene(e, &case(loaded, &Overrides::default()).settings.draw)
+}
+
+fn block_samples(e: &AnyEvaluation) -> usize {
+    e.run().2
 }
 
 fn max_abs(m: &[[f64; 6]]) -> f64 {
@@ -106,8 +123,8 @@ fn assert_blocked_matches(name: &str, samples: u64, block: usize) {
     let s = scenario(name);
     let single = evaluate(&s, &options(samples, None)).expect("evaluates");
     let blocked = evaluate(&s, &options(samples, Some(block))).expect("evaluates");
-    assert_eq!(single.meta().block_samples, samples as usize, "{name}");
-    assert_eq!(blocked.meta().block_samples, block, "{name}");
+    assert_eq!(block_samples(&single), samples as usize, "{name}");
+    assert_eq!(block_samples(&blocked), block, "{name}");
     let (a, b) = (single.records(), blocked.records());
     assert_eq!(a.len(), b.len(), "{name}: record count");
     let mut monte_carlo = 0;
@@ -152,7 +169,7 @@ fn assert_blocked_matches(name: &str, samples: u64, block: usize) {
                 for (x, y) in mean_a.iter().zip(mean_b) {
                     assert!((x - y).abs() <= 1e-12, "{name} {}: {x} vs {y}", pa.name);
                 }
-                for (x, y) in cov_a.iter().flatten().zip(cov_b.iter().flatten()) {
+                for (x, y) in cov_a.iter().zip(cov_b.iter()) {
                     assert!((x - y).abs() <= 1e-12, "{name} {}: {x} vs {y}", pa.name);
                 }
             }
@@ -160,10 +177,11 @@ fn assert_blocked_matches(name: &str, samples: u64, block: usize) {
     }
     let blocks = (samples as usize).div_ceil(block);
     assert!(
-        notes(&blocked)
-            .iter()
-            .any(|n| n.contains(&format!("{samples} samples simulated in {blocks} blocks"))),
-        "{name}: the blocked evaluation says so in its notes"
+        blocked.findings().iter().any(|f| matches!(
+            f,
+            Finding::Blocked { samples: n, blocks: k, .. } if *n == samples as usize && *k == blocks
+        )),
+        "{name}: the blocked evaluation says so in its findings"
     );
 }
 
@@ -209,7 +227,7 @@ fn blocked_compounding_and_diff_drive_match_single_block() {
         let s = scenario(name);
         let single = evaluate(&s, &options(samples, None)).expect("evaluates");
         let blocked = evaluate(&s, &options(samples, Some(1024))).expect("evaluates");
-        let (sa, sb) = (build_scene(&single).series, build_scene(&blocked).series);
+        let (sa, sb) = (draw(&s, &single).series, draw(&s, &blocked).series);
         assert_eq!(sa.len(), sb.len(), "{name}");
         for (x, y) in sa.iter().zip(&sb) {
             assert_eq!(
@@ -226,14 +244,20 @@ fn blocked_compounding_and_diff_drive_match_single_block() {
                 );
             }
         }
-        let diff_notes = |e: &AnyEvaluation| -> Vec<String> {
-            notes(e)
+        let means = |e: &AnyEvaluation| -> Vec<[f64; 2]> {
+            e.findings()
                 .iter()
-                .filter(|n| n.contains("Cartesian mean"))
-                .cloned()
+                .filter_map(|f| match f {
+                    Finding::DiffDriveMeans { cartesian_mean, .. } => Some(*cartesian_mean),
+                    _ => None,
+                })
                 .collect()
         };
-        assert_eq!(diff_notes(&single), diff_notes(&blocked), "{name}");
+        let (ma, mb) = (means(&single), means(&blocked));
+        assert_eq!(ma.len(), mb.len(), "{name}");
+        for (a, b) in ma.iter().zip(&mb) {
+            assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12, "{name}: {a:?} vs {b:?}");
+        }
     }
 }
 
@@ -246,8 +270,9 @@ fn every_block_simulates_exactly_its_slice_of_the_whole_sample() {
         let single = evaluate(&s, &options(samples, None)).expect("evaluates");
         let blocked = evaluate(&s, &options(samples, Some(block))).expect("evaluates");
         let mut k = 0;
+        let c = case(&s, &options(samples, Some(block)));
         while let Some(part) =
-            evaluate_block(&s, &options(samples, Some(block)), &blocked, k).expect("evaluates")
+            evaluate_block(&c.loaded.input.plan, &c.settings.eval, &blocked, k).expect("evaluates")
         {
             let range = k * block..((k + 1) * block).min(samples as usize);
             match (&single, &part) {
@@ -283,10 +308,15 @@ fn particle_parts_draw_each_later_block_once_with_the_main_scene_sizes() {
     let s = scenario("camera_on_robot");
     let opts = options(3000, Some(1024));
     let main = evaluate(&s, &opts).expect("evaluates");
-    let scene = build_scene(&main);
-    let parts: Vec<_> = particle_parts(&s, &opts, &main)
-        .collect::<Result<_, ScenarioError>>()
-        .expect("evaluates");
+    let c = case(&s, &opts);
+    let scene = build_scene(&main, &c.settings.draw);
+    let parts: Vec<_> = (1..)
+        .map_while(|k| {
+            evaluate_block(&c.loaded.input.plan, &c.settings.eval, &main, k)
+                .expect("evaluates")
+                .map(|block| particle_part(&main, &block, k, &c.settings.draw))
+        })
+        .collect();
     assert_eq!(parts.len(), 2);
     let cloud_points = |scene: &posecov::scene::Scene, suffix: &str| -> (usize, Vec<f64>) {
         let clouds: Vec<_> = scene
@@ -320,17 +350,18 @@ fn particle_parts_draw_each_later_block_once_with_the_main_scene_sizes() {
     }
     // Not blocked: no parts.
     let whole = evaluate(&s, &options(3000, None)).expect("evaluates");
-    assert_eq!(particle_parts(&s, &options(3000, None), &whole).count(), 0);
+    let c = case(&s, &options(3000, None));
+    assert!(evaluate_block(&c.loaded.input.plan, &c.settings.eval, &whole, 1).expect("evaluates").is_none());
 }
 
 #[test]
 fn small_samples_are_never_blocked_and_block_sizes_round_to_whole_chunks() {
     let s = scenario("na568_se3_odometry");
     let e = evaluate(&s, &options(5000, None)).expect("evaluates");
-    assert_eq!(e.meta().block_samples, 5000);
+    assert_eq!(block_samples(&e), 5000);
     let e = evaluate(&s, &options(3000, Some(1000))).expect("evaluates");
     assert_eq!(
-        e.meta().block_samples,
+        block_samples(&e),
         1024,
         "rounded up to a whole 1024-sample chunk"
     );

@@ -69,7 +69,7 @@ fn scenario_errors_exit_1_with_file_line_column_and_field() {
             "wrong length",
             GOOD.replace("std_deg = [0.05, 0.05, 20.0]", "std_deg = [0.05, 20.0]"),
             "std_deg = [0.05, 20.0]",
-            "std needs 3 numbers",
+            "std_deg needs 3 numbers",
         ),
         (
             "NaN",
@@ -121,7 +121,7 @@ fn list_names_every_bundled_scenario() {
     let out = Command::new(BIN).arg("list").output().expect("run");
     assert!(out.status.success());
     let stdout = String::from_utf8_lossy(&out.stdout);
-    for b in posecov::scenario::bundled::BUNDLED {
+    for b in posecov::input::scenario::bundled::BUNDLED {
         assert!(
             stdout.lines().any(|l| l.starts_with(b.name)),
             "{} missing",

@@ -10,10 +10,8 @@ mod rrd;
 use std::path::PathBuf;
 use std::process::Command;
 
-use posecov::draw::scene_of;
-use posecov::scenario::Scenario;
-use posecov::scenario::bundled::BUNDLED;
-use posecov::scenario::eval::EvalOptions;
+use posecov::app::{Overrides, load, pipeline};
+use posecov::input::scenario::bundled::BUNDLED;
 use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
 
 /// Particles per input in golden recordings (small files, same code paths).
@@ -26,13 +24,13 @@ fn golden_path(name: &str) -> PathBuf {
 }
 
 fn record(name: &str) -> Vec<u8> {
-    let scenario = Scenario::load_any(name).expect("bundled scenario parses");
-    let options = EvalOptions {
+    let loaded = load(name).expect("bundled scenario loads");
+    let overrides = Overrides {
         samples: Some(GOLDEN_SAMPLES),
         ..Default::default()
     };
-    let scene = scene_of(&scenario, &options).expect("bundled scenario evaluates");
-    let seed = scenario.file.scenario.seed.unwrap_or(0);
+    let (_, scene) = pipeline(&loaded, &overrides, None).expect("bundled scenario evaluates");
+    let seed = loaded.input.defaults.seed.unwrap_or(0);
     scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario(name, seed)).expect("records")
 }
 

@@ -99,7 +99,7 @@ fn frame_changes_and_inverse_are_exact() {
 fn compose_and_between_match_conventions_and_sides_agree() {
     let (xr, yr) = (x_pose(Side::Right), y_pose(Side::Right));
     let (xl, yl) = (x_pose(Side::Left), y_pose(Side::Left));
-    // CONVENTIONS §5 closed forms.
+    // docs/CONVENTIONS.md §5 closed forms.
     let ad_y_inv = yr.mean().inverse().adj();
     let right = compose(&xr, &yr);
     assert_eq!(right.method, Method::FirstOrder);

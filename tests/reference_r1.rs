@@ -1,4 +1,6 @@
-//! REFERENCE_CASES.md R1: closed-form fixtures, abs 1e-8.
+//! The closed-form fixtures of [REFERENCE_CASES R1], abs 1e-8.
+//!
+//! [REFERENCE_CASES R1]: posecov::reference_cases#r1-closed-form-fixtures
 
 mod common;
 

@@ -1,5 +1,8 @@
-//! REFERENCE_CASES.md R2 (NA 568 SE(2) odometry table, 1e-6) and R3 (right vs left form:
+//! [REFERENCE_CASES R2] (NA 568 SE(2) odometry table, 1e-6) and [R3] (right vs left form:
 //! the two recursions agree to 1e-12; the table's 6 decimals to 1e-6).
+//!
+//! [REFERENCE_CASES R2]: posecov::reference_cases#r2-se2-odometry-na-568
+//! [R3]: posecov::reference_cases#r3-right-form-against-left-form
 
 mod common;
 

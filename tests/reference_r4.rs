@@ -1,6 +1,8 @@
-//! REFERENCE_CASES.md R4, deterministic part: ROB 530 SE(3) odometry with the noise inside
+//! [REFERENCE_CASES R4], deterministic part: ROB 530 SE(3) odometry with the noise inside
 //! the exponential, X_{k+1} = X_k Exp(u_k + w_k), with and without the Jr term. (The Monte
 //! Carlo comparison belongs to the sampling suite.)
+//!
+//! [REFERENCE_CASES R4]: posecov::reference_cases#r4-se3-odometry-noise-inside-exp-rob-530
 
 mod common;
 

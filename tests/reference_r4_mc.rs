@@ -1,20 +1,28 @@
-//! REFERENCE_CASES R4 — ROB 530 SE(3) odometry with the noise inside the exponential,
+//! [REFERENCE_CASES R4] — ROB 530 SE(3) odometry with the noise inside the exponential,
 //! X_{k+1} = X_k Exp(u_k + w_k): the first-order recursion with Jr agrees with Monte Carlo,
 //! the lecture's form without Jr is 15–25 % low. Also Monte Carlo odometry with increments
-//! (R2's SE(2) model) against the first-order recursion.
+//! (R2's SE(2) model) against the first-order recursion. Monte Carlo is the evaluation
+//! engine's ([`posecov::eval::evaluate`] of an [`Op::Odometry`] plan).
 //!
 //! Tolerances: MC with N = 1e5; a covariance entry's relative standard error is ≈ √(2/N)
 //! = 0.45 % (Gaussian), so the 2 % criterion of R4 is > 4 standard errors away from sampling
 //! noise; the rest of the 2 % is the first-order truncation (≈ 1 % here).
+//!
+//! [REFERENCE_CASES R4]: posecov::reference_cases#r4-se3-odometry-noise-inside-exp-rob-530
 
 mod common;
 
-use common::{r4_inputs, r4_noise};
+use common::{
+    evaluate_plan, increment_controls, mc_settings, mc_stats, nodes, odometry_plan, particles,
+    r4_inputs, r4_noise, tangent_controls,
+};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use posecov::eval::{EvalError, EvalSettings, evaluate};
 use posecov::lie::{LieGroup, Se2, Se3};
-use posecov::propagate::monte_carlo::{MonteCarlo, odometry_increments, odometry_tangent_inputs};
+use posecov::plan::{AnyPlan, OdometryModel, Op, Operand, Plan};
 use posecov::propagate::odometry::{InputNoise, propagate_increments, propagate_tangent_inputs};
 use posecov::propagate::relative_frobenius_error;
+use posecov::sample::{SampleStatistics, sample_statistics};
 use posecov::uncertain::{Method, Side, UncertainPose};
 
 const N: usize = 100_000;
@@ -38,8 +46,17 @@ fn r4_jr_corrected_matches_monte_carlo_and_the_lecture_form_is_low() {
         propagate_tangent_inputs(&start, &inputs, &noise, InputNoise::RightJacobian).unwrap();
     let lecture =
         propagate_tangent_inputs(&start, &inputs, &noise, InputNoise::LectureNoJr).unwrap();
-    let mc = odometry_tangent_inputs(&start, &inputs, &noise, &MonteCarlo::new(N, 530)).unwrap();
-    assert_eq!((with_jr.len(), mc.len()), (5, 5));
+    let plan = odometry_plan(
+        Se3::identity(),
+        OdometryModel::Exp,
+        tangent_controls(&inputs),
+        noise,
+    );
+    let evaluation = evaluate_plan(plan, &mc_settings(N, 530));
+    let steps = nodes(&evaluation, "x");
+    assert_eq!((with_jr.len(), steps.len()), (5, 5));
+    // Lie mean and centred 1/(N−1) covariance, right side, at every step.
+    let mc: Vec<SampleStatistics<Se3, 6>> = steps.iter().map(|n| mc_stats(n)).collect();
 
     // Nominal positions (6 digits).
     let positions = [
@@ -49,23 +66,19 @@ fn r4_jr_corrected_matches_monte_carlo_and_the_lecture_form_is_low() {
         [0.460708, 11.663701, 6.289424],
     ];
     for (k, p) in positions.iter().enumerate() {
-        let got = mc[k + 1].nominal.translation();
+        let got = steps[k + 1].nominal.translation();
         assert!(
             (got - Vector3::from(*p)).amax() < 5e-6,
             "nominal position {k}: {got}"
         );
         assert!(
-            mc[k + 1]
+            steps[k + 1]
                 .nominal
                 .is_approx(with_jr[k + 1].pose.mean(), 1e-12)
         );
     }
 
-    let (jr4, lecture4, mc4) = (
-        with_jr[4].pose.cov(),
-        lecture[4].pose.cov(),
-        mc[4].propagated.pose.cov(),
-    );
+    let (jr4, lecture4, mc4) = (with_jr[4].pose.cov(), lecture[4].pose.cov(), &mc[4].cov);
     let diag = |m: &Matrix6<f64>| {
         (0..6)
             .map(|i| format!("{:.6}", m[(i, i)]))
@@ -100,18 +113,20 @@ fn r4_jr_corrected_matches_monte_carlo_and_the_lecture_form_is_low() {
     }
 
     for k in 1..=4 {
-        let e_jr = relative_frobenius_error(with_jr[k].pose.cov(), mc[k].propagated.pose.cov());
-        let e_lecture =
-            relative_frobenius_error(lecture[k].pose.cov(), mc[k].propagated.pose.cov());
-        let lecture_ratio = lecture[k].pose.cov().norm() / mc[k].propagated.pose.cov().norm();
+        let e_jr = relative_frobenius_error(with_jr[k].pose.cov(), &mc[k].cov);
+        let e_lecture = relative_frobenius_error(lecture[k].pose.cov(), &mc[k].cov);
+        let lecture_ratio = lecture[k].pose.cov().norm() / mc[k].cov.norm();
         println!(
             "step {k}: Jr vs MC {:.2} %, lecture vs MC {:.2} % (norm ratio {lecture_ratio:.3}), Lie mean offset {:.2e}",
             100.0 * e_jr,
             100.0 * e_lecture,
-            mc[k].propagated.pose.mean().rminus(&mc[k].nominal).norm()
+            mc[k].mean.rminus(&steps[k].nominal).norm()
         );
         assert!(e_jr < 0.02, "step {k}: Jr-corrected {e_jr} vs MC");
-        assert_eq!(mc[k].propagated.method, Method::MonteCarlo);
+        assert_eq!(
+            steps[k].estimates.last().map(|e| e.result.method),
+            Some(Method::MonteCarlo)
+        );
     }
     let e_lecture = relative_frobenius_error(lecture4, mc4);
     assert!(
@@ -122,8 +137,10 @@ fn r4_jr_corrected_matches_monte_carlo_and_the_lecture_form_is_low() {
 }
 
 /// R2's SE(2) model X_{k+1} = X_k U_k Exp(w_k) (7 steps): Monte Carlo within 1.5 % of the
-/// first-order recursion at every step (REFERENCE_CASES R2), and the Lie mean within ~5e-3 of
+/// first-order recursion at every step ([REFERENCE_CASES R2]), and the Lie mean within ~5e-3 of
 /// the nominal pose.
+///
+/// [REFERENCE_CASES R2]: posecov::reference_cases#r2-se2-odometry-na-568
 #[test]
 fn r2_increments_monte_carlo_matches_first_order() {
     let u2 = [
@@ -142,15 +159,20 @@ fn r2_increments_monte_carlo_matches_first_order() {
     ));
     let start = UncertainPose::certain(Se2::identity());
     let first = propagate_increments(&start, &increments, &noise).unwrap();
-    let mc = odometry_increments(&start, &increments, &noise, &MonteCarlo::new(N, 568)).unwrap();
+    let plan = odometry_plan(
+        Se2::identity(),
+        OdometryModel::Increment,
+        increment_controls(&increments),
+        noise,
+    );
+    let evaluation = evaluate_plan(plan, &mc_settings(N, 568));
+    let steps = nodes(&evaluation, "x");
+    assert_eq!(steps.len(), 8);
     for k in 1..=7 {
-        let e = relative_frobenius_error(first[k].pose.cov(), mc[k].propagated.pose.cov());
-        let offset = mc[k]
-            .propagated
-            .pose
-            .mean()
-            .rminus(first[k].pose.mean())
-            .norm();
+        // Lie mean and centred 1/(N−1) covariance, right side.
+        let mc = mc_stats(steps[k]);
+        let e = relative_frobenius_error(first[k].pose.cov(), &mc.cov);
+        let offset = mc.mean.rminus(first[k].pose.mean()).norm();
         println!(
             "R2 step {k}: first order vs MC {:.2} %, Lie mean offset {offset:.2e}",
             100.0 * e
@@ -158,40 +180,61 @@ fn r2_increments_monte_carlo_matches_first_order() {
         assert!(e < 0.015, "step {k}: {e}");
         assert!(offset < 6e-3, "step {k}: Lie mean offset {offset}");
     }
-    // The left-side Monte Carlo agrees with the left-form recursion too.
+    // The left-side Monte Carlo (left Lie mean, centred 1/(N−1) left covariance of the same
+    // particles) agrees with the left-form recursion too.
     let left_start = UncertainPose::new_unchecked(Se2::identity(), Matrix3::zeros(), Side::Left);
     let first_left = propagate_increments(&left_start, &increments, &noise).unwrap();
-    let mc_left = odometry_increments(
-        &start,
-        &increments,
-        &noise,
-        &MonteCarlo::new(N, 568).with_side(Side::Left),
-    )
-    .unwrap();
-    let e = relative_frobenius_error(first_left[7].pose.cov(), mc_left[7].propagated.pose.cov());
+    let mc_left = sample_statistics(particles(steps[7]), Side::Left).unwrap();
+    assert_eq!(particles(steps[7]).len(), N);
+    let e = relative_frobenius_error(first_left[7].pose.cov(), &mc_left.cov);
     assert!(e < 0.015, "left form, step 7: {e}");
 }
 
+/// Monte Carlo settings and inputs the engine refuses, with typed errors.
 #[test]
 fn monte_carlo_rejects_bad_settings() {
-    let start = UncertainPose::certain(Se3::identity());
-    let u = [Vector6::zeros()];
+    let plan = |noise: Matrix6<f64>| {
+        AnyPlan::Se3(odometry_plan(
+            Se3::identity(),
+            OdometryModel::Exp,
+            tangent_controls(&[Vector6::zeros()]),
+            noise,
+        ))
+    };
+    let settings = |samples| EvalSettings {
+        samples,
+        methods: vec![Method::MonteCarlo],
+        ..Default::default()
+    };
     let noise = r4_noise();
+    // A covariance needs N ≥ 2 samples.
     assert!(matches!(
-        odometry_tangent_inputs(&start, &u, &noise, &MonteCarlo::new(1, 0)),
-        Err(posecov::Error::OutOfRange { .. })
+        evaluate(&plan(noise), &settings(1)),
+        Err(EvalError::Setting {
+            what: "samples",
+            ..
+        })
     ));
+    assert!(evaluate(&plan(noise), &settings(2)).is_ok());
     let mut bad = noise;
     bad[(0, 1)] = 1.0;
     assert!(matches!(
-        odometry_tangent_inputs(&start, &u, &bad, &MonteCarlo::new(10, 0)),
-        Err(posecov::Error::NotSymmetric { .. })
+        evaluate(&plan(bad), &settings(10)),
+        Err(EvalError::Math {
+            source: posecov::Error::NotSymmetric { .. },
+            ..
+        })
     ));
-    let empty: [UncertainPose<Se3, 6>; 0] = [];
-    let result = posecov::propagate::monte_carlo::map(
-        &empty,
-        |_: &[Se3]| Se3::identity(),
-        &MonteCarlo::new(10, 0),
+    // Nothing to sample: an operation whose input is not an earlier pose.
+    let mut empty = Plan::<Se3, 6>::default();
+    empty.operation(
+        "x",
+        Op::Inverse {
+            input: Operand::Defined(0),
+        },
     );
-    assert!(matches!(result, Err(posecov::Error::TooFewSamples { .. })));
+    assert!(matches!(
+        evaluate(&AnyPlan::Se3(empty), &settings(10)),
+        Err(EvalError::Undefined { definition: 0, .. })
+    ));
 }

@@ -1,16 +1,25 @@
-//! REFERENCE_CASES R5 (Barfoot & Furgale 2014 Fig. 2: repeated compounding) and R6 (a
+//! [REFERENCE_CASES R5] (Barfoot & Furgale 2014 Fig. 2: repeated compounding) and [R6] (a
 //! deterministic Gauss–Hermite oracle that separates correct from wrong 4th-order formulas),
-//! plus the SE(2)-by-embedding compounding against SE(2) Monte Carlo.
+//! plus the SE(2)-by-embedding compounding against SE(2) Monte Carlo (the evaluation engine's:
+//! [`posecov::eval::evaluate`] of an [`Op::Compound`] or [`Op::Compose`] plan).
+//!
+//! [REFERENCE_CASES R5]: posecov::reference_cases#r5-repeated-compounding-barfoot-and-furgale-2014-fig-2
+//! [R6]: posecov::reference_cases#r6-a-deterministic-oracle-for-fourth-order
+
+mod common;
 
 use std::f64::consts::PI;
 
+use common::{evaluate_plan, mc_settings, nodes, particles};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use posecov::eval::EvalSettings;
 use posecov::lie::{LieGroup, Se2, Se3};
+use posecov::plan::{Op, Plan, StepPolicy};
 use posecov::propagate::fourth_order::{
     Order, Variant, compound_se2, compound_se3, compound_se3_variant, se2_to_se3,
 };
-use posecov::propagate::monte_carlo::{Centring, MonteCarlo, map};
 use posecov::propagate::relative_frobenius_error;
+use posecov::sample::uncentred_covariance;
 use posecov::uncertain::{Method, Side, UncertainPose};
 use rayon::prelude::*;
 
@@ -89,8 +98,10 @@ fn r5_fourth_order_recovers_the_along_track_variance() {
 ///
 /// Tolerance: ρx is a banana-shaped (non-Gaussian) variable; its variance estimate has a
 /// relative standard error √((κ − 1)/N) with kurtosis κ ≲ 10, i.e. ≲ 1 % at N = 1e5; the 3 %
-/// bound (REFERENCE_CASES R5) is > 4 standard errors, and the 4th-order truncation itself is
+/// bound ([REFERENCE_CASES R5]) is > 4 standard errors, and the 4th-order truncation itself is
 /// ≈ 0.6 % below the MC value.
+///
+/// [REFERENCE_CASES R5]: posecov::reference_cases#r5-repeated-compounding-barfoot-and-furgale-2014-fig-2
 #[test]
 fn r5_se2_embedding_matches_se3_and_monte_carlo() {
     let step = UncertainPose::try_from_std_devs(
@@ -111,13 +122,43 @@ fn r5_se2_embedding_matches_se3_and_monte_carlo() {
     }
     assert!(se2_to_se3(planar.mean()).is_approx(spatial.mean(), 1e-9));
 
-    let inputs = [step; 100];
-    let mc = MonteCarlo::new(100_000, 2014)
-        .with_side(Side::Left)
-        .with_centring(Centring::Nominal);
-    let product = |x: &[Se2]| x.iter().fold(Se2::identity(), |acc, s| s.compose(&acc));
-    let truth = map(&inputs, product, &mc).unwrap();
-    let mc_cov = truth.propagated.pose.cov();
+    // T_k = Exp(w_k) T̄ T_{k−1}, 100 compounds from T₀ = I; statistics at step 100 only.
+    let mut plan = Plan::<Se2, 3>::default();
+    let start = plan.known("start", Se2::identity());
+    plan.operation(
+        "t",
+        Op::Compound {
+            input: start,
+            step: *step.mean(),
+            noise: *step.cov(),
+            noise_side: Side::Left,
+            steps: 100,
+        },
+    );
+    let settings = EvalSettings {
+        steps: StepPolicy {
+            max_recorded: 1,
+            max_detailed: 1,
+        },
+        ..mc_settings(100_000, 2014)
+    };
+    let evaluation = evaluate_plan(plan, &settings);
+    let last = *nodes(&evaluation, "t").last().unwrap();
+    assert_eq!(last.step, Some(100));
+    assert!(
+        last.nominal
+            .is_approx(&Se2::from_xy_theta(100.0, 0.0, 0.0), 1e-9)
+    );
+    // Barfoot's Monte Carlo covariance: uncentred E[ξξᵀ] about the nominal pose, left side.
+    let mc_cov = &last
+        .monte_carlo
+        .as_ref()
+        .and_then(|mc| mc.uncentred_left)
+        .expect("the engine's uncentred left covariance of a compound");
+    assert_eq!(
+        mc_cov,
+        &uncentred_covariance(particles(last), &last.nominal, Side::Left).unwrap()
+    );
     println!(
         "R5 SE(2) MC: ρxρx {:.6}, ρyρy {:.4}, ρyθ {:.4}, θθ {:.5}",
         mc_cov[(0, 0)],
@@ -160,15 +201,28 @@ fn se2_embedding_against_monte_carlo() {
     let cov2 = Matrix3::new(0.09, -0.01, 0.02, -0.01, 0.04, 0.0, 0.02, 0.0, 0.12);
     let a = UncertainPose::try_new(Se2::from_xy_theta(1.0, 0.5, 0.4), cov1, Side::Left).unwrap();
     let b = UncertainPose::try_new(Se2::from_xy_theta(2.0, -1.0, -0.7), cov2, Side::Right).unwrap();
-    let mc = MonteCarlo::new(100_000, 7)
-        .with_side(Side::Left)
-        .with_centring(Centring::Nominal);
-    let truth = map(&[a, b], |x: &[Se2]| x[0].compose(&x[1]), &mc).unwrap();
+    let mut plan = Plan::<Se2, 3>::default();
+    let (x, y) = (plan.uncertain("a", a), plan.uncertain("b", b));
+    plan.operation(
+        "ab",
+        Op::Compose {
+            lhs: x,
+            rhs: y,
+            cross_cov: None,
+        },
+    );
+    let evaluation = evaluate_plan(plan, &mc_settings(100_000, 7));
+    let ab = nodes(&evaluation, "ab")[0];
+    let nominal = a.mean().compose(b.mean());
+    assert!(ab.nominal.is_approx(&nominal, 1e-12));
+    // Uncentred E[ξξᵀ] about the nominal pose, left side, over all N particles.
+    assert_eq!(particles(ab).len(), 100_000);
+    let truth = uncentred_covariance(particles(ab), &nominal, Side::Left).unwrap();
     let fourth = compound_se2(&a, &b, Order::Fourth);
     let second = compound_se2(&a, &b, Order::Second);
     assert_eq!(fourth.method, Method::FourthOrder);
-    let e4 = relative_frobenius_error(fourth.pose.cov(), truth.propagated.pose.cov());
-    let e2 = relative_frobenius_error(second.pose.cov(), truth.propagated.pose.cov());
+    let e4 = relative_frobenius_error(fourth.pose.cov(), &truth);
+    let e2 = relative_frobenius_error(second.pose.cov(), &truth);
     println!("SE(2) compound vs MC: 2nd order {e2:.4}, 4th order {e4:.4}");
     assert!(e4 < 0.03, "4th order {e4}");
     assert!(e4 < 0.5 * e2, "4th {e4} should beat 2nd {e2} clearly");
@@ -277,7 +331,7 @@ fn r6_fourth_order_residual_shrinks_eightfold_and_wrong_variants_do_not() {
         ratios(&fourth),
         ratios(&second)
     );
-    // The reference residuals, to the three digits REFERENCE_CASES gives.
+    // The reference residuals, to the three digits docs/REFERENCE_CASES.md R6 gives.
     for (r, expected) in fourth.iter().zip([5.46e-9, 4.37e-8, 3.50e-7]) {
         assert!(
             (r / expected - 1.0).abs() < 0.005,

@@ -1,4 +1,4 @@
-//! REFERENCE_CASES R7 — Long et al. 2012, "The Banana Distribution is Gaussian": the
+//! [REFERENCE_CASES R7] — Long et al. 2012, "The Banana Distribution is Gaussian": the
 //! differential-drive robot with wheel noise. Closed forms = numeric integral (1e-9); both
 //! within 3 % of Euler–Maruyama Monte Carlo; the Lie mean stays on the nominal end point while
 //! the Cartesian mean of the positions retreats into the banana.
@@ -9,6 +9,8 @@
 //! has the exact value E[x] = v (1 − e^{−k t})/k, k = D r²/l² (θ is a Brownian motion with
 //! variance 2 D r²/l² per second, E[cos θ(τ)] = e^{−kτ}); its standard error is
 //! sd(x)/√N < 2e-3 at N = 20 000, and Euler–Maruyama's bias at dt = 1e-3 is O(dt).
+//!
+//! [REFERENCE_CASES R7]: posecov::reference_cases#r7-the-differential-drive-banana-long-et-al-2012
 
 use std::f64::consts::FRAC_PI_2;
 

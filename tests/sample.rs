@@ -1,15 +1,20 @@
-//! Sampling and sample statistics (CONVENTIONS §8): drawn samples recover Σ on either side,
+//! Sampling and sample statistics ([CONVENTIONS §8]): drawn samples recover Σ on either side,
 //! singular Σ is handled, results do not depend on the thread count, NEES detects a wrong
 //! claimed covariance, and every degenerate input returns its typed error.
 //!
 //! Tolerances: for N Gaussian samples the sample covariance S has
 //! E‖S − Σ‖²_F = (tr(Σ)² + ‖Σ‖²_F)/N (Wishart), so the relative Frobenius error has RMS
 //! e(N) = √((tr(Σ)² + ‖Σ‖²_F)/N) / ‖Σ‖_F; tests allow 3 e(N).
+//!
+//! [CONVENTIONS §8]: posecov::conventions#8-sample-statistics
 
+mod common;
+
+use common::{evaluate_plan, mc_settings, nodes};
 use nalgebra::{Matrix3, Matrix6, Vector6};
 use posecov::Error;
 use posecov::lie::{LieGroup, Se2, Se3, So2};
-use posecov::propagate::monte_carlo::{MonteCarlo, compose};
+use posecov::plan::{Op, Plan};
 use posecov::propagate::relative_frobenius_error;
 use posecov::sample::{
     MeanError, Sampler, centred_covariance, covariance_square_root, lie_mean, nees,
@@ -139,9 +144,25 @@ fn identical_results_for_one_and_two_threads() {
     let s1 = in_pool(1, || sample_statistics(&one, Side::Right).unwrap());
     let s2 = in_pool(2, || sample_statistics(&two, Side::Right).unwrap());
     assert_eq!(s1, s2);
-    let mc = MonteCarlo::new(10_000, 3);
-    let m1 = in_pool(1, || compose(&pose, &pose, &mc).unwrap());
-    let m2 = in_pool(2, || compose(&pose, &pose, &mc).unwrap());
+    let mut plan = Plan::<Se3, 6>::default();
+    let (x, y) = (plan.uncertain("x", pose), plan.uncertain("y", pose));
+    plan.operation(
+        "xy",
+        Op::Compose {
+            lhs: x,
+            rhs: y,
+            cross_cov: None,
+        },
+    );
+    let settings = mc_settings(10_000, 3);
+    let run = || {
+        let e = evaluate_plan(plan.clone(), &settings);
+        let xy = nodes(&e, "xy")[0];
+        (xy.particles.clone(), xy.monte_carlo, xy.estimates.clone())
+    };
+    let m1 = in_pool(1, run);
+    let m2 = in_pool(2, run);
+    assert!(m1.0.as_ref().is_some_and(|p| p.len() == 10_000) && m1.1.is_some());
     assert_eq!(m1, m2);
 }
 

@@ -1,8 +1,8 @@
 //! Every way a scenario file can be wrong gets a message naming file:line:column, the field
 //! and the offending value.
 
-use posecov::scenario::eval::{EvalOptions, evaluate};
-use posecov::scenario::{Scenario, ScenarioError};
+use posecov::app::{Overrides, load_text, pipeline};
+use posecov::input::scenario::{Scenario, ScenarioError};
 
 const GOOD: &str = r#"[scenario]
 title = "t"
@@ -20,10 +20,18 @@ input = "map_from_robot"
 output = "robot_from_map"
 "#;
 
+/// Few samples: errors come from reading, lowering and evaluating, not from the sample size.
+fn small() -> Overrides {
+    Overrides {
+        samples: Some(50),
+        ..Default::default()
+    }
+}
+
 /// Parses and evaluates; returns the error's text (panics if there is none).
 fn error_of(text: &str) -> String {
-    let result = Scenario::parse(text, "bad.toml")
-        .and_then(|s| evaluate(&s, &EvalOptions::default()).map(|_| ()));
+    let result = load_text(text, "bad.toml")
+        .and_then(|loaded| pipeline(&loaded, &small(), None).map(|_| ()));
     match result {
         Ok(()) => panic!("expected an error for:\n{text}"),
         Err(e) => e.to_string(),
@@ -39,8 +47,8 @@ fn line_of(text: &str, needle: &str) -> usize {
 
 #[test]
 fn the_good_file_is_good() {
-    let s = Scenario::parse(GOOD, "good.toml").unwrap();
-    assert!(evaluate(&s, &EvalOptions::default()).is_ok());
+    let loaded = load_text(GOOD, "good.toml").unwrap();
+    assert!(pipeline(&loaded, &small(), None).is_ok());
 }
 
 #[test]

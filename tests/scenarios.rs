@@ -2,13 +2,11 @@
 //! reference cases they reproduce.
 #![allow(clippy::needless_range_loop)] // matrices are compared entry by entry, by index
 
-use posecov::draw::build_scene;
-use posecov::scenario::Scenario;
-use posecov::scenario::bundled::BUNDLED;
-use posecov::scenario::eval::{EvalOptions, evaluate};
+use posecov::app::{Overrides, load, load_text, pipeline};
+use posecov::input::scenario::bundled::BUNDLED;
 
-fn small() -> EvalOptions {
-    EvalOptions {
+fn small() -> Overrides {
+    Overrides {
         samples: Some(400),
         ..Default::default()
     }
@@ -17,22 +15,34 @@ fn small() -> EvalOptions {
 #[test]
 fn every_bundled_scenario_evaluates_and_draws() {
     for b in BUNDLED {
-        let scenario =
-            Scenario::parse(b.text, b.name).unwrap_or_else(|e| panic!("{}: {e}", b.name));
-        let evaluation =
-            evaluate(&scenario, &small()).unwrap_or_else(|e| panic!("{}: {e}", b.name));
-        let scene = build_scene(&evaluation);
-        scene
-            .validate()
-            .unwrap_or_else(|e| panic!("{}: {e}", b.name));
+        let loaded = load_text(b.text, b.name).unwrap_or_else(|e| panic!("{}: {e}", b.name));
+        let (evaluation, scene) =
+            pipeline(&loaded, &small(), None).unwrap_or_else(|e| panic!("{}: {e}", b.name));
         assert!(!scene.items.is_empty(), "{} draws nothing", b.name);
         assert!(
-            scene
-                .description_markdown
-                .contains(&evaluation.meta().title),
+            scene.description_markdown.contains(&loaded.input.about.title),
             "{}",
             b.name
         );
+        // The bundled scenarios are well posed: nothing failed, nothing indefinite.
+        assert!(
+            evaluation.findings().iter().all(|f| !matches!(
+                f,
+                posecov::eval::Finding::MethodFailed { .. }
+                    | posecov::eval::Finding::NotPositiveSemiDefinite { .. }
+            )),
+            "{}: {:?}",
+            b.name,
+            evaluation.findings()
+        );
+        // No text shown to users names an internal document.
+        for internal in ["REFERENCE_CASES", "CONVENTIONS", "^T"] {
+            assert!(
+                !scene.description_markdown.contains(internal),
+                "{} shows {internal:?}",
+                b.name
+            );
+        }
     }
 }
 
@@ -45,10 +55,8 @@ fn readme_example_parses_and_evaluates() {
         .expect("README has a ```toml block")
         + "```toml\n".len();
     let end = start + readme[start..].find("```").expect("closed block");
-    let scenario =
-        Scenario::parse(&readme[start..end], "README.md").unwrap_or_else(|e| panic!("{e}"));
-    let evaluation = evaluate(&scenario, &small()).unwrap_or_else(|e| panic!("{e}"));
-    assert!(build_scene(&evaluation).validate().is_ok());
+    let loaded = load_text(&readme[start..end], "README.md").unwrap_or_else(|e| panic!("{e}"));
+    pipeline(&loaded, &small(), None).unwrap_or_else(|e| panic!("{e}"));
 }
 
 fn record<'a>(
@@ -63,16 +71,20 @@ fn record<'a>(
 }
 
 fn bundled_records(name: &str, samples: u64) -> Vec<posecov::propagate::ResultRecord> {
-    let b = posecov::scenario::bundled::find(name).expect("bundled");
-    let s = Scenario::parse(b.text, name).expect("parses");
-    let options = EvalOptions {
+    let loaded = load(name).expect("bundled");
+    let overrides = Overrides {
         samples: Some(samples),
         ..Default::default()
     };
-    evaluate(&s, &options).expect("evaluates").records()
+    pipeline(&loaded, &overrides, None)
+        .expect("evaluates")
+        .0
+        .records()
 }
 
-/// `na568_se2_odometry` reproduces REFERENCE_CASES R2 at step 7 (1e-6).
+/// `na568_se2_odometry` reproduces [REFERENCE_CASES R2] at step 7 (1e-6).
+///
+/// [REFERENCE_CASES R2]: posecov::reference_cases#r2-se2-odometry-na-568
 #[test]
 fn na568_se2_scenario_reproduces_r2() {
     use posecov::uncertain::{Method, Side};

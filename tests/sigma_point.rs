@@ -4,15 +4,18 @@
 //!
 //! Tolerance against MC: N = 1e5, relative Frobenius RMS sampling error
 //! √((tr Σ)² + ‖Σ‖²_F)/N)/‖Σ‖_F ≈ 0.6 % for these Σ; 3 % leaves ≥ 4 RMS for sampling plus the
-//! transform's own (fourth-order) truncation.
+//! transform's own (fourth-order) truncation. Monte Carlo is the evaluation engine's
+//! ([`posecov::eval::evaluate`] of a plan), summarised by the Lie mean and the centred
+//! 1/(N−1) covariance, right side.
 
+mod common;
+
+use common::{evaluate_plan, mc_settings, mc_stats, nodes, odometry_plan, tangent_controls};
 use nalgebra::{Matrix6, Vector6};
 use posecov::Error;
 use posecov::lie::{LieGroup, Se2, Se3, So3};
+use posecov::plan::{OdometryModel, Op, Plan};
 use posecov::propagate::first_order;
-use posecov::propagate::monte_carlo::{
-    MonteCarlo, compose as mc_compose, map as mc_map, odometry_tangent_inputs,
-};
 use posecov::propagate::odometry::{InputNoise, propagate_tangent_inputs};
 use posecov::propagate::relative_frobenius_error;
 use posecov::propagate::sigma_point::{Unscented, compose, map};
@@ -75,9 +78,20 @@ fn compose_equals_first_order_and_is_close_to_monte_carlo() {
     let ut = compose(&a, &b, &Unscented::default()).unwrap();
     let fo = first_order::compose(&a, &b);
     assert!(relative_frobenius_error(ut.pose.cov(), fo.pose.cov()) < 1e-12);
-    let truth = mc_compose(&a, &b, &MonteCarlo::new(100_000, 21)).unwrap();
-    let e_ut = relative_frobenius_error(ut.pose.cov(), truth.propagated.pose.cov());
-    let mean_offset = ut.pose.mean().rminus(truth.propagated.pose.mean()).norm();
+    let mut plan = Plan::<Se3, 6>::default();
+    let (x, y) = (plan.uncertain("a", a), plan.uncertain("b", b));
+    plan.operation(
+        "ab",
+        Op::Compose {
+            lhs: x,
+            rhs: y,
+            cross_cov: None,
+        },
+    );
+    let evaluation = evaluate_plan(plan, &mc_settings(100_000, 21));
+    let truth = mc_stats(nodes(&evaluation, "ab")[0]);
+    let e_ut = relative_frobenius_error(ut.pose.cov(), &truth.cov);
+    let mean_offset = ut.pose.mean().rminus(&truth.mean).norm();
     println!(
         "SE(3) compose vs MC: sigma points {:.2} %, UT mean offset {mean_offset:.2e}",
         100.0 * e_ut
@@ -95,14 +109,38 @@ fn compose_equals_first_order_and_is_close_to_monte_carlo() {
         p(2.0, 1.0, 1.0, [0.2, 0.1, 0.05]),
     ];
     let f = |v: &[Se2]| v[0].compose(&v[1].inverse()).compose(&v[2]);
-    let truth = mc_map(&inputs, f, &MonteCarlo::new(100_000, 22)).unwrap();
+    let mut plan = Plan::<Se2, 3>::default();
+    let x = plan.uncertain("x", inputs[0]);
+    let y = plan.uncertain("y", inputs[1]);
+    let z = plan.uncertain("z", inputs[2]);
+    let y_inv = plan.operation("y_inv", Op::Inverse { input: y });
+    let x_y_inv = plan.operation(
+        "x_y_inv",
+        Op::Compose {
+            lhs: x,
+            rhs: y_inv,
+            cross_cov: None,
+        },
+    );
+    plan.operation(
+        "x_y_inv_z",
+        Op::Compose {
+            lhs: x_y_inv,
+            rhs: z,
+            cross_cov: None,
+        },
+    );
+    let evaluation = evaluate_plan(plan, &mc_settings(100_000, 22));
+    let truth = mc_stats(nodes(&evaluation, "x_y_inv_z")[0]);
     let ut = map(&inputs, f, &Unscented::default()).unwrap();
-    let e = relative_frobenius_error(ut.pose.cov(), truth.propagated.pose.cov());
+    let e = relative_frobenius_error(ut.pose.cov(), &truth.cov);
     println!("SE(2) X·Y⁻¹·Z vs MC: sigma points {:.2} %", 100.0 * e);
     assert!(e < 0.03, "{e}");
 }
 
-/// R4's inputs and noise (REFERENCE_CASES): X_{k+1} = X_k Exp(u_k + w_k), 4 steps.
+/// The inputs and noise of [REFERENCE_CASES R4]: X_{k+1} = X_k Exp(u_k + w_k), 4 steps.
+///
+/// [REFERENCE_CASES R4]: posecov::reference_cases#r4-se3-odometry-noise-inside-exp-rob-530
 fn r4() -> (Vec<Vector6<f64>>, Matrix6<f64>) {
     let v1: [f64; 4] = [0.0, 4.0 / 3.0, 8.0 / 3.0, 4.0];
     let (w1, w2, w3) = (
@@ -144,16 +182,24 @@ fn r4_unscented(params: &Unscented) -> posecov::propagate::Propagated<Se3, 6> {
 fn close_to_monte_carlo_where_first_order_is_approximate() {
     let (inputs, noise) = r4();
     let start = UncertainPose::certain(Se3::identity());
-    let truth =
-        odometry_tangent_inputs(&start, &inputs, &noise, &MonteCarlo::new(100_000, 530)).unwrap();
+    let plan = odometry_plan(
+        Se3::identity(),
+        OdometryModel::Exp,
+        tangent_controls(&inputs),
+        noise,
+    );
+    let evaluation = evaluate_plan(plan, &mc_settings(100_000, 530));
+    let steps = nodes(&evaluation, "x");
+    assert_eq!(steps[4].step, Some(4));
+    let truth = mc_stats(steps[4]);
     let fo = propagate_tangent_inputs(&start, &inputs, &noise, InputNoise::RightJacobian).unwrap();
     let ut = r4_unscented(&Unscented::default());
-    let mc = truth[4].propagated.pose.cov();
+    let mc = &truth.cov;
     let (e_ut, e_fo) = (
         relative_frobenius_error(ut.pose.cov(), mc),
         relative_frobenius_error(fo[4].pose.cov(), mc),
     );
-    let offset = |m: &Se3| m.rminus(truth[4].propagated.pose.mean()).norm();
+    let offset = |m: &Se3| m.rminus(&truth.mean).norm();
     println!(
         "R4 step 4 vs MC: sigma points {:.2} % (mean offset {:.2e}), first order {:.2} % (mean offset {:.2e})",
         100.0 * e_ut,

@@ -9,8 +9,7 @@ use std::process::{Command, Stdio};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use posecov::scenario::Scenario;
-use posecov::scenario::eval::EvalOptions;
+use posecov::app::{Overrides, load, pipeline};
 use posecov::scene::{Color, ItemKind, PointCloud, Scene, SceneItem, Timing};
 use posecov::sink::{
     LogOutcome, RecordingIds, Sink, SinkError, log_scene_cancellable, open_stream,
@@ -31,13 +30,13 @@ fn ids(seed: u64) -> RecordingIds {
 }
 
 fn small_demo(seed: u64) -> Scene {
-    let scenario = Scenario::load_any(SCENARIO).expect("bundled");
-    let options = EvalOptions {
+    let loaded = load(SCENARIO).expect("bundled");
+    let overrides = Overrides {
         seed: Some(seed),
         samples: Some(60),
         ..Default::default()
     };
-    posecov::draw::scene_of(&scenario, &options).expect("evaluates")
+    pipeline(&loaded, &overrides, None).expect("evaluates").1
 }
 
 fn scratch_dir(name: &str) -> PathBuf {

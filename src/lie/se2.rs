@@ -205,6 +205,7 @@ impl LieGroup<3> for Se2 {
     type ActJacobian = Matrix2x3<f64>;
     type PointJacobian = Matrix2<f64>;
     const NAME: &'static str = "SE(2)";
+    const KIND: super::GroupKind = super::GroupKind::Se2;
 
     #[inline]
     fn identity() -> Self {
@@ -360,6 +361,10 @@ impl LieGroup<3> for Se2 {
             0.0,
             1.0,
         )
+    }
+
+    fn to_se3(&self) -> super::Se3 {
+        crate::convert::se2_to_se3(self)
     }
 }
 

@@ -211,6 +211,7 @@ impl LieGroup<6> for Se3 {
     type ActJacobian = Matrix3x6<f64>;
     type PointJacobian = Matrix3<f64>;
     const NAME: &'static str = "SE(3)";
+    const KIND: super::GroupKind = super::GroupKind::Se3;
 
     #[inline]
     fn identity() -> Self {
@@ -368,6 +369,10 @@ impl LieGroup<6> for Se3 {
             .copy_from(&self.rotation.to_matrix());
         m.fixed_view_mut::<3, 1>(0, 3).copy_from(&self.translation);
         m
+    }
+
+    fn to_se3(&self) -> super::Se3 {
+        *self
     }
 }
 

@@ -112,6 +112,7 @@ impl LieGroup<1> for So2 {
     type ActJacobian = Matrix2x1<f64>;
     type PointJacobian = Matrix2<f64>;
     const NAME: &'static str = "SO(2)";
+    const KIND: super::GroupKind = super::GroupKind::So2;
 
     #[inline]
     fn identity() -> Self {
@@ -200,6 +201,10 @@ impl LieGroup<1> for So2 {
     #[inline]
     fn to_matrix(&self) -> Matrix2<f64> {
         self.to_rotation2().into_inner()
+    }
+
+    fn to_se3(&self) -> super::Se3 {
+        super::Se3::from_parts(nalgebra::Vector3::zeros(), super::So3::from_rpy(0.0, 0.0, self.angle()))
     }
 }
 

@@ -262,6 +262,7 @@ impl LieGroup<3> for So3 {
     type ActJacobian = Matrix3<f64>;
     type PointJacobian = Matrix3<f64>;
     const NAME: &'static str = "SO(3)";
+    const KIND: super::GroupKind = super::GroupKind::So3;
 
     #[inline]
     fn identity() -> Self {
@@ -375,6 +376,10 @@ impl LieGroup<3> for So3 {
     #[inline]
     fn to_matrix(&self) -> Matrix3<f64> {
         self.quaternion.to_rotation_matrix().into_inner()
+    }
+
+    fn to_se3(&self) -> super::Se3 {
+        super::Se3::from_parts(nalgebra::Vector3::zeros(), *self)
     }
 }
 

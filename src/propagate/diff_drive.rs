@@ -5,7 +5,7 @@
 //! # Model
 //! Wheel radius r, wheelbase l, wheel angles driven by dφᵢ = ωᵢ dt + √D dWᵢ (i = 1, 2):
 //! dx = (r/2)(dφ₁ + dφ₂) cos θ, dy = (r/2)(dφ₁ + dφ₂) sin θ, dθ = (r/l)(dφ₁ − dφ₂).
-//! On SE(2) with the **right** (body) form and tangent [v₁, v₂, α] (CONVENTIONS §2):
+//! On SE(2) with the **right** (body) form and tangent [v₁, v₂, α] ([CONVENTIONS §2]):
 //! (g⁻¹ ġ)∨ dt = h dt + H dW, h = [(r/2)(ω₁ + ω₂), 0, (r/l)(ω₁ − ω₂)],
 //! H = [[r/2, r/2], [0, 0], [r/l, −r/l]]. For constant wheel rates μ(t) = Exp(t h) and, to
 //! first order (Long et al. 2012, eq. 19 and the integral after it),
@@ -30,6 +30,8 @@
 //! assert!((closed.pose.cov() - numeric.pose.cov()).amax() < 1e-9);
 //! assert!((closed.pose.cov()[(1, 1)] - 0.01815).abs() < 1e-12);
 //! ```
+//!
+//! [CONVENTIONS §2]: crate::conventions#2-tangent-vectors-and-their-order
 
 use nalgebra::{Matrix3, Matrix3x2, Vector2, Vector3};
 use rand::Rng;

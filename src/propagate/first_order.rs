@@ -1,4 +1,4 @@
-//! Operations on uncertain poses with their covariance, for both sides (CONVENTIONS §5).
+//! Operations on uncertain poses with their covariance, for both sides ([CONVENTIONS §5]).
 //!
 //! | operation | right form (X = μ Exp ε) | left form (X = Exp ε μ) | method |
 //! |---|---|---|---|
@@ -15,6 +15,8 @@
 //! μ Exp(ε) B = (μ B) Exp(Ad_{B⁻¹} ε); (μ Exp ε)⁻¹ = μ⁻¹ Exp(−Ad_μ ε) — so a Gaussian ε stays
 //! an exactly Gaussian ε′ (Solà et al. 2018 eq. 31). Composing two uncertain poses needs
 //! Exp(a) Exp(b) ≈ Exp(a + b) (BCH truncated after the first term): first order.
+//!
+//! [CONVENTIONS §5]: crate::conventions#5-first-order-propagation
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 
@@ -336,7 +338,7 @@ pub fn between_correlated<G: LieGroup<N>, const N: usize>(
     pair.push_forward(&z, pair.x.between_jacobians(&pair.y))
 }
 
-/// Z = X · Y of independent uncertain poses, first order (CONVENTIONS §5): right form
+/// Z = X · Y of independent uncertain poses, first order ([CONVENTIONS §5]): right form
 /// Σ_Z = Ad_{μY⁻¹} Σ_X Ad_{μY⁻¹}ᵀ + Σ_Y, left form Σ_X + Ad_{μX} Σ_Y Ad_{μX}ᵀ (Barfoot &
 /// Furgale 2014 §III-A, first-order term). The result is on the side of `x` (`y` is converted).
 ///
@@ -350,6 +352,8 @@ pub fn between_correlated<G: LieGroup<N>, const N: usize>(
 /// // a heading error of 0.1 rad swings a point 2 m ahead by 0.2 m sideways
 /// assert!((z.pose.cov()[(1, 1)] - 0.04).abs() < 1e-15);
 /// ```
+///
+/// [CONVENTIONS §5]: crate::conventions#5-first-order-propagation
 pub fn compose<G: LieGroup<N>, const N: usize>(
     x: &UncertainPose<G, N>,
     y: &UncertainPose<G, N>,

@@ -75,7 +75,9 @@ impl Order {
 }
 
 /// Known wrong transcriptions of eq. 55 found in public code: kept only so the test suite can
-/// show that the Gauss–Hermite oracle (REFERENCE_CASES R6) rejects each of them. Not API.
+/// show that the Gauss–Hermite oracle ([REFERENCE_CASES R6]) rejects each of them. Not API.
+///
+/// [REFERENCE_CASES R6]: crate::reference_cases#r6-a-deterministic-oracle-for-fourth-order
 #[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Variant {

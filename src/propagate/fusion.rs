@@ -23,9 +23,13 @@ use super::Propagated;
 /// When the Gauss–Newton iteration stops.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FusionOptions {
-    /// Iteration cap (CONVENTIONS §8: 100).
+    /// Iteration cap ([CONVENTIONS §8]: 100).
+    ///
+    /// [CONVENTIONS §8]: crate::conventions#8-sample-statistics
     pub max_iterations: usize,
-    /// Converged when the step norm ‖δ‖ falls below this (CONVENTIONS §8: 1e-10).
+    /// Converged when the step norm ‖δ‖ falls below this ([CONVENTIONS §8]: 1e-10).
+    ///
+    /// [CONVENTIONS §8]: crate::conventions#8-sample-statistics
     pub tolerance: f64,
 }
 

@@ -3,13 +3,13 @@
 //! Every operation returns a [`Propagated`]: the resulting [`UncertainPose`] and the
 //! [`Method`] that produced it. [`ResultRecord`] is the same result as plain serialisable
 //! data (for the JSON report and the viewer), with the relative Frobenius error against
-//! Monte Carlo where Monte Carlo ran.
+//! Monte Carlo where Monte Carlo ran. Monte Carlo itself is the evaluation engine's
+//! ([`crate::eval`]): particles flow through the operations of a [`crate::plan::Plan`].
 
 pub mod diff_drive;
 pub mod first_order;
 pub mod fourth_order;
 pub mod fusion;
-pub mod monte_carlo;
 pub mod odometry;
 pub mod sigma_point;
 pub mod vector_space;

@@ -1,5 +1,5 @@
 //! Odometry: first-order covariance recursions along a chain of noisy motions
-//! (CONVENTIONS §5), on either side.
+//! ([CONVENTIONS §5]), on either side.
 //!
 //! Two motion models:
 //! - [`propagate_increments`]: X_{k+1} = X_k · U_k · Exp(w_k), w_k ~ N(0, Σ_w) (the NA 568 /
@@ -12,7 +12,10 @@
 //! (entry 0 is the start unchanged). The covariance side is the start's: right form
 //! Σ_{k+1} = Ad_{U_k⁻¹} Σ_k Ad_{U_k⁻¹}ᵀ + Q_k, left form Σ_{k+1} = Σ_k + Ad_{X_{k+1}} Q_k
 //! Ad_{X_{k+1}}ᵀ, Q_k the body-frame noise at X_{k+1}. The two agree exactly after conversion
-//! (REFERENCE_CASES R3): Ad_{X_{k+1}} Ad_{U_k⁻¹} = Ad_{X_k}.
+//! ([REFERENCE_CASES R3]): Ad_{X_{k+1}} Ad_{U_k⁻¹} = Ad_{X_k}.
+//!
+//! [CONVENTIONS §5]: crate::conventions#5-first-order-propagation
+//! [REFERENCE_CASES R3]: crate::reference_cases#r3-right-form-against-left-form
 
 use serde::{Deserialize, Serialize};
 
@@ -30,7 +33,9 @@ pub enum InputNoise {
     /// The correct first order; [`Method::FirstOrder`].
     RightJacobian,
     /// Q = Σ_w, as in the ROB 530 SE(3) script: 16–25 % low against Monte Carlo for large
-    /// rotational inputs (REFERENCE_CASES R4). [`Method::LectureNoJr`].
+    /// rotational inputs ([REFERENCE_CASES R4]). [`Method::LectureNoJr`].
+    ///
+    /// [REFERENCE_CASES R4]: crate::reference_cases#r4-se3-odometry-noise-inside-exp-rob-530
     LectureNoJr,
 }
 

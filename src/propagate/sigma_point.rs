@@ -22,7 +22,7 @@
 //! (X · Exp(ε) · Y = XY · Exp(Ad_{Y⁻¹} ε)), so for compose, between, inverse and their chains
 //! the unscented covariance equals the first-order one (cross terms between inputs, which
 //! 4th-order compounding captures, never appear). It differs where the nonlinearity sits
-//! inside one input, e.g. X · Exp(u + w) (REFERENCE_CASES R4) or a map using an input twice.
+//! inside one input, e.g. X · Exp(u + w) ([REFERENCE_CASES R4]) or a map using an input twice.
 //!
 //! # Parameters
 //! Defaults α = 1, β = 2, κ = 0 (λ = 0: points at ±√L σ, W₀⁽ᵐ⁾ = 0, all weights ≥ 0, so the
@@ -37,6 +37,8 @@
 //! let z = compose(&a, &a, &Unscented::default()).unwrap();
 //! assert_eq!(z.method, Method::SigmaPoints);
 //! ```
+//!
+//! [REFERENCE_CASES R4]: crate::reference_cases#r4-se3-odometry-noise-inside-exp-rob-530
 
 use crate::error::{Error, Result};
 use crate::lie::{LieGroup, TangentMatrix};

@@ -16,10 +16,10 @@
 //!
 //! # Example
 //! ```
-//! use posecov::scenario::{Scenario, eval::EvalOptions};
+//! use posecov::app::{Overrides, load, pipeline};
 //! use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
-//! let scenario = Scenario::load_any("camera_on_robot")?;
-//! let scene = posecov::draw::scene_of(&scenario, &EvalOptions { samples: Some(50), ..Default::default() })?;
+//! let loaded = load("camera_on_robot")?;
+//! let (_, scene) = pipeline(&loaded, &Overrides { samples: Some(50), ..Default::default() }, None)?;
 //! let bytes = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("camera_on_robot", 1))?;
 //! assert!(bytes.len() > 1000);
 //! # Ok::<(), Box<dyn std::error::Error>>(())

@@ -139,8 +139,8 @@ fn log_items(
 }
 
 /// The layout sent with a scene: the 3-D view of `world` on the left (two thirds); on the
-/// right the description above one plot per quantity (`plots/<quantity>/…`), or the
-/// description alone when the scene has no series. The time panel shows the `step` timeline,
+/// right the description above one view per [`Plot`](crate::scene::Plot) (its title and unit
+/// as the view's name), or the description alone when the scene has no plots. The time panel shows the `step` timeline,
 /// following the latest data, so a recording opens on its last step instead of replaying.
 ///
 /// ```
@@ -149,21 +149,12 @@ fn log_items(
 pub fn blueprint_for(scene: &Scene) -> Blueprint {
     let view3d = Spatial3DView::new("3D").with_origin(scene::WORLD);
     let text = TextDocumentView::new("Description").with_origin(scene::DESCRIPTION);
-    let mut groups: Vec<(String, String)> = Vec::new();
-    for series in &scene.series {
-        let mut parts = series.path.split('/');
-        if let (Some(_), Some(group)) = (parts.next(), parts.next())
-            && !groups.iter().any(|(g, _)| g == group)
-        {
-            groups.push((group.to_owned(), plot_title(group)));
-        }
-    }
     let mut right: Vec<rr::blueprint::ContainerLike> = vec![text.into()];
     let mut shares = vec![3.0];
-    for (group, title) in &groups {
+    for plot in &scene.plots {
         right.push(
-            TimeSeriesView::new(title.clone())
-                .with_origin(format!("{}/{group}", scene::PLOTS))
+            TimeSeriesView::new(plot.label())
+                .with_origin(format!("{}/{}", scene::PLOTS, plot.id))
                 .into(),
         );
         shares.push(2.0);
@@ -179,12 +170,6 @@ pub fn blueprint_for(scene: &Scene) -> Blueprint {
                 .with_timeline(STEP_TIMELINE)
                 .with_play_state(rr::blueprint::components::PlayState::Following),
         )
-}
-
-/// A plot title from its entity segment `<index>_<quantity_slug>`.
-fn plot_title(group: &str) -> String {
-    let name = group.split_once('_').map_or(group, |(_, rest)| rest);
-    name.replace('_', " ")
 }
 
 /// Sends one row with all `parts` as one chunk: no log time, no batcher, fixed order.

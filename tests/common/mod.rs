@@ -1,8 +1,14 @@
 //! Shared test helpers: seeded tangent samples in four regimes and central finite
-//! differences on the manifold. Used by every group suite.
+//! differences on the manifold. Used by every group suite. Also Monte Carlo through the
+//! plan + eval engine (the crate's one Monte Carlo engine): settings, evaluation, node access.
 #![allow(dead_code)]
 
 use nalgebra::{SMatrix, SVector};
+use posecov::eval::{AnyEvaluation, EvalSettings, Evaluation, Node, evaluate};
+use posecov::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
+use posecov::plan::{AnyPlan, Control, OdometryModel, Op, Plan, StepPolicy};
+use posecov::sample::SampleStatistics;
+use posecov::uncertain::Method;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -130,7 +136,9 @@ pub fn uncentred_cov<const N: usize>(samples: &[SVector<f64, N>]) -> SMatrix<f64
     cov / samples.len() as f64
 }
 
-/// REFERENCE_CASES R4 inputs u_k = (v1, 1.5 v1, 0.05 e^(0.6 v1) − 0.05, ω1, ω2, ω3), k = 0..3.
+/// [REFERENCE_CASES R4] inputs u_k = (v1, 1.5 v1, 0.05 e^(0.6 v1) − 0.05, ω1, ω2, ω3), k = 0..3.
+///
+/// [REFERENCE_CASES R4]: posecov::reference_cases#r4-se3-odometry-noise-inside-exp-rob-530
 pub fn r4_inputs() -> Vec<nalgebra::Vector6<f64>> {
     let v1: [f64; 4] = [0.0, 4.0 / 3.0, 8.0 / 3.0, 4.0];
     let w1 = [0.0, 1.0 / 6.0, 1.0 / 3.0, 0.5];
@@ -150,7 +158,9 @@ pub fn r4_inputs() -> Vec<nalgebra::Vector6<f64>> {
         .collect()
 }
 
-/// REFERENCE_CASES R4 noise Σ_w = diag(0.01², 0.01², 0.05², 0.05², 0.05², 0.2²).
+/// [REFERENCE_CASES R4] noise Σ_w = diag(0.01², 0.01², 0.05², 0.05², 0.05², 0.2²).
+///
+/// [REFERENCE_CASES R4]: posecov::reference_cases#r4-se3-odometry-noise-inside-exp-rob-530
 pub fn r4_noise() -> nalgebra::Matrix6<f64> {
     nalgebra::Matrix6::from_diagonal(&nalgebra::Vector6::new(
         0.01f64.powi(2),
@@ -160,4 +170,139 @@ pub fn r4_noise() -> nalgebra::Matrix6<f64> {
         0.05f64.powi(2),
         0.2f64.powi(2),
     ))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Monte Carlo through the plan + eval engine.
+
+/// A group whose plans the helpers below evaluate: into [`AnyPlan`] and back out of
+/// [`AnyEvaluation`].
+pub trait PlanGroup<const N: usize>: LieGroup<N> {
+    /// The plan as an [`AnyPlan`].
+    fn any_plan(plan: Plan<Self, N>) -> AnyPlan;
+    /// The evaluation of this group (panics on another group).
+    fn evaluation(e: AnyEvaluation) -> Evaluation<Self, N>;
+}
+
+macro_rules! plan_group {
+    ($g:ty, $n:literal, $v:ident) => {
+        impl PlanGroup<$n> for $g {
+            fn any_plan(plan: Plan<Self, $n>) -> AnyPlan {
+                AnyPlan::$v(plan)
+            }
+            fn evaluation(e: AnyEvaluation) -> Evaluation<Self, $n> {
+                match e {
+                    AnyEvaluation::$v(e) => e,
+                    other => panic!("expected {}, got {:?}", stringify!($v), other.group()),
+                }
+            }
+        }
+    };
+}
+plan_group!(So2, 1, So2);
+plan_group!(Se2, 3, Se2);
+plan_group!(So3, 3, So3);
+plan_group!(Se3, 6, Se3);
+
+/// Monte Carlo only: `samples` particles from `seed`, simulated in one block (so every kept
+/// node's `particles` is the whole sample), every step of a propagation recorded and kept.
+pub fn mc_settings(samples: usize, seed: u64) -> EvalSettings {
+    EvalSettings {
+        samples,
+        seed,
+        methods: vec![Method::MonteCarlo],
+        block_samples: Some(samples),
+        steps: StepPolicy {
+            max_recorded: u64::MAX,
+            max_detailed: u64::MAX,
+        },
+        ..Default::default()
+    }
+}
+
+/// Evaluates `plan` (panics on an error).
+pub fn evaluate_plan<G: PlanGroup<N>, const N: usize>(
+    plan: Plan<G, N>,
+    settings: &EvalSettings,
+) -> Evaluation<G, N> {
+    G::evaluation(evaluate(&G::any_plan(plan), settings).expect("the plan evaluates"))
+}
+
+/// The nodes named `name`, in evaluation order (step 0 first for a propagation).
+pub fn nodes<'e, G: LieGroup<N>, const N: usize>(
+    e: &'e Evaluation<G, N>,
+    name: &str,
+) -> Vec<&'e Node<G, N>> {
+    let found: Vec<_> = e.nodes.iter().filter(|n| n.name == name).collect();
+    assert!(!found.is_empty(), "no node named {name}");
+    found
+}
+
+/// A node's Monte Carlo statistics: the Lie mean and the centred 1/(N−1) covariance, right
+/// side (panics where Monte Carlo did not run).
+pub fn mc_stats<G: LieGroup<N>, const N: usize>(node: &Node<G, N>) -> SampleStatistics<G, N> {
+    let stats = node
+        .monte_carlo
+        .as_ref()
+        .unwrap_or_else(|| panic!("{} (step {:?}): no Monte Carlo", node.name, node.step))
+        .stats;
+    assert_eq!(
+        node.estimates.last().map(|e| e.result.method),
+        Some(Method::MonteCarlo),
+        "the Monte Carlo estimate comes last"
+    );
+    stats
+}
+
+/// A node's particles (panics where it kept none).
+pub fn particles<G: LieGroup<N>, const N: usize>(node: &Node<G, N>) -> &[G] {
+    node.particles
+        .as_deref()
+        .unwrap_or_else(|| panic!("{} (step {:?}): no particles", node.name, node.step))
+}
+
+/// Odometry controls from increments U_k (u_k = Log U_k).
+pub fn increment_controls<G: LieGroup<N>, const N: usize>(increments: &[G]) -> Vec<Control<G, N>> {
+    increments
+        .iter()
+        .map(|u| Control {
+            increment: *u,
+            tangent: u.log(),
+        })
+        .collect()
+}
+
+/// Odometry controls from tangents u_k (U_k = Exp u_k).
+pub fn tangent_controls<G: LieGroup<N>, const N: usize>(
+    inputs: &[Tangent<N>],
+) -> Vec<Control<G, N>> {
+    inputs
+        .iter()
+        .map(|u| Control {
+            increment: G::exp(u),
+            tangent: *u,
+        })
+        .collect()
+}
+
+/// A plan of one odometry operation, output `x`, from the known pose `start`: nodes `x` at
+/// steps 0 ..= controls.len().
+pub fn odometry_plan<G: LieGroup<N>, const N: usize>(
+    start: G,
+    model: OdometryModel,
+    controls: Vec<Control<G, N>>,
+    noise: TangentMatrix<N>,
+) -> Plan<G, N> {
+    let mut plan = Plan::default();
+    let input = plan.known("start", start);
+    plan.operation(
+        "x",
+        Op::Odometry {
+            input,
+            model,
+            controls,
+            noise,
+        },
+    );
+    plan
 }

@@ -1,12 +1,13 @@
-//! Scenario files: TOML in, validated poses and operations out.
+//! Scenario files: TOML in, a checked [`Input`](crate::input::Input) out.
 //!
 //! A scenario names poses (mean + optional covariance) and the operations applied to them
 //! (compose, invert, change frame, odometry, fusion, …), the methods to compare and what to
-//! draw. [`Scenario::parse`] checks everything a user can get wrong and reports it as
-//! `file:line:column: field: message` with the offending source line.
+//! draw. [`Scenario::parse`] reads the TOML (syntax, types, unknown keys); [`lower`] checks
+//! everything else and produces the typed plan. Every error is reported as
+//! `file:line:column: key: message` with the offending source line.
 //!
 //! ```
-//! use posecov::scenario::Scenario;
+//! use posecov::input::scenario::{Scenario, lower};
 //! let text = r#"
 //! [scenario]
 //! title = "demo"
@@ -18,9 +19,10 @@
 //! "#;
 //! let s = Scenario::parse(text, "demo.toml").unwrap();
 //! assert_eq!(s.file.poses.len(), 1);
-//! // Values are checked when the scenario is evaluated, with their place in the file.
+//! assert!(lower(&s).is_ok());
+//! // Values are checked by the lowering, with their place in the file.
 //! let bad = Scenario::parse(&text.replace("0.2]", "nan]"), "demo.toml").unwrap();
-//! let err = posecov::scenario::eval::evaluate(&bad, &Default::default()).unwrap_err();
+//! let err = lower(&bad).unwrap_err();
 //! assert!(err.to_string().starts_with("demo.toml:8:"), "{err}");
 //! ```
 
@@ -29,14 +31,14 @@ use std::ops::Range;
 use std::path::Path;
 
 pub mod bundled;
-pub mod eval;
-pub mod groups;
-pub mod model;
+mod lower;
+mod parse_errors;
 pub mod schema;
-mod spec;
+mod values;
 
+pub use lower::{OPERATION_KINDS, lower};
 pub use schema::{GroupName, ScenarioFile};
-pub use spec::SpecGroup;
+pub use values::{SpecGroup, ValueError};
 
 /// A scenario file could not be read, parsed or validated.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,6 +67,8 @@ pub enum ScenarioError {
     },
 }
 
+impl std::error::Error for ScenarioError {}
+
 impl fmt::Display for ScenarioError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -90,7 +94,6 @@ impl fmt::Display for ScenarioError {
     }
 }
 
-impl std::error::Error for ScenarioError {}
 
 /// Maps byte spans of one source text to `line:column` errors.
 #[derive(Debug, Clone)]
@@ -103,7 +106,7 @@ impl Locator {
     /// A locator for `text` read from `file`.
     ///
     /// ```
-    /// use posecov::scenario::Locator;
+    /// use posecov::input::scenario::Locator;
     /// let l = Locator::new("a.toml", "x = 1\ny = 2\n");
     /// assert_eq!(l.error(6..7, "y", "bad").to_string().lines().next().unwrap(), "a.toml:2:1: y: bad");
     /// ```
@@ -117,7 +120,7 @@ impl Locator {
     /// An error at the start of `span`.
     ///
     /// ```
-    /// use posecov::scenario::Locator;
+    /// use posecov::input::scenario::Locator;
     /// let e = Locator::new("f.toml", "abc").error(1..2, "k", "m");
     /// assert!(e.to_string().starts_with("f.toml:1:2: k: m"));
     /// ```
@@ -166,19 +169,23 @@ pub struct Scenario {
 
 impl Scenario {
     /// Parses TOML text; `origin` names the file in messages. Unknown keys, wrong types and
-    /// TOML syntax errors are reported with their location. Semantic checks (covariances,
-    /// names, operation arguments) happen in [`eval::evaluate`], with locations too.
+    /// TOML syntax errors are reported with their location and key, in the file's words.
+    /// Semantic checks (covariances, names, operation arguments) happen in [`lower`], with
+    /// locations too.
     ///
     /// ```
-    /// use posecov::scenario::Scenario;
+    /// use posecov::input::scenario::Scenario;
     /// let e = Scenario::parse("[scenario]\ntitle = 'x'\ngroup = 'se4'\n", "x.toml").unwrap_err();
-    /// assert!(e.to_string().contains("x.toml:3:"), "{e}");
+    /// assert!(e.to_string().starts_with("x.toml:3:9: scenario.group:"), "{e}");
+    /// let e = Scenario::parse("[scenario]\ntitle = 'x'\ngroup = 'se2'\nsamples = -5\n", "x.toml").unwrap_err();
+    /// assert!(e.to_string().starts_with("x.toml:4:11: scenario.samples: -5 is not a whole number ≥ 0"), "{e}");
     /// ```
     pub fn parse(text: &str, origin: &str) -> Result<Self, ScenarioError> {
         let locator = Locator::new(origin, text);
         let file: ScenarioFile = toml::from_str(text).map_err(|e| {
             let span = e.span().unwrap_or(0..0);
-            locator.error(span, "toml", e.message().trim().to_owned())
+            let field = parse_errors::key_at(text, span.start);
+            locator.error(span, &field, parse_errors::in_file_words(e.message()))
         })?;
         Ok(Self { file, locator })
     }
@@ -187,7 +194,7 @@ impl Scenario {
     /// name that is not a file either gets an error listing the bundled names.
     ///
     /// ```
-    /// use posecov::scenario::Scenario;
+    /// use posecov::input::scenario::Scenario;
     /// assert!(Scenario::load_any("so3_sampling").is_ok());
     /// let e = Scenario::load_any("no_such_scenario").unwrap_err().to_string();
     /// assert!(e.contains("camera_on_robot"), "{e}");
@@ -212,10 +219,28 @@ impl Scenario {
         }
     }
 
+    /// An error about operation `index` (at its `kind`, key `operation[index]`), or about the
+    /// file as a whole when `index` is `None` or out of range.
+    ///
+    /// ```
+    /// use posecov::input::scenario::Scenario;
+    /// let s = Scenario::parse("[scenario]\ntitle='t'\ngroup='so3'\n[[operation]]\nkind='euler_vs_exp'\noutput='r'\nrate=[0,0,1]\ndt=0.1\nsteps=3\n", "t.toml").unwrap();
+    /// assert!(s.operation_error(Some(0), "too big").to_string().starts_with("t.toml:5:8: operation[0]: too big"));
+    /// assert!(s.operation_error(None, "odd").to_string().starts_with("t.toml:1:1: file: odd"));
+    /// ```
+    pub fn operation_error(&self, index: Option<usize>, message: impl Into<String>) -> ScenarioError {
+        match index.and_then(|i| self.file.operations.get(i).map(|op| (i, op))) {
+            Some((i, op)) => self
+                .locator
+                .error(op.kind.span(), &format!("operation[{i}]"), message),
+            None => self.locator.error(0..0, "file", message),
+        }
+    }
+
     /// Reads and parses a scenario file.
     ///
     /// ```
-    /// use posecov::scenario::Scenario;
+    /// use posecov::input::scenario::Scenario;
     /// let e = Scenario::load(std::path::Path::new("/no/such/file.toml")).unwrap_err();
     /// assert!(e.to_string().starts_with("/no/such/file.toml: cannot read scenario"));
     /// ```

@@ -1,13 +1,12 @@
-//! Group-specific operations of the scenario evaluator: what only some groups can do
+//! Group-specific operations of the evaluator: what only some groups can do
 //! (differential drive on SE(2), Euler vs Exp on SO(3), compounding and the vector-space
 //! baseline on SE(2)/SE(3)), behind one trait the generic engine calls.
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::SpecGroup;
-use super::spec::fixed_matrix;
 use crate::interop::VectorChart;
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, TangentMatrix};
+use crate::plan::DiffDriveMotion;
 use crate::propagate::Propagated;
 use crate::propagate::diff_drive::{DiffDrive, EulerMaruyama};
 use crate::propagate::first_order;
@@ -16,17 +15,15 @@ use crate::propagate::vector_space::{VectorPose, ssc_compose, ssc_odometry};
 use crate::uncertain::UncertainPose;
 
 /// Group-specific operations the generic engine asks for; `None` where a group has none.
-pub trait EvalGroup<const N: usize>: SpecGroup<N> {
-    /// Coordinates of a point of the space the group acts on (2 or 3).
-    fn point_dims() -> usize;
-
-    /// An uncertain point p (covariance rows `cov`, in the pose's frame) seen from an
-    /// uncertain pose, to first order: (mean, covariance) in world coordinates, lifted to 3D.
+pub trait EvalGroup<const N: usize>: LieGroup<N> {
+    /// An uncertain point p (covariance Σ_p, in the pose's frame; planar groups read x, y)
+    /// seen from an uncertain pose, to first order: (mean, covariance) in world coordinates,
+    /// lifted to 3D (z = 0 in the plane).
     fn point_through(
         pose: &UncertainPose<Self, N>,
-        point: &[f64],
-        cov: &[Vec<f64>],
-    ) -> Result<([f64; 3], [[f64; 3]; 3]), String>;
+        point: &Vector3<f64>,
+        cov: &Matrix3<f64>,
+    ) -> crate::Result<(Vector3<f64>, Matrix3<f64>)>;
 
     /// 2nd/4th-order compounding Z = X·Y (Barfoot & Furgale 2014), where defined.
     fn compound(
@@ -55,8 +52,16 @@ pub trait EvalGroup<const N: usize>: SpecGroup<N> {
         None
     }
 
-    /// Differential drive (Long et al. 2012), SE(2) only.
-    fn diff_drive(_params: &DiffDriveParams) -> Option<crate::Result<DiffDriveOutcome<Self, N>>> {
+    /// Differential drive (Long et al. 2012), SE(2) only: closed form, the numeric integral
+    /// (when `integral`) and `samples` Euler–Maruyama end poses from chunk `first_chunk` of
+    /// the stream `seed`.
+    fn diff_drive(
+        _motion: &DiffDriveMotion,
+        _integral: bool,
+        _samples: usize,
+        _first_chunk: u64,
+        _seed: u64,
+    ) -> Option<crate::Result<DiffDriveOutcome<Self, N>>> {
         None
     }
 
@@ -68,32 +73,6 @@ pub trait EvalGroup<const N: usize>: SpecGroup<N> {
     ) -> Option<Vec<(Matrix3<f64>, Self)>> {
         None
     }
-}
-
-/// Parameters of a `diff_drive` operation (validated by [`DiffDrive::try_new`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DiffDriveParams {
-    /// Wheel radius r (m).
-    pub wheel_radius: f64,
-    /// Wheelbase l (m).
-    pub wheelbase: f64,
-    /// Duration T (s).
-    pub duration: f64,
-    /// Wheel noise intensity D.
-    pub diffusion: f64,
-    /// Forward speed v (m/s).
-    pub speed: f64,
-    /// Turn rate α̇ (rad/s).
-    pub turn_rate: f64,
-    /// Euler–Maruyama step (s).
-    pub dt: f64,
-    /// Monte Carlo samples (0: none).
-    pub samples: usize,
-    /// Chunk index of the first sample (a block of a larger sample; see
-    /// [`EulerMaruyama::first_chunk`](crate::propagate::diff_drive::EulerMaruyama::first_chunk)).
-    pub first_chunk: u64,
-    /// Seed.
-    pub seed: u64,
 }
 
 /// What a differential-drive run produces.
@@ -115,9 +94,9 @@ const DIFF_DRIVE_TRAJECTORIES: usize = 30;
 /// First-order point through pose for a group acting on ℝᴰ, lifted to 3D (z = 0 in the plane).
 fn point_estimate<G, const N: usize, const D: usize>(
     pose: &UncertainPose<G, N>,
-    point: &[f64],
-    cov: &[Vec<f64>],
-) -> Result<([f64; 3], [[f64; 3]; 3]), String>
+    point: &Vector3<f64>,
+    cov: &Matrix3<f64>,
+) -> crate::Result<(Vector3<f64>, Matrix3<f64>)>
 where
     G: LieGroup<
             N,
@@ -127,16 +106,12 @@ where
         >,
 {
     let p = nalgebra::SVector::<f64, D>::from_iterator(point.iter().copied());
-    let c = fixed_matrix::<D, D>("point_cov", cov)?;
-    let q = first_order::act_point(pose, &p, &c).map_err(|e| e.to_string())?;
-    let mut mean = [0.0; 3];
-    let mut cov3 = [[0.0; 3]; 3];
-    for (r, row) in cov3.iter_mut().enumerate().take(D) {
-        mean[r] = q.mean[r];
-        for (c, value) in row.iter_mut().enumerate().take(D) {
-            *value = q.cov[(r, c)];
-        }
-    }
+    let c = cov.fixed_view::<D, D>(0, 0).into_owned();
+    let q = first_order::act_point(pose, &p, &c)?;
+    let mut mean = Vector3::zeros();
+    let mut cov3 = Matrix3::zeros();
+    mean.fixed_rows_mut::<D>(0).copy_from(&q.mean);
+    cov3.fixed_view_mut::<D, D>(0, 0).copy_from(&q.cov);
     Ok((mean, cov3))
 }
 
@@ -164,27 +139,21 @@ fn ssc_odometry_in<G: VectorChart<N>, const N: usize>(
 }
 
 impl EvalGroup<1> for So2 {
-    fn point_dims() -> usize {
-        2
-    }
     fn point_through(
         pose: &UncertainPose<Self, 1>,
-        point: &[f64],
-        cov: &[Vec<f64>],
-    ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+        point: &Vector3<f64>,
+        cov: &Matrix3<f64>,
+    ) -> crate::Result<(Vector3<f64>, Matrix3<f64>)> {
         point_estimate::<Self, 1, 2>(pose, point, cov)
     }
 }
 
 impl EvalGroup<3> for So3 {
-    fn point_dims() -> usize {
-        3
-    }
     fn point_through(
         pose: &UncertainPose<Self, 3>,
-        point: &[f64],
-        cov: &[Vec<f64>],
-    ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+        point: &Vector3<f64>,
+        cov: &Matrix3<f64>,
+    ) -> crate::Result<(Vector3<f64>, Matrix3<f64>)> {
         point_estimate::<Self, 3, 3>(pose, point, cov)
     }
     fn euler_vs_exp(rate: &Vector3<f64>, dt: f64, steps: u64) -> Option<Vec<(Matrix3<f64>, Self)>> {
@@ -206,14 +175,11 @@ impl EvalGroup<3> for So3 {
 /// the Smith–Self–Cheeseman baseline in their vector coordinates.
 macro_rules! pose_group_ops {
     ($N:literal, $D:literal, $compound:path) => {
-        fn point_dims() -> usize {
-            $D
-        }
         fn point_through(
             pose: &UncertainPose<Self, $N>,
-            point: &[f64],
-            cov: &[Vec<f64>],
-        ) -> Result<([f64; 3], [[f64; 3]; 3]), String> {
+            point: &Vector3<f64>,
+            cov: &Matrix3<f64>,
+        ) -> crate::Result<(Vector3<f64>, Matrix3<f64>)> {
             point_estimate::<Self, $N, $D>(pose, point, cov)
         }
         fn compound(
@@ -242,7 +208,13 @@ macro_rules! pose_group_ops {
 impl EvalGroup<3> for Se2 {
     pose_group_ops!(3, 2, fourth_order::compound_se2);
 
-    fn diff_drive(p: &DiffDriveParams) -> Option<crate::Result<DiffDriveOutcome<Self, 3>>> {
+    fn diff_drive(
+        p: &DiffDriveMotion,
+        integral: bool,
+        samples: usize,
+        first_chunk: u64,
+        seed: u64,
+    ) -> Option<crate::Result<DiffDriveOutcome<Self, 3>>> {
         Some((|| {
             let robot = DiffDrive::try_new(p.wheel_radius, p.wheelbase, p.diffusion)?;
             let closed = if p.turn_rate == 0.0 {
@@ -251,21 +223,24 @@ impl EvalGroup<3> for Se2 {
                 robot.arc_closed_form(p.speed, p.turn_rate, p.duration)?
             };
             let rates = robot.wheel_rates_for(p.speed, p.turn_rate);
-            let integral = robot.numeric_integral(rates, p.duration, 1e-12)?;
+            let mut estimates = vec![closed];
+            if integral {
+                estimates.push(robot.numeric_integral(rates, p.duration, 1e-12)?);
+            }
             let nominal_path = (0..=100)
                 .map(|i| robot.nominal(rates, p.duration * f64::from(i) / 100.0))
                 .collect();
-            let (end_poses, trajectories) = if p.samples > 0 {
-                let settings = EulerMaruyama::new(p.dt, p.samples, p.seed)
+            let (end_poses, trajectories) = if samples > 0 {
+                let settings = EulerMaruyama::new(p.dt, samples, seed)
                     .with_trajectories(DIFF_DRIVE_TRAJECTORIES, 10)
-                    .starting_at_chunk(p.first_chunk);
+                    .starting_at_chunk(first_chunk);
                 let sde = robot.euler_maruyama(rates, p.duration, &settings)?;
                 (sde.end_poses, sde.trajectories)
             } else {
                 (Vec::new(), Vec::new())
             };
             Ok(DiffDriveOutcome {
-                estimates: vec![closed, integral],
+                estimates,
                 end_poses,
                 trajectories,
                 nominal_path,

@@ -26,35 +26,8 @@ pub struct ScenarioFile {
     pub draw: DrawSpec,
 }
 
-/// The Lie group every pose of a scenario lives in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum GroupName {
-    /// Planar rotations.
-    So2,
-    /// Planar poses, tangent [x, y, θ].
-    Se2,
-    /// 3D rotations, tangent θ ∈ ℝ³.
-    So3,
-    /// 3D poses, tangent [ρ; θ].
-    Se3,
-}
-
-impl GroupName {
-    /// Degrees of freedom: 1, 3, 3, 6.
-    ///
-    /// ```
-    /// use posecov::scenario::schema::GroupName;
-    /// assert_eq!(GroupName::Se3.dof(), 6);
-    /// ```
-    pub fn dof(self) -> usize {
-        match self {
-            GroupName::So2 => 1,
-            GroupName::Se2 | GroupName::So3 => 3,
-            GroupName::Se3 => 6,
-        }
-    }
-}
+/// The Lie group every pose of a scenario lives in (`group = "se2"` etc.).
+pub use crate::lie::GroupKind as GroupName;
 
 /// `[scenario]`: what this scenario is and how to evaluate it.
 #[derive(Debug, Clone, Deserialize)]
@@ -178,7 +151,7 @@ pub struct CovSpec {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OperationSpec {
-    /// One of the [`OPERATION_KINDS`].
+    /// One of the [`OPERATION_KINDS`](super::lower::OPERATION_KINDS).
     pub kind: Spanned<String>,
     /// Name of the pose this operation creates.
     pub output: Spanned<String>,
@@ -224,22 +197,43 @@ pub struct OperationSpec {
     pub rate: Option<Spanned<Vec<f64>>>,
 }
 
-/// Every operation kind the evaluator knows.
-pub const OPERATION_KINDS: &[&str] = &[
-    "inverse",
-    "change_frame_left",
-    "change_frame_right",
-    "compose",
-    "between",
-    "compose_correlated",
-    "between_correlated",
-    "odometry",
-    "compound",
-    "diff_drive",
-    "point_through_pose",
-    "fuse",
-    "euler_vs_exp",
-];
+impl OperationSpec {
+    /// The names of the keys set besides `kind` and `output`.
+    ///
+    /// ```
+    /// let op: posecov::input::scenario::schema::OperationSpec =
+    ///     toml::from_str("kind = 'inverse'\noutput = 'b'\ninput = 'a'\n").unwrap();
+    /// assert_eq!(op.keys_set(), vec!["input"]);
+    /// ```
+    pub fn keys_set(&self) -> Vec<&'static str> {
+        [
+            ("input", self.input.is_some()),
+            ("lhs", self.lhs.is_some()),
+            ("rhs", self.rhs.is_some()),
+            ("by", self.by.is_some()),
+            ("inputs", self.inputs.is_some()),
+            ("cross_cov", self.cross_cov.is_some()),
+            ("controls", self.controls.is_some()),
+            ("steps", self.steps.is_some()),
+            ("noise", self.noise.is_some()),
+            ("model", self.model.is_some()),
+            ("point", self.point.is_some()),
+            ("point_cov", self.point_cov.is_some()),
+            ("wheel_radius", self.wheel_radius.is_some()),
+            ("wheelbase", self.wheelbase.is_some()),
+            ("duration", self.duration.is_some()),
+            ("diffusion", self.diffusion.is_some()),
+            ("speed", self.speed.is_some()),
+            ("turn_rate", self.turn_rate.is_some()),
+            ("dt", self.dt.is_some()),
+            ("rate", self.rate.is_some()),
+        ]
+        .iter()
+        .filter(|(_, on)| *on)
+        .map(|(k, _)| *k)
+        .collect()
+    }
+}
 
 /// `[draw]`: what the viewer shows (all default to true).
 #[derive(Debug, Clone, Deserialize)]
@@ -268,7 +262,7 @@ pub struct DrawSpec {
     pub trajectories: bool,
     /// Length of the mean frames' axes (m); default from the scene size.
     #[serde(default)]
-    pub axis_length: Option<f64>,
+    pub axis_length: Option<Spanned<f64>>,
     /// How the 3D view faces the scene; default `top` for planar groups, else `perspective`.
     #[serde(default)]
     pub view: Option<View>,
@@ -285,17 +279,8 @@ pub enum View {
 }
 
 impl Default for DrawSpec {
+    /// Every switch on, no axis length, no view: the values of an empty `[draw]` table.
     fn default() -> Self {
-        Self {
-            axes: true,
-            clouds: true,
-            sample_axes: true,
-            ellipsoids: true,
-            bananas: true,
-            orientation: true,
-            trajectories: true,
-            axis_length: None,
-            view: None,
-        }
+        toml::from_str("").unwrap_or_else(|_| unreachable!("every [draw] key has a default"))
     }
 }

@@ -14,7 +14,7 @@ macro_rules! bundled {
     ($($name:literal),* $(,)?) => {
         /// Every bundled scenario, in teaching order.
         pub const BUNDLED: &[Bundled] = &[
-            $(Bundled { name: $name, text: include_str!(concat!("../../assets/scenarios/", $name, ".toml")) }),*
+            $(Bundled { name: $name, text: include_str!(concat!("../../../assets/scenarios/", $name, ".toml")) }),*
         ];
     };
 }
@@ -37,7 +37,7 @@ bundled!(
 /// The bundled scenario called `name` (with or without `.toml`).
 ///
 /// ```
-/// use posecov::scenario::bundled::find;
+/// use posecov::input::scenario::bundled::find;
 /// assert!(find("camera_on_robot").is_some());
 /// assert!(find("camera_on_robot.toml").is_some());
 /// assert!(find("nope").is_none());

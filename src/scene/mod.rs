@@ -4,7 +4,7 @@
 //! Rerun: it is a list of [`SceneItem`]s (frames, triad batches, point clouds, ellipsoids,
 //! surfaces, line strips, arrows, text) plus [`ScalarSeries`] for plots, each item placed on
 //! an entity path and either static or at an integer `step` of the propagation timeline.
-//! [`crate::sink`] turns it into Rerun archetypes; tests can inspect it directly.
+//! `crate::sink` turns it into Rerun archetypes; tests can inspect it directly.
 //!
 //! # Conventions at this boundary
 //! - Numbers are `f64` here; the sink converts to `f32` (Rerun speaks glam/f32). A value
@@ -266,6 +266,34 @@ impl SceneItem {
     }
 }
 
+/// A plot: one time-series view of the lines under `plots/<id>/…`. Title and unit are data,
+/// written by the drawing stage and shown by the sink as they are.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plot {
+    /// Entity segment under [`PLOTS`] (letters, digits, `_`).
+    pub id: String,
+    /// What is plotted and in which frame, e.g. "trace of position covariance, body frame".
+    pub title: String,
+    /// The unit of the values, e.g. "m²".
+    pub unit: String,
+}
+
+impl Plot {
+    /// The title with its unit, as a view shows it: "trace of rotation covariance (rad²)".
+    ///
+    /// ```
+    /// let p = posecov::scene::Plot { id: "t".into(), title: "trace".into(), unit: "m²".into() };
+    /// assert_eq!(p.label(), "trace (m²)");
+    /// ```
+    pub fn label(&self) -> String {
+        if self.unit.is_empty() {
+            self.title.clone()
+        } else {
+            format!("{} ({})", self.title, self.unit)
+        }
+    }
+}
+
 /// A named scalar time series (one line in the plot), e.g. the trace of a method's covariance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScalarSeries {
@@ -290,7 +318,9 @@ pub struct Scene {
     pub description_markdown: String,
     /// Drawables, logged in order (static ones first, then by step; stable within a step).
     pub items: Vec<SceneItem>,
-    /// Plot lines.
+    /// Plots (one view each), in display order.
+    pub plots: Vec<Plot>,
+    /// Plot lines, each under the path of its plot.
     pub series: Vec<ScalarSeries>,
     /// A planar scene (SE(2), SO(2)) lives in the x–y plane: the sink declares +y as the
     /// viewer's up axis so the default camera faces that plane instead of grazing it.
@@ -309,6 +339,7 @@ impl Scene {
             title: title.into(),
             description_markdown: description_markdown.into(),
             items: Vec::new(),
+            plots: Vec::new(),
             series: Vec::new(),
             planar: false,
         }

@@ -1,0 +1,91 @@
+//! The commands that print: `list`, `report`, `check`.
+
+use std::fmt::Write as _;
+
+use super::{AppError, Overrides, evaluate, load, report_json, resolve};
+use crate::input::scenario::{Scenario, bundled::BUNDLED};
+
+/// Samples `check` evaluates with (enough to exercise every path, quick on any input).
+pub const CHECK_SAMPLES: u64 = 32;
+
+/// `posecov list`: every bundled scenario with its title.
+///
+/// ```
+/// assert!(posecov::app::commands::list().unwrap().contains("camera_on_robot"));
+/// ```
+pub fn list() -> Result<String, AppError> {
+    let width = BUNDLED.iter().map(|b| b.name.len()).max().unwrap_or(0);
+    let mut out = String::new();
+    for b in BUNDLED {
+        let scenario = Scenario::parse(b.text, b.name)?;
+        let _ = writeln!(out, "{:width$}  {}", b.name, scenario.file.scenario.title);
+    }
+    Ok(out)
+}
+
+/// `posecov report`: every mean, covariance, method, error and finding, as JSON or text.
+///
+/// ```
+/// use posecov::app::{Overrides, commands::report};
+/// let text = report("so3_sampling", &Overrides { samples: Some(50), ..Default::default() }, true).unwrap();
+/// let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+/// assert_eq!(json["meta"]["samples"], 50);
+/// ```
+pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<String, AppError> {
+    let loaded = load(scenario)?;
+    let settings = resolve(&loaded.input, overrides, None)?;
+    let evaluation = evaluate(&loaded, &settings.eval)?;
+    let confidence = settings.draw.confidence;
+    if json {
+        let value = report_json(scenario, &loaded, &evaluation, confidence);
+        return Ok(serde_json::to_string_pretty(&value).unwrap_or_default() + "\n");
+    }
+    let (seed, samples, _, _) = evaluation.run();
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{scenario} — {} (seed {seed}, {samples} samples, {:.1} % regions)",
+        loaded.input.about.title,
+        100.0 * confidence
+    );
+    for r in &evaluation.records() {
+        let error = r
+            .relative_error_vs_monte_carlo
+            .map_or(String::new(), |e| format!(", vs Monte Carlo {:.2} %", 100.0 * e));
+        let _ = writeln!(out, "\n{} [{}] {} ({:?} side{error})", r.label, r.group, r.method.label(), r.side);
+        let tangent: Vec<String> = r.mean_tangent.iter().map(|v| format!("{v:.6}")).collect();
+        let _ = writeln!(out, "  mean Log(μ) = [{}]", tangent.join(", "));
+        let _ = writeln!(out, "  covariance:");
+        for row in &r.covariance {
+            let row: Vec<String> = row.iter().map(|v| format!("{v:>12.6}")).collect();
+            let _ = writeln!(out, "   {}", row.join(" "));
+        }
+    }
+    for finding in evaluation.findings() {
+        let _ = writeln!(out, "\nfinding: {}", serde_json::to_string(finding).unwrap_or_default());
+    }
+    Ok(out)
+}
+
+/// `posecov check`: read, evaluate with few samples and draw, without showing anything.
+///
+/// ```
+/// let line = posecov::app::commands::check("camera_on_robot", &Default::default()).unwrap();
+/// assert!(line.starts_with("camera_on_robot: ok ("), "{line}");
+/// ```
+pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> {
+    let quick = Overrides {
+        samples: Some(overrides.samples.unwrap_or(CHECK_SAMPLES).min(CHECK_SAMPLES)),
+        ..overrides.clone()
+    };
+    let loaded = load(scenario)?;
+    let (evaluation, scene) = super::pipeline(&loaded, &quick, None)?;
+    let findings = evaluation.findings().len();
+    Ok(format!(
+        "{scenario}: ok ({} results, {} drawn items, {} steps{})",
+        evaluation.records().len(),
+        scene.items.len(),
+        scene.steps().len(),
+        if findings == 0 { String::new() } else { format!(", {findings} findings (see `posecov report`)") }
+    ))
+}

@@ -1,0 +1,165 @@
+//! The application: load an input, resolve its settings once (command line over file over
+//! defaults), evaluate, draw — the pure path every command shares — and, with the `viewer`
+//! feature, one `session` that logs the scene and any later Monte Carlo blocks to a sink,
+//! used by the viewer, `--watch` and `--save` alike.
+//!
+//! ```
+//! use posecov::app::{Overrides, load, pipeline};
+//! let loaded = load("camera_on_robot").unwrap();
+//! let overrides = Overrides { samples: Some(64), ..Default::default() };
+//! let (evaluation, scene) = pipeline(&loaded, &overrides, None).unwrap();
+//! assert!(!evaluation.records().is_empty());
+//! assert!(scene.validate().is_ok());
+//! ```
+
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+use crate::draw;
+use crate::eval::{self, AnyEvaluation, EvalError, EvalSettings};
+use crate::input::Input;
+use crate::input::scenario::{Scenario, ScenarioError, lower};
+use crate::scene::{Scene, SceneError};
+
+pub mod commands;
+mod settings;
+#[cfg(feature = "viewer")]
+pub mod session;
+
+pub use settings::{
+    DEFAULT_CONFIDENCE, DEFAULT_SAMPLES, Overrides, Settings, SettingsError, resolve,
+};
+
+/// Why a command could not run. Each names where the problem is in the user's words: the
+/// file, line, column and key, or the command-line flag.
+#[derive(Debug, thiserror::Error)]
+pub enum AppError {
+    /// The input file (reading, syntax, values), or an evaluation error located in it.
+    #[error(transparent)]
+    Input(#[from] ScenarioError),
+    /// A command-line value.
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    /// The drawing is not valid (a bug: evaluation checks every number it hands on).
+    #[error("the scene is not drawable: {0}")]
+    Scene(#[from] SceneError),
+}
+
+/// An input and the file it came from (to locate evaluation errors in it).
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The parsed file.
+    pub scenario: Scenario,
+    /// The checked input.
+    pub input: Input,
+}
+
+impl Loaded {
+    /// An evaluation error, located at the operation it is about (`file:line:column:
+    /// operation[k]: …`), or at the file.
+    ///
+    /// ```
+    /// use posecov::eval::EvalError;
+    /// let loaded = posecov::app::load("camera_on_robot").unwrap();
+    /// let e = loaded.locate(&EvalError::Undefined { operation: 0, output: "x".into(), definition: 9 });
+    /// assert!(e.to_string().starts_with("camera_on_robot.toml (bundled):"), "{e}");
+    /// ```
+    pub fn locate(&self, error: &EvalError) -> ScenarioError {
+        let message = error.to_string();
+        // The location names the operation; keep its output's name, drop the repeated index.
+        let message = match error.operation() {
+            Some(i) => message
+                .strip_prefix(&format!("operation[{i}] "))
+                .unwrap_or(&message)
+                .to_owned(),
+            None => message,
+        };
+        self.scenario.operation_error(error.operation(), message)
+    }
+}
+
+/// Loads a bundled scenario by name, or a scenario file, and lowers it.
+///
+/// ```
+/// let e = posecov::app::load("no_such_thing").unwrap_err().to_string();
+/// assert!(e.contains("camera_on_robot"), "{e}");
+/// ```
+pub fn load(name_or_path: &str) -> Result<Loaded, AppError> {
+    let scenario = Scenario::load_any(name_or_path)?;
+    let input = lower(&scenario)?;
+    Ok(Loaded { scenario, input })
+}
+
+/// Parses and lowers scenario text (`origin` names it in messages).
+///
+/// ```
+/// let e = posecov::app::load_text("[scenario]\ntitle='t'\ngroup='se2'\nsamples=1\n", "t.toml").unwrap_err();
+/// assert!(e.to_string().starts_with("t.toml:4:9: scenario.samples: 1 is out of range"), "{e}");
+/// ```
+pub fn load_text(text: &str, origin: &str) -> Result<Loaded, AppError> {
+    let scenario = Scenario::parse(text, origin)?;
+    let input = lower(&scenario)?;
+    Ok(Loaded { scenario, input })
+}
+
+/// Evaluates a loaded input with resolved settings, locating any error in the file.
+///
+/// ```
+/// use posecov::app::{Overrides, load, resolve, evaluate};
+/// let loaded = load("so3_sampling").unwrap();
+/// let settings = resolve(&loaded.input, &Overrides { samples: Some(100), ..Default::default() }, None).unwrap();
+/// assert!(evaluate(&loaded, &settings.eval).is_ok());
+/// ```
+pub fn evaluate(loaded: &Loaded, settings: &EvalSettings) -> Result<AnyEvaluation, AppError> {
+    eval::evaluate(&loaded.input.plan, settings).map_err(|e| AppError::Input(loaded.locate(&e)))
+}
+
+/// The pure path in one call: resolve, evaluate, draw, validate.
+///
+/// See the [module docs](self) for an example.
+pub fn pipeline(
+    loaded: &Loaded,
+    overrides: &Overrides,
+    cancel: Option<Arc<AtomicBool>>,
+) -> Result<(AnyEvaluation, Scene), AppError> {
+    let settings = resolve(&loaded.input, overrides, cancel)?;
+    let evaluation = evaluate(loaded, &settings.eval)?;
+    let scene = draw::scene(&evaluation, &settings.draw);
+    scene.validate()?;
+    Ok((evaluation, scene))
+}
+
+/// The JSON report of an evaluation: the settings it ran with, every estimate with its error
+/// against Monte Carlo, and every finding. Keys are stable (see the README).
+///
+/// ```
+/// use posecov::app::{Overrides, load, pipeline, report_json};
+/// let loaded = load("camera_on_robot").unwrap();
+/// let (evaluation, _) = pipeline(&loaded, &Overrides { samples: Some(64), ..Default::default() }, None).unwrap();
+/// let json = report_json("camera_on_robot", &loaded, &evaluation, 0.95);
+/// assert_eq!(json["meta"]["samples"], 64);
+/// ```
+pub fn report_json(
+    name: &str,
+    loaded: &Loaded,
+    evaluation: &AnyEvaluation,
+    confidence: f64,
+) -> serde_json::Value {
+    let (seed, samples, block_samples, methods) = evaluation.run();
+    serde_json::json!({
+        "scenario": name,
+        "meta": {
+            "title": loaded.input.about.title,
+            "description": loaded.input.about.description,
+            "source": loaded.input.about.source,
+            "group": evaluation.group().name(),
+            "seed": seed,
+            "samples": samples,
+            "block_samples": block_samples,
+            "confidence": confidence,
+            "methods": methods,
+        },
+        "results": evaluation.records(),
+        "findings": evaluation.findings(),
+    })
+}

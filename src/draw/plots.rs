@@ -1,0 +1,212 @@
+//! Plots over the `step` timeline: what each quantity is, its unit and frame (as data, for
+//! the sink's views), and one line per method.
+
+use std::collections::BTreeSet;
+
+use crate::eval::{Evaluation, Node, Role};
+use crate::lie::LieGroup;
+use crate::plan::OpKind;
+use crate::scene::{self, Plot, ScalarSeries};
+use crate::uncertain::Method;
+
+/// A kind of plot: entity id, title (what and in which frame) and unit.
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct PlotKind {
+    id: &'static str,
+    title: &'static str,
+    unit: &'static str,
+}
+
+const TRACE_POSITION: PlotKind = PlotKind {
+    id: "trace_of_position_covariance_m_body_frame",
+    title: "trace of the position covariance, body frame",
+    unit: "m²",
+};
+const TRACE_ROTATION: PlotKind = PlotKind {
+    id: "trace_of_rotation_covariance_rad",
+    title: "trace of the rotation covariance",
+    unit: "rad²",
+};
+const ALONG_TRACK: PlotKind = PlotKind {
+    id: "along_track_variance_x_x_left_form_m",
+    title: "along-track variance Σ_ρxρx, world frame (left form)",
+    unit: "m²",
+};
+const ORTHOGONALITY: PlotKind = PlotKind {
+    id: "orthogonality_error_max_r_t_r_i",
+    title: "orthogonality error max |RᵀR − I|",
+    unit: "",
+};
+
+/// One line of a plot.
+pub(super) struct Line {
+    kind: PlotKind,
+    /// The method (colour, legend); `None`: a line named by `label`.
+    method: Option<Method>,
+    /// Legend label.
+    pub(super) label: String,
+    /// (step, value).
+    pub(super) points: Vec<(i64, f64)>,
+}
+
+/// Adds each method's value at `step` to its line (a new line per method).
+fn add(lines: &mut Vec<Line>, kind: PlotKind, step: i64, values: impl IntoIterator<Item = (Method, f64)>) {
+    for (method, value) in values {
+        match lines.iter_mut().find(|l| l.kind == kind && l.method == Some(method)) {
+            Some(line) => line.points.push((step, value)),
+            None => lines.push(Line {
+                kind,
+                method: Some(method),
+                label: method.label().to_owned(),
+                points: vec![(step, value)],
+            }),
+        }
+    }
+}
+
+/// The outputs of propagations, in evaluation order.
+fn propagations<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, op: OpKind) -> Vec<&str> {
+    let mut seen = BTreeSet::new();
+    e.nodes
+        .iter()
+        .filter(|n| n.op == Some(op) && n.step.is_some() && n.role == Role::Output)
+        .filter_map(|n| seen.insert(n.name.as_str()).then_some(n.name.as_str()))
+        .collect()
+}
+
+fn steps_of<'e, G: LieGroup<N>, const N: usize>(
+    e: &'e Evaluation<G, N>,
+    name: &'e str,
+) -> impl Iterator<Item = &'e Node<G, N>> {
+    e.nodes.iter().filter(move |n| n.name == name && n.step.is_some())
+}
+
+/// Trace of the position covariance (rotation groups: of the rotation covariance), right
+/// form, per method and step.
+fn trace_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, name: &str, lines: &mut Vec<Line>) {
+    let rot = G::rotation_range();
+    let (kind, block) = if G::KIND.is_rotation_only() {
+        (TRACE_ROTATION, rot)
+    } else {
+        (TRACE_POSITION, 0..rot.start)
+    };
+    for node in steps_of(e, name) {
+        let values = node.estimates.iter().map(|est| {
+            let cov = est.result.pose.cov_right();
+            (est.result.method, block.clone().map(|i| cov[(i, i)]).sum())
+        });
+        add(lines, kind, node.step.unwrap_or(0) as i64, values);
+    }
+}
+
+/// Σ_ρxρx in the left (world) form per method and step: the along-track variance that
+/// second-order compounding misses (Barfoot & Furgale 2014, Fig. 2). Monte Carlo is the
+/// uncentred E[ξξᵀ] about the propagated mean, as in their experiments.
+pub(super) fn along_track_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, name: &str) -> Vec<Line> {
+    let mut lines = Vec::new();
+    if G::KIND.is_rotation_only() {
+        return lines;
+    }
+    for node in steps_of(e, name) {
+        let analytic = node
+            .estimates
+            .iter()
+            .filter(|est| est.result.method != Method::MonteCarlo)
+            .map(|est| (est.result.method, est.result.pose.cov_left()[(0, 0)]));
+        let monte_carlo = node
+            .monte_carlo
+            .and_then(|mc| mc.uncentred_left)
+            .map(|c| (Method::MonteCarlo, c[(0, 0)]));
+        add(&mut lines, ALONG_TRACK, node.step.unwrap_or(0) as i64, analytic.chain(monte_carlo));
+    }
+    lines
+}
+
+/// max |RᵀR − I| per step of the Euler matrices and of the Exp rotations.
+fn orthogonality_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, name: &str, lines: &mut Vec<Line>) {
+    let drift = |m: &nalgebra::Matrix3<f64>| (m.transpose() * m - nalgebra::Matrix3::identity()).amax();
+    let frames = e.matrix_frames.iter().filter(|f| name.strip_suffix("_exp") == Some(f.output.as_str()));
+    lines.push(Line {
+        kind: ORTHOGONALITY,
+        method: None,
+        label: "Euler steps R(I + ω̂dt)".to_owned(),
+        points: frames.map(|f| (f.step as i64, drift(&f.columns))).collect(),
+    });
+    lines.push(Line {
+        kind: ORTHOGONALITY,
+        method: Some(Method::Exact),
+        label: "exponential map R·Exp(ωdt)".to_owned(),
+        points: steps_of(e, name)
+            .map(|n| (n.step.unwrap_or(0) as i64, drift(&n.nominal.to_se3().rotation().to_matrix())))
+            .collect(),
+    });
+}
+
+/// Every plot of an evaluation and its lines, in evaluation order.
+pub(super) fn plots<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> (Vec<Plot>, Vec<ScalarSeries>) {
+    let mut lines = Vec::new();
+    let mut order: Vec<(usize, &str, OpKind)> = [OpKind::Odometry, OpKind::Compound, OpKind::EulerVsExp]
+        .into_iter()
+        .flat_map(|op| propagations(e, op).into_iter().map(move |name| (op, name)))
+        .map(|(op, name)| {
+            let first = e.nodes.iter().position(|n| n.name == name).unwrap_or(0);
+            (first, name, op)
+        })
+        .collect();
+    order.sort_by_key(|(first, ..)| *first);
+    for (_, name, op) in order {
+        match op {
+            OpKind::Odometry => trace_lines(e, name, &mut lines),
+            OpKind::Compound => {
+                trace_lines(e, name, &mut lines);
+                lines.extend(along_track_lines(e, name));
+            }
+            _ => orthogonality_lines(e, name, &mut lines),
+        }
+    }
+    let mut plots: Vec<(PlotKind, String)> = Vec::new();
+    let mut series = Vec::new();
+    for line in lines {
+        let id = match plots.iter().find(|(k, _)| *k == line.kind) {
+            Some((_, id)) => id.clone(),
+            None => {
+                let id = format!("{}_{}", plots.len(), line.kind.id);
+                plots.push((line.kind, id.clone()));
+                id
+            }
+        };
+        let (segment, color) = match line.method {
+            Some(m) => (m.slug().to_owned(), m.color()),
+            None => (slug(&line.label), scene::NOMINAL),
+        };
+        series.push(ScalarSeries {
+            path: format!("{}/{id}/{segment}", scene::PLOTS),
+            name: line.label,
+            color,
+            width: 2.0,
+            points: line.points,
+        });
+    }
+    let plots = plots
+        .into_iter()
+        .map(|(k, id)| Plot {
+            id,
+            title: k.title.to_owned(),
+            unit: k.unit.to_owned(),
+        })
+        .collect();
+    (plots, series)
+}
+
+/// An entity-path segment from a label: lower-case letters and digits, `_` between words.
+fn slug(s: &str) -> String {
+    let mut out = String::new();
+    for c in s.chars() {
+        if c.is_ascii_alphanumeric() {
+            out.push(c.to_ascii_lowercase());
+        } else if !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    out.trim_matches('_').to_owned()
+}

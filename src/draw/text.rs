@@ -1,0 +1,196 @@
+//! The text panel: the input's own description, then the convention, the methods and their
+//! colours, each method's error against Monte Carlo, and every finding of the evaluation.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use super::DrawSettings;
+use super::plots::along_track_lines;
+use super::shapes::chi2_radius;
+use crate::eval::{Evaluation, Finding, Node, Role};
+use crate::lie::{GroupKind, LieGroup};
+use crate::plan::OpKind;
+use crate::uncertain::Method;
+
+/// The Markdown of the text panel.
+pub(super) fn description<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSettings) -> String {
+    let about = &settings.about;
+    let mut s = format!("# {}\n\n", about.title);
+    if !about.source.is_empty() {
+        let _ = writeln!(s, "*Source: {}*\n", about.source);
+    }
+    let _ = writeln!(s, "{}\n", about.description.trim());
+    let _ = writeln!(
+        s,
+        "**Convention:** {} with tangent order {}; covariances are read as X = μ · Exp(ε) (right / body) unless marked left. \
+         Regions are drawn at {:.1} % confidence (χ² radius {:.3} for the {}-DOF tangent ellipsoid).\n",
+        G::NAME,
+        tangent_order(G::KIND),
+        settings.confidence * 100.0,
+        chi2_radius(settings.confidence, N),
+        N
+    );
+    if !e.methods.is_empty() {
+        let _ = writeln!(s, "| method | colour |\n|---|---|");
+        for method in &e.methods {
+            let _ = writeln!(s, "| {} | {} |", method.label(), method.color_name());
+        }
+        let _ = writeln!(
+            s,
+            "| Monte Carlo samples | grey cloud ({} samples, seed {}) |\n",
+            e.samples, e.seed
+        );
+    }
+    errors_table(&mut s, e);
+    for name in compounds(e) {
+        let lines = along_track_lines(e, name);
+        let last = e.nodes.iter().rev().find(|n| n.name == name).and_then(|n| n.step);
+        if let (Some(step), false) = (last, lines.is_empty()) {
+            let summary: Vec<String> = lines
+                .iter()
+                .filter_map(|l| l.points.last().map(|(_, v)| format!("{} {v:.4}", l.label)))
+                .collect();
+            let _ = writeln!(
+                s,
+                "Along-track variance Σ_ρxρx (world frame, left form) at step {step}: {}.\n",
+                summary.join(", ")
+            );
+        }
+    }
+    for finding in &e.findings {
+        let _ = writeln!(s, "{}\n", finding_text(finding));
+    }
+    s
+}
+
+/// The outputs of compounding propagations.
+fn compounds<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Vec<&str> {
+    let mut names: Vec<&str> = Vec::new();
+    for n in e.nodes.iter().filter(|n| n.op == Some(OpKind::Compound)) {
+        if !names.contains(&n.name.as_str()) {
+            names.push(&n.name);
+        }
+    }
+    names
+}
+
+/// Each final node's methods and their error against Monte Carlo.
+fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G, N>) {
+    let finals = final_nodes(e);
+    let with_errors: Vec<_> = finals
+        .iter()
+        .filter(|n| n.estimates.iter().any(|x| x.error_vs_monte_carlo.is_some()))
+        .collect();
+    if with_errors.is_empty() {
+        return;
+    }
+    let _ = writeln!(s, "**Error against Monte Carlo** (‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F, right side):\n");
+    let _ = writeln!(s, "| pose | method | error |\n|---|---|---|");
+    for node in with_errors {
+        let label = node
+            .step
+            .map_or(node.name.clone(), |k| format!("{} (step {k})", node.name));
+        for est in node.estimates.iter().filter(|x| x.result.method != Method::MonteCarlo) {
+            let Some(err) = est.error_vs_monte_carlo else {
+                continue;
+            };
+            let method = if node.role == Role::Input {
+                "given Σ (sampling noise floor)"
+            } else {
+                est.result.method.label()
+            };
+            let _ = writeln!(s, "| {label} | {method} | {:.1} % |", 100.0 * err);
+        }
+    }
+    s.push('\n');
+}
+
+/// What a finding says, in one paragraph.
+fn finding_text(f: &Finding) -> String {
+    let at = |step: &Option<u64>| step.map_or(String::new(), |k| format!(" at step {k}"));
+    match f {
+        Finding::Blocked {
+            samples,
+            blocks,
+            block_samples,
+            passes,
+        } => format!(
+            "Monte Carlo: {samples} samples simulated in {blocks} blocks of {block_samples} to bound memory; the statistics \
+             use every sample ({passes} passes of the Lie-mean iteration); the clouds of samples beyond the first block are logged block by block."
+        ),
+        Finding::Fusion {
+            output,
+            inputs,
+            cost,
+            iterations,
+        } => format!(
+            "Fusion of {inputs} estimates into `{output}`: final cost V = ½ Σ eᵢᵀ Σᵢ⁻¹ eᵢ = {cost:.4} after {iterations} Gauss–Newton iterations."
+        ),
+        Finding::DiffDriveMeans {
+            output,
+            diffusion,
+            nominal_end,
+            lie_mean,
+            cartesian_mean,
+        } => format!(
+            "`{output}` (D = {diffusion}): nominal end ({:.3}, {:.3}); **Lie mean** of the samples ({:.3}, {:.3}); **Cartesian mean** of their positions ({:.3}, {:.3}) — it retreats inside the banana.",
+            nominal_end[0], nominal_end[1], lie_mean[0], lie_mean[1], cartesian_mean[0], cartesian_mean[1]
+        ),
+        Finding::EulerDrift {
+            output: _,
+            steps,
+            dt,
+            euler,
+            exp,
+        } => format!(
+            "After {steps} steps of dt = {dt} s: Euler max |RᵀR − I| = **{euler:.3}**; exponential map {exp:.1e}. The Euler frame (the columns of its matrix, drawn as arrows) stretches; the Exp frame stays a rotation."
+        ),
+        Finding::MethodFailed {
+            output,
+            step,
+            method,
+            reason,
+        } => format!("*{} gave no estimate for `{output}`{}: {reason}.*", method.label(), at(step)),
+        Finding::NotPositiveSemiDefinite {
+            output,
+            step,
+            method,
+            smallest_eigenvalue,
+            largest_eigenvalue,
+        } => format!(
+            "**Warning:** the {} covariance of `{output}`{} is not positive semi-definite (smallest eigenvalue {smallest_eigenvalue:.3e}, largest {largest_eigenvalue:.3e}); its regions are drawn from its positive part.",
+            method.label(),
+            at(step)
+        ),
+        Finding::StepsThinned {
+            output,
+            steps,
+            recorded,
+        } => format!(
+            "`{output}` has {steps} steps: {recorded} evenly spaced ones (and the last) are recorded and drawn, to bound memory."
+        ),
+        Finding::Interrupted => "*Evaluation interrupted: later operations or steps were not evaluated.*".to_owned(),
+    }
+}
+
+fn tangent_order(kind: GroupKind) -> &'static str {
+    match kind {
+        GroupKind::So2 => "[θ]",
+        GroupKind::So3 => "[θx, θy, θz]",
+        GroupKind::Se2 => "[ρx, ρy, θ]",
+        GroupKind::Se3 => "[ρx, ρy, ρz, θx, θy, θz]",
+    }
+}
+
+/// The last step of every node name (or the node itself when static), in first-seen order.
+fn final_nodes<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Vec<&Node<G, N>> {
+    let mut last: BTreeMap<&str, &Node<G, N>> = BTreeMap::new();
+    let mut order = Vec::new();
+    for node in &e.nodes {
+        if !last.contains_key(node.name.as_str()) {
+            order.push(node.name.as_str());
+        }
+        last.insert(&node.name, node);
+    }
+    order.iter().filter_map(|n| last.get(n).copied()).collect()
+}

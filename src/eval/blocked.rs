@@ -1,0 +1,155 @@
+//! Monte Carlo statistics of a sample too large to hold, gathered block by block
+//! ([blocked Monte Carlo](super#blocked-monte-carlo-bounded-memory)): per node the Lie mean
+//! and covariance through the crate's one [`LieMeanAccumulator`] (started from block 0's
+//! mean), and in the first pass the sums behind the uncentred left covariance about the
+//! nominal and the Cartesian position mean; per point node the points' mean and covariance.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::model::{Evaluation, McSummary, Node};
+use crate::lie::{LieGroup, TangentMatrix};
+use crate::sample::{LieMeanAccumulator, MeanError, tangent_moments};
+use crate::uncertain::{Method, Side};
+
+/// One node's running sums.
+struct NodeSums<G: LieGroup<N>, const N: usize> {
+    mean: LieMeanAccumulator<G, N>,
+    count: usize,
+    /// Σ Log_left(X nominal⁻¹) Log_left(…)ᵀ, where asked for.
+    left_outer: Option<TangentMatrix<N>>,
+    /// Positions are summed relative to `shift` (block 0's mean) to avoid cancellation.
+    shift: Vector3<f64>,
+    position_sum: Option<Vector3<f64>>,
+}
+
+/// Running sums of 3-vectors relative to a shift: mean and 1/(n−1) covariance.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct VectorSums {
+    shift: Vector3<f64>,
+    sum: Vector3<f64>,
+    outer: Matrix3<f64>,
+    count: usize,
+}
+
+impl VectorSums {
+    /// Empty sums about `shift`.
+    pub(super) fn new(shift: Vector3<f64>) -> Self {
+        Self {
+            shift,
+            sum: Vector3::zeros(),
+            outer: Matrix3::zeros(),
+            count: 0,
+        }
+    }
+
+    /// Adds points.
+    pub(super) fn add(&mut self, points: &[[f64; 3]]) {
+        for x in points {
+            let d = Vector3::from(*x) - self.shift;
+            self.sum += d;
+            self.outer += d * d.transpose();
+        }
+        self.count += points.len();
+    }
+
+    /// Mean and 1/(n−1) covariance.
+    pub(super) fn statistics(&self) -> (Vector3<f64>, Matrix3<f64>) {
+        let n = self.count as f64;
+        let d = self.sum / n;
+        let cov = (self.outer - d * d.transpose() * n) / (n - 1.0);
+        (self.shift + d, (cov + cov.transpose()) * 0.5)
+    }
+}
+
+/// The statistics of every node and point over all blocks.
+pub(super) struct BlockedStats<G: LieGroup<N>, const N: usize> {
+    nodes: Vec<Option<NodeSums<G, N>>>,
+    points: Vec<Option<VectorSums>>,
+}
+
+impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
+    /// Starts from block 0's evaluation: its Monte Carlo means start each iteration and
+    /// shift each sum.
+    pub(super) fn start(first: &Evaluation<G, N>) -> Self {
+        let nodes = first
+            .nodes
+            .iter()
+            .map(|node| {
+                let mc = node.monte_carlo.as_ref()?;
+                Some(NodeSums {
+                    mean: LieMeanAccumulator::new(mc.stats.mean, Side::Right),
+                    count: 0,
+                    left_outer: mc.uncentred_left.map(|_| TangentMatrix::<N>::zeros()),
+                    shift: mc.position_mean.unwrap_or_else(Vector3::zeros),
+                    position_sum: mc.position_mean.map(|_| Vector3::zeros()),
+                })
+            })
+            .collect();
+        let points = first
+            .points
+            .iter()
+            .map(|p| {
+                p.estimates
+                    .iter()
+                    .find(|(m, ..)| *m == Method::MonteCarlo)
+                    .map(|(_, mean, _)| VectorSums::new(*mean))
+            })
+            .collect();
+        Self { nodes, points }
+    }
+
+    /// Whether some node's Lie mean is still iterating.
+    pub(super) fn iterating(&self) -> bool {
+        self.nodes.iter().flatten().any(|n| n.mean.is_iterating())
+    }
+
+    /// Adds one block's particles of node `index` (`first_pass`: also the one-pass sums).
+    pub(super) fn add_node(&mut self, index: usize, node: &Node<G, N>, particles: &[G], first_pass: bool) {
+        let Some(Some(sums)) = self.nodes.get_mut(index) else {
+            return;
+        };
+        sums.mean.add(particles, None);
+        if first_pass {
+            sums.count += particles.len();
+            if let Some(outer) = sums.left_outer.as_mut() {
+                *outer += tangent_moments(particles, None, &node.nominal, Side::Left).1;
+            }
+            if let Some(sum) = sums.position_sum.as_mut() {
+                *sum += particles
+                    .iter()
+                    .map(|g| g.to_se3().translation() - sums.shift)
+                    .sum::<Vector3<f64>>();
+            }
+        }
+    }
+
+    /// Adds one block's points of point node `index` (first pass only).
+    pub(super) fn add_point(&mut self, index: usize, points: &[[f64; 3]], first_pass: bool) {
+        if let (true, Some(Some(sums))) = (first_pass, self.points.get_mut(index)) {
+            sums.add(points);
+        }
+    }
+
+    /// Ends a pass over all samples: one Lie-mean step per node still iterating.
+    pub(super) fn finish_pass(&mut self) {
+        for sums in self.nodes.iter_mut().flatten() {
+            sums.mean.finish_pass();
+        }
+    }
+
+    /// Node `index`'s statistics over every block (`None` where it has no particles).
+    pub(super) fn node(&self, index: usize) -> Option<Result<McSummary<G, N>, MeanError<G>>> {
+        let sums = self.nodes.get(index)?.as_ref()?;
+        let n = sums.count as f64;
+        Some(sums.mean.statistics().map(|stats| McSummary {
+            stats,
+            uncentred_left: sums.left_outer.map(|o| o / n),
+            position_mean: sums.position_sum.map(|s| sums.shift + s / n),
+        }))
+    }
+
+    /// Point node `index`'s mean and covariance over every block.
+    pub(super) fn point(&self, index: usize) -> Option<(Vector3<f64>, Matrix3<f64>)> {
+        self.points.get(index)?.as_ref().map(VectorSums::statistics)
+    }
+}

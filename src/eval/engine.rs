@@ -1,0 +1,481 @@
+//! The evaluation engine: the table of what each definition evaluated to, particles, and
+//! the one place where a result becomes a node (checked, with its Monte Carlo statistics).
+
+use std::ops::Range;
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, Matrix3, SymmetricEigen, Vector3};
+
+use super::blocked::{BlockedStats, VectorSums};
+use super::groups::EvalGroup;
+use super::model::{Estimate, Evaluation, Finding, McSummary, Node, PointNode, Role};
+use super::{EvalError, EvalSettings};
+use crate::lie::{LieGroup, TangentMatrix};
+use crate::plan::{OpKind, Operand, Plan, PoseValue, limits};
+use crate::propagate::{Propagated, relative_frobenius_error};
+use crate::sample::{CHUNK_SIZE, MeanError, Sampler, sample_statistics, uncentred_covariance};
+use crate::uncertain::{Method, Side, UncertainPose};
+
+/// An operand's Gaussian (its primary estimate) and its particles.
+pub(super) type Gaussian<G, const N: usize> = (UncertainPose<G, N>, Option<Arc<Vec<G>>>);
+
+/// Where a run takes its Monte Carlo statistics from.
+pub(super) enum StatsMode<'s, G: LieGroup<N>, const N: usize> {
+    /// From this run's particles: the whole sample, when it fits in one block.
+    Own,
+    /// Nowhere: one block of a larger sample, for its particles only.
+    Skip,
+    /// A pass over one block of a larger sample: add to the running sums (`true`: first pass).
+    Collect(&'s mut BlockedStats<G, N>, bool),
+    /// From the sums over every block.
+    Blocked(&'s BlockedStats<G, N>),
+}
+
+/// The particles of a new node.
+pub(super) enum Particles<'p, G> {
+    /// None (no Monte Carlo, or a deterministic result).
+    None,
+    /// A whole particle set, kept.
+    Owned(Arc<Vec<G>>),
+    /// The particles of one step of a propagation, kept only at detailed steps.
+    Step(&'p [G]),
+}
+
+/// Monte Carlo statistics an operation asks for beyond the Lie mean and covariance.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Extras {
+    /// Uncentred left covariance about the nominal (Barfoot & Furgale's).
+    pub uncentred_left: bool,
+    /// Cartesian mean of the positions.
+    pub position_mean: bool,
+}
+
+/// A result about to become a node.
+pub(super) struct Draft<'p, G: LieGroup<N>, const N: usize> {
+    pub step: Option<u64>,
+    pub last_step: Option<u64>,
+    /// The estimates; the first is the primary one (first order, exact or closed form).
+    pub estimates: Vec<Propagated<G, N>>,
+    pub particles: Particles<'p, G>,
+    pub extras: Extras,
+}
+
+impl<G: LieGroup<N>, const N: usize> Draft<'_, G, N> {
+    /// A single (not per-step) result.
+    pub(super) fn single(estimates: Vec<Propagated<G, N>>, particles: Option<Arc<Vec<G>>>) -> Self {
+        Draft {
+            step: None,
+            last_step: None,
+            estimates,
+            particles: particles.map_or(Particles::None, Particles::Owned),
+            extras: Extras::default(),
+        }
+    }
+}
+
+pub(super) struct Engine<'a, 's, G: EvalGroup<N>, const N: usize> {
+    pub plan: &'a Plan<G, N>,
+    pub settings: &'a EvalSettings,
+    pub monte_carlo: bool,
+    /// Node index of each definition that is a pose (`None`: a known pose or not a pose).
+    defined: Vec<Option<usize>>,
+    pub out: Evaluation<G, N>,
+    /// Random families already used (one per sampled input or noise source).
+    families: u64,
+    /// The sample indices this run simulates; `block.start` a multiple of [`CHUNK_SIZE`],
+    /// so every random draw is the one the whole sample would make.
+    pub block: Range<usize>,
+    stats: StatsMode<'s, G, N>,
+    /// The operation being evaluated: index and output name.
+    pub current: (usize, String),
+    /// Its kind (`None` while sampling the inputs).
+    current_kind: Option<OpKind>,
+}
+
+impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
+    pub(super) fn run(
+        plan: &'a Plan<G, N>,
+        settings: &'a EvalSettings,
+        block: Range<usize>,
+        stats: StatsMode<'s, G, N>,
+    ) -> Result<Evaluation<G, N>, EvalError> {
+        let monte_carlo = settings.monte_carlo();
+        let mut engine = Engine {
+            plan,
+            settings,
+            monte_carlo,
+            defined: Vec::with_capacity(plan.definitions()),
+            out: Evaluation {
+                seed: settings.seed,
+                samples: if monte_carlo { block.len() } else { 0 },
+                block_samples: block.len(),
+                methods: settings.methods.clone(),
+                nodes: Vec::new(),
+                points: Vec::new(),
+                paths: Vec::new(),
+                matrix_frames: Vec::new(),
+                findings: Vec::new(),
+            },
+            families: 0,
+            block,
+            stats,
+            current: (0, String::new()),
+            current_kind: None,
+        };
+        engine.inputs()?;
+        for (i, operation) in plan.operations.iter().enumerate() {
+            if settings.cancelled() {
+                engine.out.findings.push(Finding::Interrupted);
+                break;
+            }
+            engine.current = (i, operation.output.clone());
+            engine.current_kind = Some(operation.op.kind());
+            engine.operation(&operation.op)?;
+            let node = engine
+                .out
+                .nodes
+                .iter()
+                .rposition(|n| n.name == operation.output);
+            engine.defined.push(node);
+        }
+        Ok(engine.out)
+    }
+
+    /// The plan's poses: known transforms and sampled inputs.
+    fn inputs(&mut self) -> Result<(), EvalError> {
+        for def in &self.plan.poses {
+            match def.value {
+                PoseValue::Known(mean) => {
+                    self.out.nodes.push(Node {
+                        name: def.name.clone(),
+                        role: Role::Fixed,
+                        op: None,
+                        step: None,
+                        last_step: None,
+                        nominal: mean,
+                        estimates: Vec::new(),
+                        monte_carlo: None,
+                        particles: None,
+                    });
+                    self.defined.push(None);
+                }
+                PoseValue::Uncertain(pose) => {
+                    self.current = (usize::MAX, def.name.clone());
+                    let particles = if self.monte_carlo {
+                        Some(Arc::new(self.sample(&pose)?))
+                    } else {
+                        None
+                    };
+                    let estimate = Propagated {
+                        pose,
+                        method: Method::Exact,
+                    };
+                    self.push(&def.name, Role::Input, Draft::single(vec![estimate], particles))?;
+                    self.defined.push(Some(self.out.nodes.len() - 1));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The next random family (one per sampled input or noise source, in plan order).
+    pub(super) fn next_family(&mut self) -> u64 {
+        self.families += 1;
+        self.families
+    }
+
+    /// The chunk index of this run's first particle.
+    pub(super) fn first_chunk(&self) -> u64 {
+        (self.block.start / CHUNK_SIZE) as u64
+    }
+
+    /// An error about the current operation.
+    pub(super) fn math(&self, source: crate::Error) -> EvalError {
+        EvalError::Math {
+            operation: self.current.0,
+            output: self.current.1.clone(),
+            source,
+        }
+    }
+
+    /// A finding that a method failed for the current output.
+    pub(super) fn method_failed(&mut self, step: Option<u64>, method: Method, reason: String) {
+        self.out.findings.push(Finding::MethodFailed {
+            output: self.current.1.clone(),
+            step,
+            method,
+            reason,
+        });
+    }
+
+    /// n particles of `pose` for this run's block.
+    pub(super) fn sample(&mut self, pose: &UncertainPose<G, N>) -> Result<Vec<G>, EvalError> {
+        let family = self.next_family();
+        let mut out = vec![*pose.mean(); self.block.len()];
+        let sampler = Sampler::new(pose).map_err(|e| self.math(e))?;
+        sampler.fill_par_from(&mut out, self.settings.seed, family, self.first_chunk());
+        Ok(out)
+    }
+
+    /// The Gaussian (the primary estimate) and the particles of an operand.
+    pub(super) fn gaussian(
+        &self,
+        operand: Operand<G>,
+    ) -> Result<Gaussian<G, N>, EvalError> {
+        match operand {
+            Operand::Known(g) => Ok((UncertainPose::certain(g), None)),
+            Operand::Defined(k) => {
+                let node = self
+                    .defined
+                    .get(k)
+                    .copied()
+                    .flatten()
+                    .map(|i| &self.out.nodes[i])
+                    .ok_or_else(|| EvalError::Undefined {
+                        operation: self.current.0,
+                        output: self.current.1.clone(),
+                        definition: k,
+                    })?;
+                let pose = node
+                    .estimates
+                    .first()
+                    .map_or(UncertainPose::certain(node.nominal), |e| e.result.pose);
+                Ok((pose, node.particles.clone()))
+            }
+        }
+    }
+
+    /// Particles for `operand`: its own, or n copies of its mean.
+    pub(super) fn particles_of(
+        &self,
+        pose: &UncertainPose<G, N>,
+        particles: Option<Arc<Vec<G>>>,
+    ) -> Arc<Vec<G>> {
+        particles.unwrap_or_else(|| Arc::new(vec![*pose.mean(); self.block.len()]))
+    }
+
+    /// The kind of the operation being evaluated.
+    pub(super) fn current_kind(&self) -> Option<OpKind> {
+        self.current_kind
+    }
+
+    /// Whether `method` was requested.
+    pub(super) fn wants(&self, method: Method) -> bool {
+        self.settings.methods.contains(&method)
+    }
+
+    /// Adds a node for the current output (checked: a non-finite primary result is an error,
+    /// any other non-finite estimate is dropped with a finding, an indefinite covariance is
+    /// reported), with its Monte Carlo statistics and errors against them. Steps that the
+    /// [`StepPolicy`](crate::plan::StepPolicy) does not record are skipped.
+    pub(super) fn push(&mut self, name: &str, role: Role, draft: Draft<'_, G, N>) -> Result<(), EvalError> {
+        let policy = self.settings.steps;
+        if let (Some(k), Some(last)) = (draft.step, draft.last_step)
+            && !policy.records(k, last)
+        {
+            return Ok(());
+        }
+        let mut estimates = Vec::with_capacity(draft.estimates.len() + 1);
+        for (i, result) in draft.estimates.into_iter().enumerate() {
+            if !finite_pose(&result) {
+                if i == 0 {
+                    return Err(EvalError::NonFinite {
+                        operation: self.current.0,
+                        output: self.current.1.clone(),
+                        step: draft.step,
+                        method: result.method.label(),
+                    });
+                }
+                self.method_failed(draft.step, result.method, "the result is not finite (overflow)".to_owned());
+                continue;
+            }
+            self.check_psd(name, draft.step, result.method, result.pose.cov());
+            estimates.push(Estimate {
+                result,
+                error_vs_monte_carlo: None,
+            });
+        }
+        let nominal = estimates.first().map_or_else(G::identity, |e| *e.result.pose.mean());
+        let index = self.out.nodes.len();
+        let mut node = Node {
+            name: name.to_owned(),
+            role,
+            op: self.current_kind,
+            step: draft.step,
+            last_step: draft.last_step,
+            nominal,
+            estimates,
+            monte_carlo: None,
+            particles: None,
+        };
+        let particles: Option<&[G]> = match &draft.particles {
+            Particles::None => None,
+            Particles::Owned(p) => Some(p),
+            Particles::Step(p) => Some(p),
+        };
+        if let Some(p) = particles.filter(|_| self.monte_carlo) {
+            let summary = self.summary(index, &node, p, draft.extras);
+            let overflow = summary.as_ref().is_some_and(|r| {
+                r.as_ref().is_ok_and(|mc| {
+                    !finite_pose(&Propagated {
+                        pose: mc.stats.to_pose(),
+                        method: Method::MonteCarlo,
+                    })
+                })
+            });
+            match summary {
+                Some(Ok(_)) if overflow => {
+                    self.method_failed(
+                        draft.step,
+                        Method::MonteCarlo,
+                        "the sample statistics are not finite (overflow)".to_owned(),
+                    );
+                }
+                Some(Ok(mc)) => {
+                    for e in &mut node.estimates {
+                        // Undefined (not reported) when the Monte Carlo covariance is zero.
+                        let error = relative_frobenius_error(&e.result.pose.cov_right(), &mc.stats.cov);
+                        e.error_vs_monte_carlo = error.is_finite().then_some(error);
+                    }
+                    node.estimates.push(Estimate {
+                        result: Propagated {
+                            pose: mc.stats.to_pose(),
+                            method: Method::MonteCarlo,
+                        },
+                        error_vs_monte_carlo: Some(0.0),
+                    });
+                    node.monte_carlo = Some(mc);
+                }
+                Some(Err(e)) => {
+                    let reason = crate::Error::from(e).to_string();
+                    self.method_failed(draft.step, Method::MonteCarlo, reason);
+                }
+                None => {}
+            }
+        }
+        node.particles = match draft.particles {
+            Particles::None => None,
+            Particles::Owned(p) => Some(p),
+            Particles::Step(p) => {
+                let detailed = match (draft.step, draft.last_step) {
+                    (Some(k), Some(last)) => policy.detailed(k, last),
+                    _ => true,
+                };
+                detailed.then(|| Arc::new(p.to_vec()))
+            }
+        };
+        self.out.nodes.push(node);
+        Ok(())
+    }
+
+    /// Monte Carlo statistics of node `index` from the current [`StatsMode`].
+    fn summary(
+        &mut self,
+        index: usize,
+        node: &Node<G, N>,
+        particles: &[G],
+        extras: Extras,
+    ) -> Option<Result<McSummary<G, N>, MeanError<G>>> {
+        match &mut self.stats {
+            StatsMode::Own => Some(sample_statistics(particles, Side::Right).map(|stats| McSummary {
+                stats,
+                uncentred_left: extras
+                    .uncentred_left
+                    .then(|| uncentred_covariance(particles, &node.nominal, Side::Left).ok())
+                    .flatten(),
+                position_mean: extras.position_mean.then(|| {
+                    particles
+                        .iter()
+                        .map(|g| *g.to_se3().translation())
+                        .sum::<Vector3<f64>>()
+                        / particles.len() as f64
+                }),
+            })),
+            StatsMode::Skip => None,
+            StatsMode::Collect(stats, first_pass) => {
+                stats.add_node(index, node, particles, *first_pass);
+                None
+            }
+            StatsMode::Blocked(stats) => stats.node(index),
+        }
+    }
+
+    /// Adds a point node with its first-order estimate and, where Monte Carlo ran, its cloud
+    /// and statistics.
+    pub(super) fn push_point(
+        &mut self,
+        name: &str,
+        first_order: (Vector3<f64>, Matrix3<f64>),
+        cloud: Option<Vec<[f64; 3]>>,
+    ) -> Result<(), EvalError> {
+        let (mean, cov) = first_order;
+        if !(mean.iter().all(|v| v.abs() <= limits::OVERFLOW_COORDINATE)
+            && cov.iter().all(|v| v.abs() <= limits::OVERFLOW_VARIANCE))
+        {
+            return Err(EvalError::NonFinite {
+                operation: self.current.0,
+                output: self.current.1.clone(),
+                step: None,
+                method: Method::FirstOrder.label(),
+            });
+        }
+        let mut estimates = vec![(Method::FirstOrder, mean, cov)];
+        let index = self.out.points.len();
+        if let Some(points) = &cloud {
+            let stats = match &mut self.stats {
+                StatsMode::Own if points.len() >= 2 => {
+                    let mut sums = VectorSums::new(Vector3::from(points[0]));
+                    sums.add(points);
+                    Some(sums.statistics())
+                }
+                StatsMode::Collect(stats, first_pass) => {
+                    stats.add_point(index, points, *first_pass);
+                    None
+                }
+                StatsMode::Blocked(stats) => stats.point(index),
+                _ => None,
+            };
+            if let Some((m, c)) = stats {
+                if m.iter().chain(c.iter()).all(|v| v.is_finite()) {
+                    estimates.push((Method::MonteCarlo, m, c));
+                } else {
+                    self.method_failed(None, Method::MonteCarlo, "the sample statistics are not finite".to_owned());
+                }
+            }
+        }
+        self.out.points.push(PointNode {
+            name: name.to_owned(),
+            estimates,
+            particles: cloud,
+        });
+        Ok(())
+    }
+
+    /// Reports a covariance that is not positive semi-definite (smallest eigenvalue below
+    /// −1e-9 of the largest magnitude).
+    fn check_psd(&mut self, name: &str, step: Option<u64>, method: Method, cov: &TangentMatrix<N>) {
+        let sym = (cov + cov.transpose()) * 0.5;
+        let eig = SymmetricEigen::new(DMatrix::from_iterator(N, N, sym.iter().copied()));
+        let smallest = eig.eigenvalues.min();
+        let largest = eig.eigenvalues.max();
+        let scale = eig.eigenvalues.amax().max(f64::MIN_POSITIVE);
+        if smallest < -1e-9 * scale {
+            self.out.findings.push(Finding::NotPositiveSemiDefinite {
+                output: name.to_owned(),
+                step,
+                method,
+                smallest_eigenvalue: smallest,
+                largest_eigenvalue: largest,
+            });
+        }
+    }
+}
+
+/// Whether a result's mean and covariance are finite and within the magnitudes that can be
+/// computed on and drawn ([`limits::OVERFLOW_COORDINATE`], [`limits::OVERFLOW_VARIANCE`]).
+fn finite_pose<G: LieGroup<N>, const N: usize>(result: &Propagated<G, N>) -> bool {
+    let mean = result.pose.mean().to_se3();
+    result.pose.cov().iter().all(|v| v.abs() <= limits::OVERFLOW_VARIANCE)
+        && mean.translation().iter().all(|v| v.abs() <= limits::OVERFLOW_COORDINATE)
+        && mean.rotation().to_quaternion_xyzw().iter().all(|v| v.is_finite())
+}

@@ -1,0 +1,424 @@
+//! Evaluating a [`Plan`]: every pose and every operation, with every requested method,
+//! Monte Carlo particles flowing through the operations, and errors against Monte Carlo.
+//! Numbers only: nothing here knows entity paths, colours, Markdown or plots.
+//!
+//! Monte Carlo is end to end: each uncertain input is sampled once (n particles, seeded from
+//! the seed and the input's order), and every operation maps particles to particles, drawing
+//! fresh process noise where it has some. Each node's Monte Carlo estimate is the iterative
+//! Lie mean and 1/(N−1) covariance of its particles, right side
+//! ([`LieMeanAccumulator`](crate::sample::LieMeanAccumulator)). Analytic methods propagate
+//! Gaussians operation by operation. Statistics are taken as particles pass a node; a long
+//! propagation keeps the particles of at most [`StepPolicy::max_detailed`] steps, so memory
+//! does not grow with the step count.
+//!
+//! # Blocked Monte Carlo: bounded memory
+//! Every random draw comes from the stream of its 1024-sample chunk
+//! ([`crate::sample::chunk_rng`]), so any block of samples `k·1024 ..` can be simulated
+//! through all operations on its own and gets exactly the particles a whole-sample run would.
+//! When the particles would exceed [`PARTICLE_MEMORY_BUDGET`] (e.g. 10⁷ samples), the sample
+//! is split into blocks: the statistics are summed block by block (one pass over the blocks
+//! per Lie-mean iteration, each re-simulating the blocks), the evaluation keeps the first
+//! block's particles, and [`evaluate_block`] re-simulates any later block for its clouds.
+//!
+//! ```
+//! use posecov::input::scenario::{Scenario, lower};
+//! use posecov::eval::{EvalSettings, evaluate};
+//! use posecov::uncertain::Method;
+//! let text = "[scenario]\ntitle='t'\ngroup='se2'\n[[pose]]\nname='a'\nmean={xy_theta=[1,0,0]}\ncov={std=[0.1,0.1,0.1]}\n\
+//!             [[operation]]\nkind='inverse'\ninput='a'\noutput='a_inv'\n";
+//! let plan = lower(&Scenario::parse(text, "t.toml").unwrap()).unwrap().plan;
+//! let settings = EvalSettings { samples: 500, methods: vec![Method::FirstOrder, Method::MonteCarlo], ..Default::default() };
+//! let e = evaluate(&plan, &settings).unwrap();
+//! assert!(e.records().iter().any(|r| r.label == "a_inv" && r.relative_error_vs_monte_carlo.is_some()));
+//! ```
+
+use std::ops::Range;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+mod blocked;
+mod engine;
+pub mod groups;
+mod model;
+mod ops;
+
+pub use model::{
+    AnyEvaluation, Estimate, Evaluation, Finding, MatrixFrame, McSummary, Node, PathKind,
+    PointNode, PosePath, Role,
+};
+
+use crate::lie::{Se2, Se3, So2, So3};
+use crate::plan::{AnyPlan, Op, Plan, StepPolicy, limits};
+use crate::sample::CHUNK_SIZE;
+use crate::uncertain::Method;
+use blocked::BlockedStats;
+use engine::{Engine, StatsMode};
+use groups::EvalGroup;
+
+/// Bytes of Monte Carlo particles (all nodes together) an evaluation holds at once; larger
+/// samples are simulated in blocks ([blocked Monte Carlo](self#blocked-monte-carlo-bounded-memory)).
+pub const PARTICLE_MEMORY_BUDGET: usize = 128 << 20;
+/// At most this many particles per block (also the size of the drawn first block's clouds).
+pub const MAX_BLOCK_SAMPLES: usize = 64 * CHUNK_SIZE;
+/// At least this many particles per block, however many nodes hold particles.
+pub const MIN_BLOCK_SAMPLES: usize = 4 * CHUNK_SIZE;
+
+/// What an evaluation needs besides the plan, resolved once by the caller.
+#[derive(Debug, Clone)]
+pub struct EvalSettings {
+    /// Seed of every random draw.
+    pub seed: u64,
+    /// Monte Carlo samples (used when `methods` has Monte Carlo), 2 ..= 10⁷.
+    pub samples: usize,
+    /// Methods to compare (the first-order or exact result is always computed).
+    pub methods: Vec<Method>,
+    /// Particles held at once (rounded up to a multiple of [`CHUNK_SIZE`]); `None` chooses
+    /// from [`PARTICLE_MEMORY_BUDGET`].
+    pub block_samples: Option<usize>,
+    /// Which steps of long propagations keep numbers and particles.
+    pub steps: StepPolicy,
+    /// Set to stop early (Ctrl-C): the evaluation returns what it has, with
+    /// [`Finding::Interrupted`].
+    pub cancel: Option<Arc<AtomicBool>>,
+}
+
+impl Default for EvalSettings {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            samples: 2000,
+            methods: Vec::new(),
+            block_samples: None,
+            steps: StepPolicy::default(),
+            cancel: None,
+        }
+    }
+}
+
+impl EvalSettings {
+    fn cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
+    fn monte_carlo(&self) -> bool {
+        self.methods.contains(&Method::MonteCarlo)
+    }
+}
+
+/// Why a plan could not be evaluated. `operation` is the index of the operation in the plan
+/// (`operation[k]` in a scenario file), `output` the name it defines.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EvalError {
+    /// A setting is out of range (the caller validates its own flags first).
+    #[error("{what} = {value} is out of range: {expected}")]
+    Setting {
+        /// Which setting.
+        what: &'static str,
+        /// Its value.
+        value: String,
+        /// What is accepted.
+        expected: String,
+    },
+    /// An operand refers to a definition that does not exist yet, or is not a pose.
+    #[error("operation[{operation}] (`{output}`): operand {definition} is not an earlier pose")]
+    Undefined {
+        /// Operation index.
+        operation: usize,
+        /// Its output.
+        output: String,
+        /// The definition referred to.
+        definition: usize,
+    },
+    /// An operation that the plan's group cannot do.
+    #[error("operation[{operation}] (`{output}`): {what} is not available for {group}")]
+    WrongGroup {
+        /// Operation index.
+        operation: usize,
+        /// Its output.
+        output: String,
+        /// The operation.
+        what: &'static str,
+        /// The group.
+        group: &'static str,
+    },
+    /// The work asked for exceeds [`limits::MAX_PARTICLE_STEPS`].
+    #[error(
+        "operation[{operation}] (`{output}`): {samples} samples × {steps} steps = {work:.2e} particle-steps in all exceeds the limit {limit:.0e}; lower the samples or the steps"
+    )]
+    TooMuchWork {
+        /// Operation index (where the limit is crossed).
+        operation: usize,
+        /// Its output.
+        output: String,
+        /// Samples.
+        samples: usize,
+        /// Steps of that operation.
+        steps: u64,
+        /// Particle-steps of the whole plan.
+        work: f64,
+        /// The limit.
+        limit: f64,
+    },
+    /// The result is not finite: an input too large, a noise too strong, a parameter too small.
+    #[error(
+        "operation[{operation}] (`{output}`{}): the {method} result is not finite (overflow); check the magnitudes of its inputs and parameters",
+        step.map_or(String::new(), |k| format!(", step {k}"))
+    )]
+    NonFinite {
+        /// Operation index.
+        operation: usize,
+        /// Its output.
+        output: String,
+        /// Step, for propagations.
+        step: Option<u64>,
+        /// The method whose result overflowed.
+        method: &'static str,
+    },
+    /// Fusion failed; `input` is the position in `inputs` of the estimate at fault, if one is.
+    #[error(
+        "operation[{operation}] (`{output}`): fusion failed{}: {source}",
+        input.map_or(String::new(), |i| format!(" at inputs[{i}]"))
+    )]
+    Fusion {
+        /// Operation index.
+        operation: usize,
+        /// Its output.
+        output: String,
+        /// The estimate at fault.
+        input: Option<usize>,
+        /// The library's error.
+        source: crate::Error,
+    },
+    /// The library refused (e.g. an invalid robot, a singular joint covariance).
+    #[error("operation[{operation}] (`{output}`): {source}")]
+    Math {
+        /// Operation index.
+        operation: usize,
+        /// Its output.
+        output: String,
+        /// The library's error.
+        source: crate::Error,
+    },
+}
+
+impl EvalError {
+    /// The index of the operation the error is about, if any.
+    ///
+    /// ```
+    /// use posecov::eval::EvalError;
+    /// let e = EvalError::Undefined { operation: 2, output: "x".into(), definition: 9 };
+    /// assert_eq!(e.operation(), Some(2));
+    /// ```
+    pub fn operation(&self) -> Option<usize> {
+        match self {
+            EvalError::Setting { .. } => None,
+            EvalError::Undefined { operation, .. }
+            | EvalError::WrongGroup { operation, .. }
+            | EvalError::TooMuchWork { operation, .. }
+            | EvalError::NonFinite { operation, .. }
+            | EvalError::Fusion { operation, .. }
+            | EvalError::Math { operation, .. } => Some(*operation),
+        }
+    }
+}
+
+/// Evaluates a plan of any group.
+///
+/// ```
+/// use posecov::eval::{EvalSettings, evaluate};
+/// use posecov::plan::{AnyPlan, Plan};
+/// use posecov::uncertain::Method;
+/// let settings = EvalSettings { samples: 1, methods: vec![Method::MonteCarlo], ..Default::default() };
+/// let e = evaluate(&AnyPlan::So2(Plan::default()), &settings).unwrap_err();
+/// assert!(e.to_string().starts_with("samples = 1 is out of range"), "{e}");
+/// ```
+pub fn evaluate(plan: &AnyPlan, settings: &EvalSettings) -> Result<AnyEvaluation, EvalError> {
+    check_settings(settings)?;
+    Ok(match plan {
+        AnyPlan::So2(p) => AnyEvaluation::So2(run::<So2, 1>(p, settings)?),
+        AnyPlan::Se2(p) => AnyEvaluation::Se2(run::<Se2, 3>(p, settings)?),
+        AnyPlan::So3(p) => AnyEvaluation::So3(run::<So3, 3>(p, settings)?),
+        AnyPlan::Se3(p) => AnyEvaluation::Se3(run::<Se3, 6>(p, settings)?),
+    })
+}
+
+/// Evaluates block `block` (0-based) of a blocked Monte Carlo sample for its particles only:
+/// nodes carry the particles of samples `block · b ..` (b = `main`'s block size) and no
+/// statistics. `None` past the last block. The caller draws and logs each block's clouds
+/// in turn, holding one block at a time.
+///
+/// ```
+/// use posecov::input::scenario::{Scenario, lower};
+/// use posecov::eval::{EvalSettings, evaluate, evaluate_block};
+/// use posecov::uncertain::Method;
+/// let plan = lower(&Scenario::load_any("so3_sampling").unwrap()).unwrap().plan;
+/// let settings = EvalSettings { samples: 5000, block_samples: Some(2048), methods: vec![Method::MonteCarlo], ..Default::default() };
+/// let main = evaluate(&plan, &settings).unwrap();
+/// assert_eq!(main.run().2, 2048);
+/// assert!(evaluate_block(&plan, &settings, &main, 2).unwrap().is_some()); // samples 4096..5000
+/// assert!(evaluate_block(&plan, &settings, &main, 3).unwrap().is_none());
+/// ```
+pub fn evaluate_block(
+    plan: &AnyPlan,
+    settings: &EvalSettings,
+    main: &AnyEvaluation,
+    block: usize,
+) -> Result<Option<AnyEvaluation>, EvalError> {
+    let (_, n, b, _) = main.run();
+    let start = block.saturating_mul(b.max(1));
+    if start >= n || !settings.monte_carlo() {
+        return Ok(None);
+    }
+    let range = start..(start + b).min(n);
+    Ok(Some(match plan {
+        AnyPlan::So2(p) => AnyEvaluation::So2(Engine::run(p, settings, range, StatsMode::Skip)?),
+        AnyPlan::Se2(p) => AnyEvaluation::Se2(Engine::run(p, settings, range, StatsMode::Skip)?),
+        AnyPlan::So3(p) => AnyEvaluation::So3(Engine::run(p, settings, range, StatsMode::Skip)?),
+        AnyPlan::Se3(p) => AnyEvaluation::Se3(Engine::run(p, settings, range, StatsMode::Skip)?),
+    }))
+}
+
+fn check_settings(settings: &EvalSettings) -> Result<(), EvalError> {
+    let n = settings.samples as u64;
+    if settings.monte_carlo() && !(limits::MIN_SAMPLES..=limits::MAX_SAMPLES).contains(&n) {
+        return Err(EvalError::Setting {
+            what: "samples",
+            value: n.to_string(),
+            expected: format!("use {} ..= {}", limits::MIN_SAMPLES, limits::MAX_SAMPLES),
+        });
+    }
+    if settings.block_samples == Some(0) {
+        return Err(EvalError::Setting {
+            what: "block_samples",
+            value: "0".to_owned(),
+            expected: "at least 1".to_owned(),
+        });
+    }
+    Ok(())
+}
+
+/// Refuses plans whose Monte Carlo work exceeds [`limits::MAX_PARTICLE_STEPS`], naming the
+/// operation at which the sum crosses it.
+fn check_work<G: EvalGroup<N>, const N: usize>(
+    plan: &Plan<G, N>,
+    settings: &EvalSettings,
+) -> Result<(), EvalError> {
+    if !settings.monte_carlo() {
+        return Ok(());
+    }
+    let samples = settings.samples;
+    let mut work = samples as f64 * plan.poses.len() as f64;
+    for (i, o) in plan.operations.iter().enumerate() {
+        let steps = match &o.op {
+            Op::DiffDrive { motion, .. } => (motion.duration / motion.dt).ceil() as u64,
+            op => op.steps().max(1),
+        };
+        work += samples as f64 * steps as f64;
+        if work > limits::MAX_PARTICLE_STEPS {
+            return Err(EvalError::TooMuchWork {
+                operation: i,
+                output: o.output.clone(),
+                samples,
+                steps,
+                work,
+                limit: limits::MAX_PARTICLE_STEPS,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// One evaluation, in one block when the particles fit [`PARTICLE_MEMORY_BUDGET`], else
+/// blocked.
+fn run<G: EvalGroup<N>, const N: usize>(
+    plan: &Plan<G, N>,
+    settings: &EvalSettings,
+) -> Result<Evaluation<G, N>, EvalError> {
+    check_work(plan, settings)?;
+    let n = if settings.monte_carlo() {
+        settings.samples
+    } else {
+        0
+    };
+    let b = block_samples(plan, settings)?.min(n);
+    if b >= n {
+        return Engine::run(plan, settings, 0..n, StatsMode::Own);
+    }
+    run_blocked(plan, settings, n, b)
+}
+
+/// Particles per block: the settings', else as many as fit the budget given how many
+/// particle sets are held at once (counted by an evaluation without Monte Carlo), within
+/// [`MIN_BLOCK_SAMPLES`] ..= [`MAX_BLOCK_SAMPLES`]; always a multiple of [`CHUNK_SIZE`].
+fn block_samples<G: EvalGroup<N>, const N: usize>(
+    plan: &Plan<G, N>,
+    settings: &EvalSettings,
+) -> Result<usize, EvalError> {
+    let round = |b: usize| b.div_ceil(CHUNK_SIZE).max(1) * CHUNK_SIZE;
+    if let Some(b) = settings.block_samples {
+        return Ok(round(b));
+    }
+    if !settings.monte_carlo() {
+        return Ok(0);
+    }
+    let mut dry = settings.clone();
+    dry.methods.retain(|m| *m != Method::MonteCarlo);
+    let shape = Engine::<G, N>::run(plan, &dry, 0..0, StatsMode::Skip)?;
+    let held = shape
+        .nodes
+        .iter()
+        .filter(|n| {
+            n.role != Role::Fixed
+                && n.step
+                    .is_none_or(|k| settings.steps.detailed(k, n.last_step.unwrap_or(k)))
+        })
+        .count()
+        + 1; // the propagation step in flight
+    let bytes = held * std::mem::size_of::<G>() + shape.points.len() * 24;
+    let fit = PARTICLE_MEMORY_BUDGET / bytes.max(1);
+    Ok(fit.clamp(MIN_BLOCK_SAMPLES, MAX_BLOCK_SAMPLES) / CHUNK_SIZE * CHUNK_SIZE)
+}
+
+/// Blocked Monte Carlo: block 0 is evaluated (its Lie means start the iteration), then
+/// every block is re-simulated once per pass of the Lie-mean iteration, summing each node's
+/// tangent moments ([`BlockedStats`]); finally block 0 again, with those statistics.
+fn run_blocked<G: EvalGroup<N>, const N: usize>(
+    plan: &Plan<G, N>,
+    settings: &EvalSettings,
+    n: usize,
+    b: usize,
+) -> Result<Evaluation<G, N>, EvalError> {
+    let blocks: Vec<Range<usize>> = (0..n).step_by(b).map(|s| s..(s + b).min(n)).collect();
+    let first = Engine::<G, N>::run(plan, settings, 0..b, StatsMode::Own)?;
+    let mut stats = BlockedStats::start(&first);
+    drop(first);
+    let mut passes = 0;
+    while stats.iterating() {
+        for range in &blocks {
+            if settings.cancelled() {
+                let mut out = Engine::run(plan, settings, 0..b, StatsMode::Own)?;
+                out.findings.push(Finding::Interrupted);
+                return Ok(out);
+            }
+            Engine::run(
+                plan,
+                settings,
+                range.clone(),
+                StatsMode::Collect(&mut stats, passes == 0),
+            )?;
+        }
+        stats.finish_pass();
+        passes += 1;
+    }
+    let mut out = Engine::run(plan, settings, 0..b, StatsMode::Blocked(&stats))?;
+    out.samples = n;
+    out.findings.push(Finding::Blocked {
+        samples: n,
+        blocks: blocks.len(),
+        block_samples: b,
+        passes,
+    });
+    Ok(out)
+}

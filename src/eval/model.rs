@@ -1,0 +1,334 @@
+//! What an evaluation produces: numbers only, for drawing and for `report --json`.
+
+use std::sync::Arc;
+
+use nalgebra::{Matrix3, Vector3};
+use serde::Serialize;
+
+use crate::lie::{GroupKind, LieGroup, Se2, Se3, So2, So3, TangentMatrix};
+use crate::plan::OpKind;
+use crate::propagate::{MatrixRows, Propagated, ResultRecord};
+use crate::sample::SampleStatistics;
+use crate::uncertain::Method;
+
+/// Where a node comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// A pose given with a covariance.
+    Input,
+    /// A known transform (no covariance).
+    Fixed,
+    /// The result of an operation.
+    Output,
+}
+
+/// One method's estimate of a node, with its error against Monte Carlo where that ran.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate<G: LieGroup<N>, const N: usize> {
+    /// Mean, covariance, side and method.
+    pub result: Propagated<G, N>,
+    /// ‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F with both on the right side, where Monte Carlo ran.
+    pub error_vs_monte_carlo: Option<f64>,
+}
+
+/// Monte Carlo statistics of a node beyond its Lie mean and covariance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct McSummary<G: LieGroup<N>, const N: usize> {
+    /// The Lie mean and centred 1/(N−1) covariance (right side).
+    pub stats: SampleStatistics<G, N>,
+    /// E\[ξξᵀ\] about the nominal pose, left (world) side, uncentred — Barfoot & Furgale's
+    /// Monte Carlo covariance (2014, §IV), where the operation asks for it.
+    pub uncentred_left: Option<TangentMatrix<N>>,
+    /// The Cartesian mean of the samples' positions, where the operation asks for it.
+    pub position_mean: Option<Vector3<f64>>,
+}
+
+/// A named pose at one step, with every method's estimate.
+#[derive(Debug, Clone)]
+pub struct Node<G: LieGroup<N>, const N: usize> {
+    /// Pose name.
+    pub name: String,
+    /// Input, fixed or output.
+    pub role: Role,
+    /// The operation that produced it (`None` for the input's poses).
+    pub op: Option<OpKind>,
+    /// Step on the `step` timeline (propagations); `None` for single results.
+    pub step: Option<u64>,
+    /// The last step of this name's propagation (`None` for single results).
+    pub last_step: Option<u64>,
+    /// The nominal (noise-free) pose.
+    pub nominal: G,
+    /// One estimate per method that applies (Monte Carlo last, where it ran).
+    pub estimates: Vec<Estimate<G, N>>,
+    /// Monte Carlo statistics, where Monte Carlo ran.
+    pub monte_carlo: Option<McSummary<G, N>>,
+    /// Monte Carlo particles, kept for the input's nodes and the detailed steps of a
+    /// propagation ([`StepPolicy`](crate::plan::StepPolicy)); shared with the operations that
+    /// read them.
+    pub particles: Option<Arc<Vec<G>>>,
+}
+
+/// An uncertain point (a landmark seen from an uncertain pose), in world coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointNode {
+    /// Name.
+    pub name: String,
+    /// Per method: (method, mean in world, 3×3 covariance in world).
+    pub estimates: Vec<(Method, Vector3<f64>, Matrix3<f64>)>,
+    /// Monte Carlo particles, world coordinates.
+    pub particles: Option<Vec<[f64; 3]>>,
+}
+
+/// What a path of poses shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathKind {
+    /// The noise-free trajectory.
+    Nominal,
+    /// Sampled trajectory `k` (Monte Carlo).
+    Sample(usize),
+}
+
+/// A polyline of poses (nominal trajectories, sampled trajectories) of an output.
+#[derive(Debug, Clone)]
+pub struct PosePath<G> {
+    /// The output it belongs to.
+    pub output: String,
+    /// Nominal or sampled.
+    pub kind: PathKind,
+    /// The poses, in order.
+    pub poses: Vec<G>,
+}
+
+/// A 3×3 matrix that need not be a rotation, per step: what Euler integration leaves of one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MatrixFrame {
+    /// The output it belongs to.
+    pub output: String,
+    /// Step on the `step` timeline.
+    pub step: u64,
+    /// The matrix; column k is the image of axis k.
+    pub columns: Matrix3<f64>,
+}
+
+/// A fact the evaluation found that is not an estimate: something to tell the user in the
+/// text panel and in `report --json`. Failures that let the run finish are findings too;
+/// nothing is swallowed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Finding {
+    /// The Monte Carlo sample was simulated in blocks to bound memory.
+    Blocked {
+        /// Samples in all.
+        samples: usize,
+        /// Blocks.
+        blocks: usize,
+        /// Samples per block.
+        block_samples: usize,
+        /// Lie-mean passes over all blocks.
+        passes: usize,
+    },
+    /// Gauss–Newton fusion result.
+    Fusion {
+        /// The output.
+        output: String,
+        /// How many estimates were fused.
+        inputs: usize,
+        /// Final cost V = ½ Σ eᵢᵀ Σᵢ⁻¹ eᵢ (Barfoot & Furgale 2014, §IV).
+        cost: f64,
+        /// Iterations.
+        iterations: usize,
+    },
+    /// A differential drive's nominal end, the samples' Lie mean and their Cartesian mean.
+    DiffDriveMeans {
+        /// The output.
+        output: String,
+        /// Wheel noise intensity D.
+        diffusion: f64,
+        /// Nominal end (x, y).
+        nominal_end: [f64; 2],
+        /// Lie mean of the samples (x, y).
+        lie_mean: [f64; 2],
+        /// Cartesian mean of the samples' positions (x, y).
+        cartesian_mean: [f64; 2],
+    },
+    /// Euler integration's drift off SO(3) against the exponential map's.
+    EulerDrift {
+        /// The output.
+        output: String,
+        /// Steps.
+        steps: u64,
+        /// dt (s).
+        dt: f64,
+        /// max |RᵀR − I| after Euler steps.
+        euler: f64,
+        /// max |RᵀR − I| after Exp steps.
+        exp: f64,
+    },
+    /// A method could not produce an estimate for an output; the others stand.
+    MethodFailed {
+        /// The output.
+        output: String,
+        /// Step, for propagations.
+        step: Option<u64>,
+        /// The method.
+        method: Method,
+        /// Why.
+        reason: String,
+    },
+    /// An estimate's covariance is not positive semi-definite (it is reported and drawn
+    /// clamped to its PSD part, never hidden).
+    NotPositiveSemiDefinite {
+        /// The output.
+        output: String,
+        /// Step, for propagations.
+        step: Option<u64>,
+        /// The method.
+        method: Method,
+        /// Smallest eigenvalue.
+        smallest_eigenvalue: f64,
+        /// Largest eigenvalue.
+        largest_eigenvalue: f64,
+    },
+    /// Recorded steps of a long propagation were thinned ([`StepPolicy`](crate::plan::StepPolicy)).
+    StepsThinned {
+        /// The output.
+        output: String,
+        /// Steps in all.
+        steps: u64,
+        /// Steps recorded.
+        recorded: u64,
+    },
+    /// Ctrl-C stopped the evaluation: later operations or steps are missing.
+    Interrupted,
+}
+
+/// Everything a plan evaluates to, for one group: numbers, no drawing.
+#[derive(Debug, Clone)]
+pub struct Evaluation<G: LieGroup<N>, const N: usize> {
+    /// The seed every random draw came from.
+    pub seed: u64,
+    /// Monte Carlo samples (0 when Monte Carlo was not requested).
+    pub samples: usize,
+    /// Particles simulated and held at once (= `samples` unless blocked).
+    pub block_samples: usize,
+    /// Methods compared.
+    pub methods: Vec<Method>,
+    /// Every pose at every recorded step, in evaluation order.
+    pub nodes: Vec<Node<G, N>>,
+    /// Uncertain points.
+    pub points: Vec<PointNode>,
+    /// Polylines of poses.
+    pub paths: Vec<PosePath<G>>,
+    /// Non-orthonormal frames (Euler integration).
+    pub matrix_frames: Vec<MatrixFrame>,
+    /// What the user should know besides the estimates.
+    pub findings: Vec<Finding>,
+}
+
+impl<G: LieGroup<N>, const N: usize> Evaluation<G, N>
+where
+    G::Matrix: MatrixRows,
+{
+    /// Every estimate as a plain record (label `name` or `name@step`).
+    ///
+    /// ```
+    /// use posecov::input::scenario::{Scenario, lower};
+    /// use posecov::eval::{EvalSettings, evaluate};
+    /// let s = Scenario::parse("[scenario]\ntitle='t'\ngroup='se2'\nmethods=['first_order']\n[[pose]]\nname='a'\nmean={xy_theta=[1,2,0]}\ncov={std=[0.1,0.1,0.1]}\n", "t.toml").unwrap();
+    /// let e = evaluate(&lower(&s).unwrap().plan, &EvalSettings::default()).unwrap();
+    /// assert!(!e.records().is_empty());
+    /// ```
+    pub fn records(&self) -> Vec<ResultRecord> {
+        self.nodes
+            .iter()
+            .flat_map(|node| {
+                let label = match node.step {
+                    Some(k) => format!("{}@{k}", node.name),
+                    None => node.name.clone(),
+                };
+                node.estimates
+                    .iter()
+                    .map(move |e| ResultRecord::new(&label, &e.result, e.error_vs_monte_carlo))
+            })
+            .collect()
+    }
+}
+
+/// An evaluation of any group.
+#[derive(Debug, Clone)]
+pub enum AnyEvaluation {
+    /// SO(2).
+    So2(Evaluation<So2, 1>),
+    /// SE(2).
+    Se2(Evaluation<Se2, 3>),
+    /// SO(3).
+    So3(Evaluation<So3, 3>),
+    /// SE(3).
+    Se3(Evaluation<Se3, 6>),
+}
+
+/// Calls `$body` with `$e` bound to the group-typed evaluation inside an [`AnyEvaluation`].
+#[macro_export]
+#[doc(hidden)]
+macro_rules! with_evaluation {
+    ($any:expr, $e:ident => $body:expr) => {
+        match $any {
+            $crate::eval::AnyEvaluation::So2($e) => $body,
+            $crate::eval::AnyEvaluation::Se2($e) => $body,
+            $crate::eval::AnyEvaluation::So3($e) => $body,
+            $crate::eval::AnyEvaluation::Se3($e) => $body,
+        }
+    };
+}
+
+impl AnyEvaluation {
+    /// The group.
+    ///
+    /// ```
+    /// use posecov::{eval::{EvalSettings, evaluate}, lie::GroupKind, plan::{AnyPlan, Plan}};
+    /// let e = evaluate(&AnyPlan::So3(Plan::default()), &EvalSettings::default()).unwrap();
+    /// assert_eq!(e.group(), GroupKind::So3);
+    /// ```
+    pub fn group(&self) -> GroupKind {
+        match self {
+            AnyEvaluation::So2(_) => GroupKind::So2,
+            AnyEvaluation::Se2(_) => GroupKind::Se2,
+            AnyEvaluation::So3(_) => GroupKind::So3,
+            AnyEvaluation::Se3(_) => GroupKind::Se3,
+        }
+    }
+
+    /// Every estimate as a plain record.
+    ///
+    /// ```
+    /// use posecov::{eval::{EvalSettings, evaluate}, plan::{AnyPlan, Plan}};
+    /// let e = evaluate(&AnyPlan::So3(Plan::default()), &EvalSettings::default()).unwrap();
+    /// assert!(e.records().is_empty());
+    /// ```
+    pub fn records(&self) -> Vec<ResultRecord> {
+        with_evaluation!(self, e => e.records())
+    }
+
+    /// The findings.
+    ///
+    /// ```
+    /// use posecov::{eval::{EvalSettings, evaluate}, plan::{AnyPlan, Plan}};
+    /// let e = evaluate(&AnyPlan::So3(Plan::default()), &EvalSettings::default()).unwrap();
+    /// assert!(e.findings().is_empty());
+    /// ```
+    pub fn findings(&self) -> &[Finding] {
+        with_evaluation!(self, e => &e.findings)
+    }
+
+    /// (seed, samples, block samples, methods) the evaluation ran with.
+    ///
+    /// ```
+    /// use posecov::{eval::{EvalSettings, evaluate}, plan::{AnyPlan, Plan}};
+    /// let e = evaluate(&AnyPlan::So3(Plan::default()), &EvalSettings::default()).unwrap();
+    /// assert_eq!(e.run().0, 0);
+    /// ```
+    pub fn run(&self) -> (u64, usize, usize, &[Method]) {
+        with_evaluation!(self, e => (e.seed, e.samples, e.block_samples, e.methods.as_slice()))
+    }
+}

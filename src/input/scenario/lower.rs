@@ -1,0 +1,780 @@
+//! Lowering a parsed scenario file to a typed [`Plan`]: every check a user can fail, each
+//! reported at `file:line:column` with the key (`operation[2].noise`) and the value.
+//!
+//! This is the only place that reads the flat [`OperationSpec`]: which keys each kind takes
+//! ([`OPERATION_KINDS`]), whether names exist and are of the right kind (a known transform,
+//! an uncertain pose, or a point, which pose operations reject), and every numeric range.
+//! The evaluation then sees only typed values.
+
+use std::collections::{BTreeMap, HashMap};
+use std::ops::Range;
+
+use nalgebra::{DMatrix, Matrix3, Vector3};
+use toml::Spanned;
+
+use super::schema::{CovSpec, DrawSpec, OperationSpec, ScenarioFile};
+use super::values::{SpecGroup, control_for, cov_for, fixed_matrix, mean_for};
+use super::{Scenario, ScenarioError};
+use crate::input::{About, DrawChoices, FileSettings, Input};
+use crate::lie::{GroupKind, LieGroup, Se2, Se3, So2, So3, TangentMatrix};
+use crate::plan::{
+    AnyPlan, DiffDriveMotion, FrameSide, Op, OdometryModel, Operand, Plan, limits,
+};
+use crate::propagate::first_order::CorrelatedPair;
+use crate::uncertain::{Side, UncertainPose};
+
+/// Every operation kind, with the keys it requires and the keys it accepts besides `kind`
+/// and `output`. The one table of operation keys.
+pub const OPERATION_KINDS: &[(&str, &[&str], &[&str])] = &[
+    ("inverse", &["input"], &[]),
+    ("change_frame_left", &["input", "by"], &[]),
+    ("change_frame_right", &["input", "by"], &[]),
+    ("compose", &["lhs", "rhs"], &[]),
+    ("between", &["lhs", "rhs"], &[]),
+    ("compose_correlated", &["lhs", "rhs", "cross_cov"], &[]),
+    ("between_correlated", &["lhs", "rhs", "cross_cov"], &[]),
+    ("odometry", &["input", "controls", "noise", "model"], &["steps"]),
+    ("compound", &["input", "by", "noise", "steps"], &[]),
+    (
+        "diff_drive",
+        &[
+            "wheel_radius",
+            "wheelbase",
+            "duration",
+            "diffusion",
+            "speed",
+            "turn_rate",
+        ],
+        &["input", "dt"],
+    ),
+    ("point_through_pose", &["input", "point"], &["point_cov"]),
+    ("fuse", &["inputs"], &[]),
+    ("euler_vs_exp", &["rate", "dt", "steps"], &["input"]),
+];
+
+/// Lowers a parsed scenario: the plan of its group, its text, the file's settings and drawing
+/// choices, all checked.
+///
+/// ```
+/// use posecov::input::scenario::{Scenario, lower};
+/// let s = Scenario::parse("[scenario]\ntitle='t'\ngroup='se2'\n[[pose]]\nname='a'\nmean={xy_theta=[1,0,0]}\ncov={std=[0.1,0.1,0.1]}\n[[operation]]\nkind='inverse'\ninput='b'\noutput='c'\n", "t.toml").unwrap();
+/// let e = lower(&s).unwrap_err().to_string();
+/// assert!(e.starts_with("t.toml:10:7: operation[0].input: no pose named `b`"), "{e}");
+/// ```
+pub fn lower(scenario: &Scenario) -> Result<Input, ScenarioError> {
+    let file = &scenario.file;
+    let lower = Lowering {
+        file,
+        loc: scenario,
+    };
+    let defaults = lower.settings()?;
+    let draw = lower.draw_choices(&file.draw)?;
+    let plan = match file.scenario.group {
+        GroupKind::So2 => AnyPlan::So2(lower.plan::<So2, 1>()?),
+        GroupKind::Se2 => AnyPlan::Se2(lower.plan::<Se2, 3>()?),
+        GroupKind::So3 => AnyPlan::So3(lower.plan::<So3, 3>()?),
+        GroupKind::Se3 => AnyPlan::Se3(lower.plan::<Se3, 6>()?),
+    };
+    let h = &file.scenario;
+    Ok(Input {
+        about: About {
+            title: h.title.clone(),
+            description: h.description.clone(),
+            source: h.source.clone(),
+        },
+        plan,
+        defaults,
+        draw,
+    })
+}
+
+/// The accepted range of a number: `low` (excluded when `open_low`) ..= `high`.
+#[derive(Clone, Copy)]
+struct Bounds {
+    low: f64,
+    open_low: bool,
+    high: f64,
+}
+
+/// What a name stands for while lowering.
+#[derive(Clone, Copy)]
+enum Named<G> {
+    /// A known transform.
+    Known(G),
+    /// An uncertain pose (definition number).
+    Pose(usize),
+    /// An uncertain point (a `point_through_pose` output): not a pose.
+    Point,
+}
+
+struct Lowering<'a> {
+    file: &'a ScenarioFile,
+    loc: &'a Scenario,
+}
+
+/// The plan being built and the names defined so far.
+struct Table<G: LieGroup<N>, const N: usize> {
+    plan: Plan<G, N>,
+    names: HashMap<String, Named<G>>,
+}
+
+impl Lowering<'_> {
+    fn err(&self, span: Range<usize>, field: &str, message: impl Into<String>) -> ScenarioError {
+        self.loc.locator.error(span, field, message)
+    }
+
+    /// `[scenario]` seed, samples, confidence, methods.
+    fn settings(&self) -> Result<FileSettings, ScenarioError> {
+        let h = &self.file.scenario;
+        if let Some(n) = &h.samples
+            && !(limits::MIN_SAMPLES..=limits::MAX_SAMPLES).contains(n.get_ref())
+        {
+            return Err(self.err(
+                n.span(),
+                "scenario.samples",
+                format!(
+                    "{} is out of range: use {} ..= {}",
+                    n.get_ref(),
+                    limits::MIN_SAMPLES,
+                    limits::MAX_SAMPLES
+                ),
+            ));
+        }
+        if let Some(c) = &h.confidence
+            && !(*c.get_ref() > 0.0 && *c.get_ref() < 1.0)
+        {
+            return Err(self.err(
+                c.span(),
+                "scenario.confidence",
+                format!("{} is not a probability in (0, 1), e.g. 0.95", c.get_ref()),
+            ));
+        }
+        let mut methods = h.methods.clone();
+        methods.dedup();
+        Ok(FileSettings {
+            seed: h.seed,
+            samples: h.samples.as_ref().map(|s| *s.get_ref()),
+            confidence: h.confidence.as_ref().map(|c| *c.get_ref()),
+            methods,
+        })
+    }
+
+    /// `[draw]` and each pose's `draw`.
+    fn draw_choices(&self, spec: &DrawSpec) -> Result<DrawChoices, ScenarioError> {
+        if let Some(len) = &spec.axis_length {
+            let v = *len.get_ref();
+            if !(v.is_finite() && v > 0.0 && v <= limits::MAX_AXIS_LENGTH) {
+                return Err(self.err(
+                    len.span(),
+                    "draw.axis_length",
+                    format!(
+                        "{v} is out of range: a length in metres, > 0 and ≤ {}",
+                        limits::MAX_AXIS_LENGTH
+                    ),
+                ));
+            }
+        }
+        let shown: BTreeMap<String, bool> = self
+            .file
+            .poses
+            .iter()
+            .filter_map(|p| p.draw.map(|d| (p.name.get_ref().clone(), d)))
+            .collect();
+        Ok(DrawChoices {
+            axes: spec.axes,
+            clouds: spec.clouds,
+            sample_axes: spec.sample_axes,
+            ellipsoids: spec.ellipsoids,
+            bananas: spec.bananas,
+            orientation: spec.orientation,
+            trajectories: spec.trajectories,
+            axis_length: spec.axis_length.as_ref().map(|l| *l.get_ref()),
+            top_view: spec.view.map(|v| v == super::schema::View::Top),
+            shown,
+        })
+    }
+
+    fn plan<G: SpecGroup<N>, const N: usize>(&self) -> Result<Plan<G, N>, ScenarioError> {
+        let mut t = Table {
+            plan: Plan::default(),
+            names: HashMap::new(),
+        };
+        for (i, spec) in self.file.poses.iter().enumerate() {
+            let field = format!("pose[{i}]");
+            let name = self.new_name(&t, &spec.name, &format!("{field}.name"))?;
+            let mean: G = mean_for(spec.mean.get_ref())
+                .map_err(|e| self.err(spec.mean.span(), &format!("{field}.mean"), e.to_string()))?;
+            match &spec.cov {
+                None => {
+                    t.plan.known(&name, mean);
+                    t.names.insert(name, Named::Known(mean));
+                }
+                Some(cov) => {
+                    let (cov, side) = self.cov::<G, N>(cov, &mean, &format!("{field}.cov"))?;
+                    let operand = t
+                        .plan
+                        .uncertain(&name, UncertainPose::new_unchecked(mean, cov, side));
+                    let Operand::Defined(k) = operand else {
+                        unreachable!("an uncertain pose is a definition")
+                    };
+                    t.names.insert(name, Named::Pose(k));
+                }
+            }
+        }
+        for (i, op) in self.file.operations.iter().enumerate() {
+            let field = format!("operation[{i}]");
+            self.check_keys(op, &field)?;
+            let output = self.new_name(&t, &op.output, &format!("{field}.output"))?;
+            let lowered = self.operation::<G, N>(&t, op, &field)?;
+            let is_point = matches!(lowered, Op::PointThroughPose { .. });
+            let k = t.plan.definitions();
+            t.plan.operation(&output, lowered);
+            t.names
+                .insert(output, if is_point { Named::Point } else { Named::Pose(k) });
+        }
+        Ok(t.plan)
+    }
+
+    fn new_name<G: LieGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        name: &Spanned<String>,
+        field: &str,
+    ) -> Result<String, ScenarioError> {
+        let n = name.get_ref();
+        if n.is_empty()
+            || !n
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+        {
+            return Err(self.err(
+                name.span(),
+                field,
+                format!("`{n}` is not a valid name: use letters, digits, `_`, `-` or `.` (e.g. `world_from_body`)"),
+            ));
+        }
+        if t.names.contains_key(n) {
+            return Err(self.err(name.span(), field, format!("`{n}` is already defined")));
+        }
+        Ok(n.clone())
+    }
+
+    /// The keys set are the kind's: none foreign, none missing.
+    fn check_keys(&self, op: &OperationSpec, field: &str) -> Result<(), ScenarioError> {
+        let kind = op.kind.get_ref().as_str();
+        let Some((_, required, optional)) = OPERATION_KINDS.iter().find(|(k, ..)| *k == kind)
+        else {
+            let kinds: Vec<&str> = OPERATION_KINDS.iter().map(|(k, ..)| *k).collect();
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.kind"),
+                format!("unknown operation `{kind}`; expected one of {}", kinds.join(", ")),
+            ));
+        };
+        let set = op.keys_set();
+        if let Some(extra) = set
+            .iter()
+            .find(|k| !required.contains(k) && !optional.contains(k))
+        {
+            let mut takes: Vec<&str> = required.to_vec();
+            takes.extend(*optional);
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.{extra}"),
+                format!(
+                    "`{extra}` does not apply to `{kind}`, which takes {} (and output)",
+                    takes.join(", ")
+                ),
+            ));
+        }
+        if let Some(missing) = required.iter().find(|k| !set.contains(k)) {
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.{missing}"),
+                format!("`{kind}` needs `{missing}`"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// A key the kind requires (present after [`check_keys`](Self::check_keys)).
+    fn need<'b, T>(
+        &self,
+        value: &'b Option<T>,
+        op: &OperationSpec,
+        field: &str,
+        key: &str,
+    ) -> Result<&'b T, ScenarioError> {
+        value.as_ref().ok_or_else(|| {
+            self.err(
+                op.kind.span(),
+                &format!("{field}.{key}"),
+                format!("`{}` needs `{key}`", op.kind.get_ref()),
+            )
+        })
+    }
+
+    /// A name that must stand for a pose (known or uncertain).
+    fn operand<G: LieGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        name: &Spanned<String>,
+        field: &str,
+        kind: &str,
+    ) -> Result<Operand<G>, ScenarioError> {
+        match self.lookup(t, name, field)? {
+            Named::Known(g) => Ok(Operand::Known(g)),
+            Named::Pose(k) => Ok(Operand::Defined(k)),
+            Named::Point => Err(self.err(
+                name.span(),
+                field,
+                format!(
+                    "`{}` is a point (the output of `point_through_pose`), but `{kind}` needs a pose",
+                    name.get_ref()
+                ),
+            )),
+        }
+    }
+
+    /// A name that must stand for a known transform.
+    fn known<G: LieGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        name: &Spanned<String>,
+        field: &str,
+    ) -> Result<G, ScenarioError> {
+        match self.lookup(t, name, field)? {
+            Named::Known(g) => Ok(g),
+            _ => Err(self.err(
+                name.span(),
+                field,
+                format!(
+                    "`{}` must be a known transform (a pose without `cov`)",
+                    name.get_ref()
+                ),
+            )),
+        }
+    }
+
+    fn lookup<G: LieGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        name: &Spanned<String>,
+        field: &str,
+    ) -> Result<Named<G>, ScenarioError> {
+        t.names.get(name.get_ref()).copied().ok_or_else(|| {
+            let mut known: Vec<&str> = t.names.keys().map(String::as_str).collect();
+            known.sort_unstable();
+            self.err(
+                name.span(),
+                field,
+                format!(
+                    "no pose named `{}` (defined so far: {})",
+                    name.get_ref(),
+                    known.join(", ")
+                ),
+            )
+        })
+    }
+
+    fn cov<G: SpecGroup<N>, const N: usize>(
+        &self,
+        spec: &Spanned<CovSpec>,
+        mean: &G,
+        field: &str,
+    ) -> Result<(TangentMatrix<N>, Side), ScenarioError> {
+        cov_for::<G, N>(spec.get_ref(), mean)
+            .map_err(|e| self.err(spec.span(), field, e.to_string()))
+    }
+
+    fn steps(&self, op: &OperationSpec, field: &str) -> Result<Option<u64>, ScenarioError> {
+        match &op.steps {
+            None => Ok(None),
+            Some(s) if (1..=limits::MAX_STEPS).contains(s.get_ref()) => Ok(Some(*s.get_ref())),
+            Some(s) => Err(self.err(
+                s.span(),
+                &format!("{field}.steps"),
+                format!(
+                    "{} is out of range: use 1 ..= {}",
+                    s.get_ref(),
+                    limits::MAX_STEPS
+                ),
+            )),
+        }
+    }
+
+    /// A finite number within `bounds`.
+    fn number(
+        &self,
+        value: &Option<Spanned<f64>>,
+        op: &OperationSpec,
+        field: &str,
+        key: &str,
+        bounds: Bounds,
+    ) -> Result<f64, ScenarioError> {
+        let Bounds { low, open_low, high } = bounds;
+        let v = self.need(value, op, field, key)?;
+        let x = *v.get_ref();
+        let above = if open_low { x > low } else { x >= low };
+        if x.is_finite() && above && x <= high {
+            return Ok(x);
+        }
+        Err(self.err(
+            v.span(),
+            &format!("{field}.{key}"),
+            format!(
+                "{x} is out of range: must be finite, {} {low} and ≤ {high}",
+                if open_low { ">" } else { "≥" }
+            ),
+        ))
+    }
+
+    fn operation<G: SpecGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        op: &OperationSpec,
+        field: &str,
+    ) -> Result<Op<G, N>, ScenarioError> {
+        let kind = op.kind.get_ref().as_str();
+        let f = |k: &str| format!("{field}.{k}");
+        let pose = |value: &Option<Spanned<String>>, key: &str| -> Result<Operand<G>, ScenarioError> {
+            self.operand(t, self.need(value, op, field, key)?, &f(key), kind)
+        };
+        let known = |value: &Option<Spanned<String>>, key: &str| -> Result<G, ScenarioError> {
+            self.known(t, self.need(value, op, field, key)?, &f(key))
+        };
+        Ok(match kind {
+            "inverse" => Op::Inverse {
+                input: pose(&op.input, "input")?,
+            },
+            "change_frame_left" | "change_frame_right" => Op::ChangeFrame {
+                input: pose(&op.input, "input")?,
+                by: known(&op.by, "by")?,
+                side: if kind == "change_frame_left" {
+                    FrameSide::Left
+                } else {
+                    FrameSide::Right
+                },
+            },
+            "compose" | "between" | "compose_correlated" | "between_correlated" => {
+                let (lhs, rhs) = (pose(&op.lhs, "lhs")?, pose(&op.rhs, "rhs")?);
+                let cross_cov = match &op.cross_cov {
+                    None => None,
+                    Some(c) => Some(self.cross_cov(t, field, lhs, rhs, c)?),
+                };
+                if kind.starts_with("compose") {
+                    Op::Compose {
+                        lhs,
+                        rhs,
+                        cross_cov,
+                    }
+                } else {
+                    Op::Between {
+                        lhs,
+                        rhs,
+                        cross_cov,
+                    }
+                }
+            }
+            "odometry" => self.odometry(op, field, pose(&op.input, "input")?)?,
+            "compound" => {
+                let step = known(&op.by, "by")?;
+                let noise = self.need(&op.noise, op, field, "noise")?;
+                let (noise, noise_side) = self.cov::<G, N>(noise, &step, &f("noise"))?;
+                Op::Compound {
+                    input: pose(&op.input, "input")?,
+                    step,
+                    noise,
+                    noise_side,
+                    steps: self.steps(op, field)?.unwrap_or(1),
+                }
+            }
+            "diff_drive" => self.diff_drive(op, field, t)?,
+            "point_through_pose" => self.point_through_pose(op, field, pose(&op.input, "input")?)?,
+            "fuse" => {
+                let inputs = op.inputs.as_deref().unwrap_or(&[]);
+                if inputs.len() < 2 {
+                    return Err(self.err(
+                        op.kind.span(),
+                        &f("inputs"),
+                        format!("`fuse` needs at least 2 estimates, got {}", inputs.len()),
+                    ));
+                }
+                let inputs = inputs
+                    .iter()
+                    .enumerate()
+                    .map(|(i, name)| self.operand(t, name, &f(&format!("inputs[{i}]")), kind))
+                    .collect::<Result<_, _>>()?;
+                Op::Fuse { inputs }
+            }
+            "euler_vs_exp" => {
+                if G::KIND != GroupKind::So3 {
+                    return Err(self.err(
+                        op.kind.span(),
+                        &f("kind"),
+                        format!(
+                            "`euler_vs_exp` integrates a 3D body rate: it needs group = \"so3\", not {}",
+                            G::NAME
+                        ),
+                    ));
+                }
+                if let Some(input) = &op.input
+                    && !self.known(t, input, &f("input"))?.is_approx(&G::identity(), 1e-12)
+                {
+                    return Err(self.err(
+                        input.span(),
+                        &f("input"),
+                        "`euler_vs_exp` starts at the identity: give a start pose equal to it, or drop `input`",
+                    ));
+                }
+                let rate_spec = self.need(&op.rate, op, field, "rate")?;
+                let rate = rate_spec.get_ref();
+                if rate.len() != 3 || rate.iter().any(|v| !v.is_finite() || v.abs() > 1e6) {
+                    return Err(self.err(
+                        rate_spec.span(),
+                        &f("rate"),
+                        format!("needs 3 finite numbers (rad/s, |ω| ≤ 1e6), got {rate:?}"),
+                    ));
+                }
+                Op::EulerVsExp {
+                    rate: Vector3::new(rate[0], rate[1], rate[2]),
+                    dt: self.number(&op.dt, op, field, "dt", Bounds { low: 0.0, open_low: true, high: 1e3 })?,
+                    steps: self.steps(op, field)?.unwrap_or(1),
+                }
+            }
+            other => {
+                return Err(self.err(
+                    op.kind.span(),
+                    &f("kind"),
+                    format!("`{other}` is not available for {} yet", G::NAME),
+                ));
+            }
+        })
+    }
+
+    /// Σ_XY, checked against the operands' covariances: the joint covariance must be PSD.
+    fn cross_cov<G: SpecGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        field: &str,
+        lhs: Operand<G>,
+        rhs: Operand<G>,
+        spec: &Spanned<Vec<Vec<f64>>>,
+    ) -> Result<TangentMatrix<N>, ScenarioError> {
+        let at = |m: String| self.err(spec.span(), &format!("{field}.cross_cov"), m);
+        let cross: TangentMatrix<N> =
+            fixed_matrix::<N, N>("cross_cov", spec.get_ref()).map_err(|e| at(e.to_string()))?;
+        // Inputs given in the file can be checked now; outputs of operations are checked
+        // when evaluated (their covariance is computed there).
+        let given = |o: Operand<G>| match o {
+            Operand::Known(g) => Some(UncertainPose::certain(g)),
+            Operand::Defined(k) => match t.plan.poses.get(k).map(|p| p.value) {
+                Some(crate::plan::PoseValue::Uncertain(p)) => Some(p),
+                _ => None,
+            },
+        };
+        if let (Some(x), Some(y)) = (given(lhs), given(rhs)) {
+            let y = y.to_side(x.side());
+            let mut joint = DMatrix::zeros(2 * N, 2 * N);
+            joint.view_mut((0, 0), (N, N)).copy_from(x.cov());
+            joint.view_mut((0, N), (N, N)).copy_from(&cross);
+            joint
+                .view_mut((N, 0), (N, N))
+                .copy_from(&cross.transpose());
+            joint.view_mut((N, N), (N, N)).copy_from(y.cov());
+            CorrelatedPair::try_new(*x.mean(), *y.mean(), &joint, x.side()).map_err(|e| {
+                at(format!(
+                    "the joint covariance [[Σ_X, Σ_XY], [Σ_XYᵀ, Σ_Y]] is invalid: {e}"
+                ))
+            })?;
+        }
+        Ok(cross)
+    }
+
+    fn odometry<G: SpecGroup<N>, const N: usize>(
+        &self,
+        op: &OperationSpec,
+        field: &str,
+        input: Operand<G>,
+    ) -> Result<Op<G, N>, ScenarioError> {
+        let model_spec = self.need(&op.model, op, field, "model")?;
+        let model = match model_spec.get_ref().as_str() {
+            "increment" => OdometryModel::Increment,
+            "exp" => OdometryModel::Exp,
+            other => {
+                return Err(self.err(
+                    model_spec.span(),
+                    &format!("{field}.model"),
+                    format!("unknown odometry model `{other}`; use `increment` (X·U·Exp(w), NA 568) or `exp` (X·Exp(u + w))"),
+                ));
+            }
+        };
+        let noise_spec = self.need(&op.noise, op, field, "noise")?;
+        let (noise, side) = self.cov::<G, N>(noise_spec, &G::identity(), &format!("{field}.noise"))?;
+        if side != Side::Right {
+            return Err(self.err(
+                noise_spec.span(),
+                &format!("{field}.noise"),
+                "odometry noise enters on the right (body frame): remove `side = \"left\"`",
+            ));
+        }
+        let controls_spec = self.need(&op.controls, op, field, "controls")?;
+        let mut controls = Vec::new();
+        for (i, c) in controls_spec.get_ref().iter().enumerate() {
+            let control = control_for::<G, N>(c, model == OdometryModel::Increment).map_err(|e| {
+                self.err(
+                    controls_spec.span(),
+                    &format!("{field}.controls[{i}]"),
+                    e.to_string(),
+                )
+            })?;
+            controls.push(control);
+        }
+        if controls.is_empty() {
+            return Err(self.err(
+                controls_spec.span(),
+                &format!("{field}.controls"),
+                "needs at least one control",
+            ));
+        }
+        if controls.len() as u64 > limits::MAX_STEPS {
+            return Err(self.err(
+                controls_spec.span(),
+                &format!("{field}.controls"),
+                format!("{} controls: at most {} steps", controls.len(), limits::MAX_STEPS),
+            ));
+        }
+        if let Some(steps) = self.steps(op, field)? {
+            if controls.len() != 1 {
+                return Err(self.err(
+                    self.need(&op.steps, op, field, "steps")?.span(),
+                    &format!("{field}.steps"),
+                    "`steps` repeats a single control: give one control, or drop `steps`",
+                ));
+            }
+            controls = vec![controls[0]; steps as usize];
+        }
+        Ok(Op::Odometry {
+            input,
+            model,
+            controls,
+            noise,
+        })
+    }
+
+    fn diff_drive<G: SpecGroup<N>, const N: usize>(
+        &self,
+        op: &OperationSpec,
+        field: &str,
+        t: &Table<G, N>,
+    ) -> Result<Op<G, N>, ScenarioError> {
+        if G::KIND != GroupKind::Se2 {
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.kind"),
+                format!(
+                    "`diff_drive` is a planar robot: it needs group = \"se2\", not {}",
+                    G::NAME
+                ),
+            ));
+        }
+        let start = match &op.input {
+            Some(name) => self.known(t, name, &format!("{field}.input"))?,
+            None => G::identity(),
+        };
+        let n = |key: &str, value: &Option<Spanned<f64>>, low: f64, open_low: bool, high: f64| {
+            self.number(value, op, field, key, Bounds { low, open_low, high })
+        };
+        let big = limits::MAX_DIFF_DRIVE_VALUE;
+        let dt = match &op.dt {
+            Some(_) => n("dt", &op.dt, 0.0, true, 1.0)?,
+            None => limits::DEFAULT_DIFF_DRIVE_DT,
+        };
+        let motion = DiffDriveMotion {
+            wheel_radius: n("wheel_radius", &op.wheel_radius, 1e-6, false, big)?,
+            wheelbase: n("wheelbase", &op.wheelbase, 1e-6, false, big)?,
+            duration: n("duration", &op.duration, 0.0, true, big)?,
+            diffusion: n("diffusion", &op.diffusion, 0.0, false, big)?,
+            speed: n("speed", &op.speed, 0.0, true, big)?,
+            turn_rate: n("turn_rate", &op.turn_rate, -big, false, big)?,
+            dt,
+        };
+        let turned = (motion.turn_rate * motion.duration).abs();
+        if turned > limits::MAX_DIFF_DRIVE_TURN {
+            let span = self.need(&op.turn_rate, op, field, "turn_rate")?.span();
+            return Err(self.err(
+                span,
+                &format!("{field}.turn_rate"),
+                format!(
+                    "turn_rate × duration = {turned:.3e} rad: at most {} rad (about {:.0} turns) are integrated",
+                    limits::MAX_DIFF_DRIVE_TURN,
+                    limits::MAX_DIFF_DRIVE_TURN / std::f64::consts::TAU
+                ),
+            ));
+        }
+        let euler_steps = motion.duration / motion.dt;
+        if euler_steps > limits::MAX_STEPS as f64 {
+            let span = op
+                .dt
+                .as_ref()
+                .map_or_else(|| op.kind.span(), Spanned::span);
+            return Err(self.err(
+                span,
+                &format!("{field}.dt"),
+                format!(
+                    "duration / dt = {euler_steps:.3e} Euler–Maruyama steps: at most {}; raise dt or shorten duration",
+                    limits::MAX_STEPS
+                ),
+            ));
+        }
+        Ok(Op::DiffDrive { start, motion })
+    }
+
+    fn point_through_pose<G: SpecGroup<N>, const N: usize>(
+        &self,
+        op: &OperationSpec,
+        field: &str,
+        input: Operand<G>,
+    ) -> Result<Op<G, N>, ScenarioError> {
+        let point = self.need(&op.point, op, field, "point")?;
+        let dims = G::KIND.space_dims();
+        let p = point.get_ref();
+        if p.len() != dims || p.iter().any(|v| !v.is_finite() || v.abs() > limits::MAX_COORDINATE) {
+            return Err(self.err(
+                point.span(),
+                &format!("{field}.point"),
+                format!(
+                    "needs {dims} finite coordinates of at most {:e} m for {}, got {p:?}",
+                    limits::MAX_COORDINATE,
+                    G::NAME
+                ),
+            ));
+        }
+        let mut point_cov = Matrix3::zeros();
+        if let Some(cov) = &op.point_cov {
+            let at = |m: String| self.err(cov.span(), &format!("{field}.point_cov"), m);
+            let dyn_cov = if dims == 2 {
+                let c = fixed_matrix::<2, 2>("point_cov", cov.get_ref()).map_err(|e| at(e.to_string()))?;
+                point_cov.fixed_view_mut::<2, 2>(0, 0).copy_from(&c);
+                DMatrix::from_iterator(2, 2, c.iter().copied())
+            } else {
+                point_cov = fixed_matrix::<3, 3>("point_cov", cov.get_ref()).map_err(|e| at(e.to_string()))?;
+                DMatrix::from_iterator(3, 3, point_cov.iter().copied())
+            };
+            if dyn_cov.amax() > limits::MAX_VARIANCE {
+                return Err(at(format!(
+                    "an entry of {:e} is too large: at most {:e}",
+                    dyn_cov.amax(),
+                    limits::MAX_VARIANCE
+                )));
+            }
+            crate::uncertain::validate_covariance_dyn("point_cov", &dyn_cov)
+                .map_err(|e| at(e.to_string()))?;
+        }
+        Ok(Op::PointThroughPose {
+            input,
+            point: Vector3::new(p[0], p[1], p.get(2).copied().unwrap_or(0.0)),
+            point_cov,
+        })
+    }
+}
