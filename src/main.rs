@@ -233,9 +233,11 @@ fn try_main() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
         Some(Command::List) => emit(&commands::list()?),
-        Some(Command::Report { scenario, json }) => {
-            emit(&commands::report(scenario.scenario(), &scenario.overrides(), json)?)
-        }
+        Some(Command::Report { scenario, json }) => emit(&commands::report(
+            scenario.scenario(),
+            &scenario.overrides(),
+            json,
+        )?),
         Some(Command::Check { scenario }) => {
             emit(&(commands::check(scenario.scenario(), &scenario.overrides())? + "\n"))
         }

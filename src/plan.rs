@@ -463,6 +463,8 @@ pub mod limits {
     pub const DEFAULT_DIFF_DRIVE_DT: f64 = 1e-3;
     /// Longest frame axes drawn (m).
     pub const MAX_AXIS_LENGTH: f64 = 1e3;
+    /// Shortest frame axes drawn (m): shorter ones and their line widths vanish.
+    pub const MIN_AXIS_LENGTH: f64 = 1e-4;
     /// Largest coordinate of a given position or point (m): beyond it, products overflow
     /// long before anything can be drawn.
     pub const MAX_COORDINATE: f64 = 1e12;

@@ -544,7 +544,10 @@ impl<G: LieGroup<N>, const N: usize> UncertainPose<G, N> {
         }
         let cov = self.cov_right();
         let block = Matrix3::from_fn(|r, c| if r < d && c < d { cov[(r, c)] } else { 0.0 });
-        Some(rotate_cov(&self.mean.to_se3().rotation().to_matrix(), &block))
+        Some(rotate_cov(
+            &self.mean.to_se3().rotation().to_matrix(),
+            &block,
+        ))
     }
 }
 

@@ -88,7 +88,10 @@ fn case(loaded: &Loaded, overrides: &Overrides) -> Case {
     }
 }
 
-fn evaluate(loaded: &Loaded, overrides: &Overrides) -> Result<AnyEvaluation, posecov::app::AppError> {
+fn evaluate(
+    loaded: &Loaded,
+    overrides: &Overrides,
+) -> Result<AnyEvaluation, posecov::app::AppError> {
     let c = case(loaded, overrides);
     posecov::app::evaluate(&c.loaded, &c.settings.eval)
 }
@@ -256,7 +259,10 @@ fn blocked_compounding_and_diff_drive_match_single_block() {
         let (ma, mb) = (means(&single), means(&blocked));
         assert_eq!(ma.len(), mb.len(), "{name}");
         for (a, b) in ma.iter().zip(&mb) {
-            assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12, "{name}: {a:?} vs {b:?}");
+            assert!(
+                (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12,
+                "{name}: {a:?} vs {b:?}"
+            );
         }
     }
 }
@@ -351,7 +357,11 @@ fn particle_parts_draw_each_later_block_once_with_the_main_scene_sizes() {
     // Not blocked: no parts.
     let whole = evaluate(&s, &options(3000, None)).expect("evaluates");
     let c = case(&s, &options(3000, None));
-    assert!(evaluate_block(&c.loaded.input.plan, &c.settings.eval, &whole, 1).expect("evaluates").is_none());
+    assert!(
+        evaluate_block(&c.loaded.input.plan, &c.settings.eval, &whole, 1)
+            .expect("evaluates")
+            .is_none()
+    );
 }
 
 #[test]

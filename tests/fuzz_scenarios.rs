@@ -91,7 +91,11 @@ struct Reported {
 }
 
 /// Runs the whole pure path. `stage` is told where the run is (for hang reports).
-fn run_pipeline(text: &str, origin: &str, stage: &dyn Fn(&'static str)) -> Result<Output, Reported> {
+fn run_pipeline(
+    text: &str,
+    origin: &str,
+    stage: &dyn Fn(&'static str),
+) -> Result<Output, Reported> {
     let reported = |e: AppError| Reported {
         text: e.to_string(),
         field: match &e {
@@ -179,7 +183,11 @@ fn scene_nonfinite(scene: &Scene) -> Vec<(String, &'static str, f64)> {
             ItemKind::Triads(t) => {
                 check(p, "translations", &mut flat(&t.translations).into_iter());
                 check(p, "rotations", &mut t.rotations.iter().flatten().copied());
-                check(p, "axis_length", &mut [t.axis_length, t.line_radius].into_iter());
+                check(
+                    p,
+                    "axis_length",
+                    &mut [t.axis_length, t.line_radius].into_iter(),
+                );
             }
             ItemKind::Points(c) => {
                 check(p, "positions", &mut flat(&c.positions).into_iter());
@@ -198,7 +206,11 @@ fn scene_nonfinite(scene: &Scene) -> Vec<(String, &'static str, f64)> {
                 check(p, "normals", &mut flat(&s.normals).into_iter());
             }
             ItemKind::LineStrips(l) => {
-                check(p, "strips", &mut l.strips.iter().flatten().flatten().copied());
+                check(
+                    p,
+                    "strips",
+                    &mut l.strips.iter().flatten().flatten().copied(),
+                );
                 check(p, "radius", &mut std::iter::once(l.radius));
             }
             ItemKind::Arrows(a) => {
@@ -210,7 +222,11 @@ fn scene_nonfinite(scene: &Scene) -> Vec<(String, &'static str, f64)> {
         }
     }
     for s in &scene.series {
-        check(&s.path, "series", &mut s.points.iter().map(|p| p.1).chain([s.width]));
+        check(
+            &s.path,
+            "series",
+            &mut s.points.iter().map(|p| p.1).chain([s.width]),
+        );
     }
     bad
 }
@@ -284,7 +300,8 @@ impl Limits {
         let ms = |k: &str, d: u64| Duration::from_millis(env_u64(k).unwrap_or(d));
         Self {
             hang: ms("POSECOV_FUZZ_HANG_MS", 5000),
-            slow: ms("POSECOV_FUZZ_SLOW_MS", 1000),
+            // The requirement: no run over 5 s (a longer one would need a progress display).
+            slow: ms("POSECOV_FUZZ_SLOW_MS", 5000),
             memory: (env_u64("POSECOV_FUZZ_MEMORY_MB").unwrap_or(512) as usize) << 20,
             memory_cap: (env_u64("POSECOV_FUZZ_MEMORY_CAP_MB").unwrap_or(4096) as usize) << 20,
         }
@@ -292,6 +309,7 @@ impl Limits {
 }
 
 /// How one run ended.
+#[allow(clippy::large_enum_variant)] // one value per case, moved once: size does not matter
 enum Run {
     Finished {
         result: Result<Output, Reported>,
@@ -346,13 +364,22 @@ fn run_one(text: &str, origin: &str, limits: &Limits) -> Run {
             .stack_size(16 << 20)
             .spawn(move || {
                 let r = catch_unwind(AssertUnwindSafe(|| {
-                    run_pipeline(&text, &origin, &|s| stage.lock().unwrap().push((s, Instant::now())))
+                    run_pipeline(&text, &origin, &|s| {
+                        stage.lock().unwrap().push((s, Instant::now()))
+                    })
                 }));
                 let _ = tx.send(r);
             })
             .expect("spawn worker");
     }
-    let current_stage = || stage.lock().unwrap_or_else(|e| e.into_inner()).last().unwrap().0;
+    let current_stage = || {
+        stage
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .last()
+            .unwrap()
+            .0
+    };
     // The stage that took longest, and its time.
     let slowest_stage = || {
         let st = stage.lock().unwrap_or_else(|e| e.into_inner());
@@ -446,7 +473,10 @@ fn classify(text: &str, origin: &str, run: Run) -> (Vec<Finding>, Option<Duratio
     let f = |class, message: String| Finding { class, message };
     let (result, elapsed, peak, slowest) = match run {
         Run::Panicked { message, stage } => {
-            return (vec![f("panic", format!("panic in {stage}: {message}"))], None);
+            return (
+                vec![f("panic", format!("panic in {stage}: {message}"))],
+                None,
+            );
         }
         Run::Stuck {
             stage,
@@ -457,7 +487,10 @@ fn classify(text: &str, origin: &str, run: Run) -> (Vec<Finding>, Option<Duratio
             return (
                 vec![f(
                     class,
-                    format!("still running in {stage} after {:.1} s", elapsed.as_secs_f64()),
+                    format!(
+                        "still running in {stage} after {:.1} s",
+                        elapsed.as_secs_f64()
+                    ),
                 )],
                 Some(elapsed),
             );
@@ -505,7 +538,11 @@ fn classify(text: &str, origin: &str, run: Run) -> (Vec<Finding>, Option<Duratio
 }
 
 fn outcome_word(r: &Result<Output, Reported>) -> &'static str {
-    if r.is_ok() { "succeeded" } else { "then errored" }
+    if r.is_ok() {
+        "succeeded"
+    } else {
+        "then errored"
+    }
 }
 
 /// `origin:line:column: rest` → (line, column, rest).
@@ -525,7 +562,8 @@ fn field_in_user_vocabulary(field: &str) -> bool {
             None => (s, None),
         };
         !name.is_empty()
-            && name.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+            // A key as the user typed it (bare-key characters), or one of ours.
+            && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
             && index.is_none_or(|i| {
                 i.strip_suffix(']')
                     .is_some_and(|d| !d.is_empty() && d.chars().all(|c| c.is_ascii_digit()))
@@ -534,8 +572,8 @@ fn field_in_user_vocabulary(field: &str) -> bool {
     let mut segs = field.split('.');
     let head = segs.next().unwrap_or("");
     // `file`: the text is too broken to name a table (a mangled header, a bad top-level key).
-    let head_ok = matches!(head, "scenario" | "draw" | "pose" | "operation" | "file")
-        || (head.starts_with("pose[") || head.starts_with("operation[")) && seg_ok(head);
+    // A top-level key (where the text lost its table header) is named as the user wrote it.
+    let head_ok = seg_ok(head);
     head_ok && segs.all(seg_ok)
 }
 
@@ -593,13 +631,20 @@ fn check_output(text: &str, out: &Output) -> Vec<Finding> {
                 }
             }
         }
-        if r.relative_error_vs_monte_carlo.is_some_and(|x| !x.is_finite()) {
+        if r.relative_error_vs_monte_carlo
+            .is_some_and(|x| !x.is_finite())
+        {
             nulls.push("relative_error_vs_monte_carlo");
         }
         if !nulls.is_empty() {
             found.push(f(
                 "nonfinite_record",
-                format!("{:?} record: {} non-finite (JSON null) — `{}`", r.method, nulls.join(", "), r.label),
+                format!(
+                    "{:?} record: {} non-finite (JSON null) — `{}`",
+                    r.method,
+                    nulls.join(", "),
+                    r.label
+                ),
             ));
         }
     }
@@ -607,16 +652,25 @@ fn check_output(text: &str, out: &Output) -> Vec<Finding> {
     while let Some(v) = stack.pop() {
         match v {
             serde_json::Value::Array(a) => stack.extend(a),
-            serde_json::Value::Object(o) => stack.extend(o.values()),
+            // `step` is null for a result that is not per step; numbers are never null.
+            serde_json::Value::Object(o) => {
+                stack.extend(o.iter().filter(|(k, _)| *k != "step").map(|(_, v)| v))
+            }
             serde_json::Value::Null => {
-                found.push(f("nonfinite_record", "a finding has a non-finite number (JSON null)".to_owned()));
+                found.push(f(
+                    "nonfinite_record",
+                    "a finding has a non-finite number (JSON null)".to_owned(),
+                ));
                 break;
             }
             _ => {}
         }
     }
     for (path, field, v) in scene_nonfinite(&out.scene).into_iter().take(3) {
-        found.push(f("nonfinite_scene", format!("{} {field} = {v}", normalise_path(&path))));
+        found.push(f(
+            "nonfinite_scene",
+            format!("{} {field} = {v}", normalise_path(&path)),
+        ));
     }
     if let Err(e) = &out.scene_valid {
         found.push(f("scene_invalid", e.clone()));
@@ -631,7 +685,10 @@ fn check_output(text: &str, out: &Output) -> Vec<Finding> {
         if asym > 1e-9 * scale.max(1e-300) {
             found.push(f(
                 "asymmetric_cov",
-                format!("{}: |Σ − Σᵀ| = {asym:.3e} of max |Σ| = {scale:.3e}", method_of(label)),
+                format!(
+                    "{}: |Σ − Σᵀ| = {asym:.3e} of max |Σ| = {scale:.3e}",
+                    method_of(label)
+                ),
             ));
         }
         let eig = SymmetricEigen::new((m + m.transpose()) * 0.5);
@@ -667,7 +724,9 @@ fn reported_indefinite(findings: &[EvalFinding], label: &str) -> bool {
 
 /// The `(Method)` part of a covariance label.
 fn method_of(label: &str) -> &str {
-    label.rsplit_once('(').map_or(label, |(_, m)| m.trim_end_matches(')'))
+    label
+        .rsplit_once('(')
+        .map_or(label, |(_, m)| m.trim_end_matches(')'))
 }
 
 /// `world/robot/first_order/banana` → `world/*/first_order/banana` (dedup by what, not where).
@@ -691,12 +750,22 @@ fn input_oracles(text: &str) -> Vec<Finding> {
     let mut found = Vec::new();
     let mut defined: BTreeSet<String> = BTreeSet::new();
     let mut points: BTreeSet<String> = BTreeSet::new();
-    for p in doc.get("pose").and_then(Value::as_array).into_iter().flatten() {
+    for p in doc
+        .get("pose")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
         if let Some(n) = p.get("name").and_then(Value::as_str) {
             defined.insert(n.to_owned());
         }
     }
-    for op in doc.get("operation").and_then(Value::as_array).into_iter().flatten() {
+    for op in doc
+        .get("operation")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
         let kind = op.get("kind").and_then(Value::as_str).unwrap_or("?");
         let mut refs: Vec<(&str, &str)> = Vec::new();
         for key in ["input", "lhs", "rhs", "by"] {
@@ -704,7 +773,12 @@ fn input_oracles(text: &str) -> Vec<Finding> {
                 refs.push((key, s));
             }
         }
-        for v in op.get("inputs").and_then(Value::as_array).into_iter().flatten() {
+        for v in op
+            .get("inputs")
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+        {
             if let Some(s) = v.as_str() {
                 refs.push(("inputs", s));
             }
@@ -903,9 +977,38 @@ const DRAW_KEYS: &[&str] = &[
 
 /// Bytes and tokens the byte mutator inserts.
 const TOKENS: &[&str] = &[
-    "[", "]", "{", "}", "=", "\"", "'", ",", "\n", "#", ".", "-", "0", "1", "nan", "inf", "-inf",
-    "1e308", "1e-300", "[[operation]]\n", "[[pose]]\n", "[draw]\n", "[scenario]\n", "\"\"\"",
-    "\\u0000", "\u{e9}", "\u{1F600}", "true", "99999999999999999999", "1_000", "0x1f", "1979-05-27",
+    "[",
+    "]",
+    "{",
+    "}",
+    "=",
+    "\"",
+    "'",
+    ",",
+    "\n",
+    "#",
+    ".",
+    "-",
+    "0",
+    "1",
+    "nan",
+    "inf",
+    "-inf",
+    "1e308",
+    "1e-300",
+    "[[operation]]\n",
+    "[[pose]]\n",
+    "[draw]\n",
+    "[scenario]\n",
+    "\"\"\"",
+    "\\u0000",
+    "\u{e9}",
+    "\u{1F600}",
+    "true",
+    "99999999999999999999",
+    "1_000",
+    "0x1f",
+    "1979-05-27",
 ];
 
 #[derive(Debug, Clone)]
@@ -1296,7 +1399,9 @@ impl Generator {
                 if n > 0 && rng.random_bool(0.5) {
                     let i = rng.random_range(0..n);
                     let k = KINDS[rng.random_range(0..KINDS.len())];
-                    if let Some(Value::Table(t)) = at_mut(doc, &[Seg::Key("operation".into()), Seg::Idx(i)]) {
+                    if let Some(Value::Table(t)) =
+                        at_mut(doc, &[Seg::Key("operation".into()), Seg::Idx(i)])
+                    {
                         t.insert("kind".into(), Value::String(k.into()));
                     }
                     format!("operation[{i}].kind = {k}")
@@ -1325,8 +1430,15 @@ impl Generator {
             // Crossover: a pose or an operation from another bundled scenario.
             13 => {
                 let (other, _, t) = &self.corpus[rng.random_range(0..self.corpus.len())];
-                let key = if rng.random_bool(0.5) { "pose" } else { "operation" };
-                let Some(entries) = t.as_ref().and_then(|t| t.get(key)).and_then(Value::as_array)
+                let key = if rng.random_bool(0.5) {
+                    "pose"
+                } else {
+                    "operation"
+                };
+                let Some(entries) = t
+                    .as_ref()
+                    .and_then(|t| t.get(key))
+                    .and_then(Value::as_array)
                 else {
                     return "no entries".into();
                 };
@@ -1395,7 +1507,6 @@ impl Generator {
     }
 }
 
-
 fn show(p: &[Seg]) -> String {
     let mut s = String::new();
     for seg in p {
@@ -1430,12 +1541,22 @@ fn remove(doc: &mut Value, p: &[Seg]) {
 /// Names defined in the document: poses, outputs (points marked).
 fn names_in(doc: &Value) -> Vec<String> {
     let mut names = Vec::new();
-    for p in doc.get("pose").and_then(Value::as_array).into_iter().flatten() {
+    for p in doc
+        .get("pose")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
         if let Some(n) = p.get("name").and_then(Value::as_str) {
             names.push(n.to_owned());
         }
     }
-    for o in doc.get("operation").and_then(Value::as_array).into_iter().flatten() {
+    for o in doc
+        .get("operation")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
         if let Some(n) = o.get("output").and_then(Value::as_str) {
             names.push(n.to_owned());
         }
@@ -1447,7 +1568,9 @@ fn random_name(rng: &mut ChaCha8Rng, names: &[String]) -> String {
     match rng.random_range(0..10) {
         0..=5 if !names.is_empty() => names[rng.random_range(0..names.len())].clone(),
         6 => "nowhere_from_nothing".into(),
-        7 => ["", "a b", "world/x", "ü", "x".repeat(300).as_str()][rng.random_range(0..5)].to_owned(),
+        7 => {
+            ["", "a b", "world/x", "ü", "x".repeat(300).as_str()][rng.random_range(0..5)].to_owned()
+        }
         8 => "landmark".into(),
         _ => "start".into(),
     }
@@ -1487,17 +1610,28 @@ fn pick_table(rng: &mut ChaCha8Rng, doc: &mut Value) -> (Vec<Seg>, &'static [&'s
             vec![key("operation"), Seg::Idx(rng.random_range(0..ops))],
             OPERATION_KEYS,
         ),
-        5 if poses > 0 => (vec![key("pose"), Seg::Idx(rng.random_range(0..poses))], POSE_KEYS),
+        5 if poses > 0 => (
+            vec![key("pose"), Seg::Idx(rng.random_range(0..poses))],
+            POSE_KEYS,
+        ),
         6 if poses > 0 => {
             let i = rng.random_range(0..poses);
-            if doc.get("pose").and_then(|p| p.as_array()?.get(i)?.get("cov")).is_some() {
+            if doc
+                .get("pose")
+                .and_then(|p| p.as_array()?.get(i)?.get("cov"))
+                .is_some()
+            {
                 (vec![key("pose"), Seg::Idx(i), key("cov")], COV_KEYS)
             } else {
                 (vec![key("pose"), Seg::Idx(i), key("mean")], MEAN_KEYS)
             }
         }
         7 if poses > 0 => (
-            vec![key("pose"), Seg::Idx(rng.random_range(0..poses)), key("mean")],
+            vec![
+                key("pose"),
+                Seg::Idx(rng.random_range(0..poses)),
+                key("mean"),
+            ],
             MEAN_KEYS,
         ),
         8 => {
@@ -1513,23 +1647,31 @@ fn pick_table(rng: &mut ChaCha8Rng, doc: &mut Value) -> (Vec<Seg>, &'static [&'s
 
 /// A value for `key`: usually of a plausible shape with edge numbers, sometimes wrong.
 fn random_value(rng: &mut ChaCha8Rng, names: &[String], key: &str) -> Value {
-    let f = |rng: &mut ChaCha8Rng| Value::Float(FLOAT_EDGES[rng.random_range(0..FLOAT_EDGES.len())]);
-    let small = |rng: &mut ChaCha8Rng| {
-        Value::Float([0.0, 0.1, 1.0, -1.0, 0.5][rng.random_range(0..5)])
-    };
+    let f =
+        |rng: &mut ChaCha8Rng| Value::Float(FLOAT_EDGES[rng.random_range(0..FLOAT_EDGES.len())]);
+    let small =
+        |rng: &mut ChaCha8Rng| Value::Float([0.0, 0.1, 1.0, -1.0, 0.5][rng.random_range(0..5)]);
     if rng.random_bool(0.1) {
         return wrong_type(rng);
     }
     let vec_of = |rng: &mut ChaCha8Rng, n: usize| {
         Value::Array(
             (0..n)
-                .map(|_| if rng.random_bool(0.3) { f(rng) } else { small(rng) })
+                .map(|_| {
+                    if rng.random_bool(0.3) {
+                        f(rng)
+                    } else {
+                        small(rng)
+                    }
+                })
                 .collect(),
         )
     };
     let n = [1, 2, 3, 4, 6, 36][rng.random_range(0..6)];
     match key {
-        "input" | "lhs" | "rhs" | "by" | "output" | "name" => Value::String(random_name(rng, names)),
+        "input" | "lhs" | "rhs" | "by" | "output" | "name" => {
+            Value::String(random_name(rng, names))
+        }
         "inputs" => Value::Array(
             (0..rng.random_range(0..4))
                 .map(|_| Value::String(random_name(rng, names)))
@@ -1578,10 +1720,8 @@ fn random_value(rng: &mut ChaCha8Rng, names: &[String], key: &str) -> Value {
         "angle" | "angle_deg" | "wheel_radius" | "wheelbase" | "duration" | "diffusion"
         | "speed" | "turn_rate" | "dt" | "confidence" | "axis_length" => f(rng),
         "xy_theta" | "xy_theta_deg" | "xyz" | "rpy" | "rpy_deg" | "rate" => {
-            {
             let len = if rng.random_bool(0.8) { 3 } else { n };
             vec_of(rng, len)
-        }
         }
         "quaternion_xyzw" | "axis_angle" => {
             let len = if rng.random_bool(0.8) { 4 } else { n };
@@ -1682,7 +1822,9 @@ fn mutate_bytes(
 // =========================================================================================
 
 fn env_u64(k: &str) -> Option<u64> {
-    std::env::var(k).ok().and_then(|v| v.replace('_', "").parse().ok())
+    std::env::var(k)
+        .ok()
+        .and_then(|v| v.replace('_', "").parse().ok())
 }
 
 fn target_dir() -> PathBuf {
@@ -1764,7 +1906,10 @@ fn fuzz(seed: u64, cases: std::ops::Range<u64>, reduce_failures: bool) -> Summar
         .flatten()
         .filter(|e| e.path().extension().is_some_and(|x| x == "txt"))
         .filter_map(|e| std::fs::read_to_string(e.path()).ok())
-        .filter_map(|t| t.lines().find_map(|l| l.strip_prefix("key: ").map(str::to_owned)))
+        .filter_map(|t| {
+            t.lines()
+                .find_map(|l| l.strip_prefix("key: ").map(str::to_owned))
+        })
         .collect();
     let started = Instant::now();
     for case in cases {
@@ -1775,7 +1920,7 @@ fn fuzz(seed: u64, cases: std::ops::Range<u64>, reduce_failures: bool) -> Summar
         let (findings, elapsed) = classify(&text, ORIGIN, run);
         if let Some(e) = elapsed {
             s.slowest.push((e, case));
-            s.slowest.sort_by(|a, b| b.0.cmp(&a.0));
+            s.slowest.sort_by_key(|a| std::cmp::Reverse(a.0));
             s.slowest.truncate(5);
         }
         let mut failing = false;
@@ -1812,10 +1957,12 @@ fn fuzz(seed: u64, cases: std::ops::Range<u64>, reduce_failures: bool) -> Summar
                 if reduce_failures && !stuck && !["slow", "memory"].contains(&f.class) {
                     match reduce(&text, &key, &limits) {
                         Ok(r) => {
-                            let _ = std::fs::write(failures.join(format!("{stem}-reduced.toml")), r);
+                            let _ =
+                                std::fs::write(failures.join(format!("{stem}-reduced.toml")), r);
                         }
                         Err(hung) => {
-                            let p = dir.join(format!("fuzz-hang-s{seed}-c{case}-during-reduction.toml"));
+                            let p = dir
+                                .join(format!("fuzz-hang-s{seed}-c{case}-during-reduction.toml"));
                             let _ = std::fs::write(&p, hung);
                             s.stopped = Some(format!(
                                 "a reduction candidate of case {case} hung; written to {}",
@@ -1831,7 +1978,10 @@ fn fuzz(seed: u64, cases: std::ops::Range<u64>, reduce_failures: bool) -> Summar
         }
         if stuck {
             let f = &findings[0];
-            let _ = std::fs::write(dir.join(format!("fuzz-{}-s{seed}-c{case}.toml", f.class)), &text);
+            let _ = std::fs::write(
+                dir.join(format!("fuzz-{}-s{seed}-c{case}.toml", f.class)),
+                &text,
+            );
             s.stopped = Some(format!(
                 "case {case} (seed {seed}): {} {} — input in {}; stopping (the thread cannot be killed)",
                 f.class,
@@ -1885,14 +2035,20 @@ fn fuzz_100k() {
     };
     let reduce = env_u64("POSECOV_FUZZ_REDUCE").unwrap_or(0) != 0;
     let s = fuzz(seed, cases, reduce);
-    assert!(s.stopped.is_none() && s.failing_cases == 0, "fuzzing found failures (see above)");
+    assert!(
+        s.stopped.is_none() && s.failing_cases == 0,
+        "fuzzing found failures (see above)"
+    );
 }
 
 /// Short and bounded: runs in CI.
 #[test]
 fn fuzz_smoke() {
     let s = fuzz(1, 0..300, false);
-    assert!(s.stopped.is_none() && s.failing_cases == 0, "fuzzing found failures (see above)");
+    assert!(
+        s.stopped.is_none() && s.failing_cases == 0,
+        "fuzzing found failures (see above)"
+    );
 }
 
 /// The extra seeds are valid scenarios (so their mutants start from something that works).
@@ -1900,7 +2056,11 @@ fn fuzz_smoke() {
 fn extra_seeds_evaluate() {
     for (name, text) in EXTRA_SEEDS {
         let out = run_pipeline(text, name, &|_| {});
-        assert!(out.is_ok(), "{name}: {}", out.err().map(|e| e.text).unwrap_or_default());
+        assert!(
+            out.is_ok(),
+            "{name}: {}",
+            out.err().map(|e| e.text).unwrap_or_default()
+        );
     }
 }
 
@@ -1940,7 +2100,10 @@ fn fuzz_file() {
         println!("{}: {}", f.class, f.message);
     }
     if env_u64("POSECOV_FUZZ_REDUCE").unwrap_or(0) != 0 {
-        for f in findings.iter().filter(|f| !["ok", "error_ok", "hang", "slow", "memory"].contains(&f.class)) {
+        for f in findings
+            .iter()
+            .filter(|f| !["ok", "error_ok", "hang", "slow", "memory"].contains(&f.class))
+        {
             match reduce(&text, &dedup_key(f), &limits) {
                 Ok(r) => println!("--- reduced for {}:\n{r}---", f.class),
                 Err(_) => println!("--- reduction of {} hung", f.class),

@@ -20,7 +20,9 @@ fn every_bundled_scenario_evaluates_and_draws() {
             pipeline(&loaded, &small(), None).unwrap_or_else(|e| panic!("{}: {e}", b.name));
         assert!(!scene.items.is_empty(), "{} draws nothing", b.name);
         assert!(
-            scene.description_markdown.contains(&loaded.input.about.title),
+            scene
+                .description_markdown
+                .contains(&loaded.input.about.title),
             "{}",
             b.name
         );

@@ -49,10 +49,17 @@ pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<Strin
         100.0 * confidence
     );
     for r in &evaluation.records() {
-        let error = r
-            .relative_error_vs_monte_carlo
-            .map_or(String::new(), |e| format!(", vs Monte Carlo {:.2} %", 100.0 * e));
-        let _ = writeln!(out, "\n{} [{}] {} ({:?} side{error})", r.label, r.group, r.method.label(), r.side);
+        let error = r.relative_error_vs_monte_carlo.map_or(String::new(), |e| {
+            format!(", vs Monte Carlo {:.2} %", 100.0 * e)
+        });
+        let _ = writeln!(
+            out,
+            "\n{} [{}] {} ({:?} side{error})",
+            r.label,
+            r.group,
+            r.method.label(),
+            r.side
+        );
         let tangent: Vec<String> = r.mean_tangent.iter().map(|v| format!("{v:.6}")).collect();
         let _ = writeln!(out, "  mean Log(μ) = [{}]", tangent.join(", "));
         let _ = writeln!(out, "  covariance:");
@@ -62,7 +69,11 @@ pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<Strin
         }
     }
     for finding in evaluation.findings() {
-        let _ = writeln!(out, "\nfinding: {}", serde_json::to_string(finding).unwrap_or_default());
+        let _ = writeln!(
+            out,
+            "\nfinding: {}",
+            serde_json::to_string(finding).unwrap_or_default()
+        );
     }
     Ok(out)
 }
@@ -75,7 +86,12 @@ pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<Strin
 /// ```
 pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> {
     let quick = Overrides {
-        samples: Some(overrides.samples.unwrap_or(CHECK_SAMPLES).min(CHECK_SAMPLES)),
+        samples: Some(
+            overrides
+                .samples
+                .unwrap_or(CHECK_SAMPLES)
+                .min(CHECK_SAMPLES),
+        ),
         ..overrides.clone()
     };
     let loaded = load(scenario)?;
@@ -86,6 +102,10 @@ pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> 
         evaluation.records().len(),
         scene.items.len(),
         scene.steps().len(),
-        if findings == 0 { String::new() } else { format!(", {findings} findings (see `posecov report`)") }
+        if findings == 0 {
+            String::new()
+        } else {
+            format!(", {findings} findings (see `posecov report`)")
+        }
     ))
 }

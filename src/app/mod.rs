@@ -22,9 +22,9 @@ use crate::input::scenario::{Scenario, ScenarioError, lower};
 use crate::scene::{Scene, SceneError};
 
 pub mod commands;
-mod settings;
 #[cfg(feature = "viewer")]
 pub mod session;
+mod settings;
 
 pub use settings::{
     DEFAULT_CONFIDENCE, DEFAULT_SAMPLES, Overrides, Settings, SettingsError, resolve,

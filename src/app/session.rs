@@ -104,8 +104,13 @@ impl Session {
     /// Logs the scene, then the clouds of any later Monte Carlo blocks one block at a time
     /// (each re-simulated, drawn, logged, flushed and dropped: memory stays bounded); reports
     /// how far it got if Ctrl-C interrupted it.
-    pub fn log(&self, rec: &rerun::RecordingStream, cancel: &AtomicBool) -> anyhow::Result<LogOutcome> {
-        let mut outcome = sink::log_scene_cancellable(rec, &self.scene, cancel).context("logging the scene")?;
+    pub fn log(
+        &self,
+        rec: &rerun::RecordingStream,
+        cancel: &AtomicBool,
+    ) -> anyhow::Result<LogOutcome> {
+        let mut outcome =
+            sink::log_scene_cancellable(rec, &self.scene, cancel).context("logging the scene")?;
         let later = self.later_blocks();
         if outcome == LogOutcome::Complete && later > 0 {
             let bar = ProgressBar::new(later).with_message("logging Monte Carlo blocks");
@@ -119,15 +124,17 @@ impl Session {
                     break;
                 }
                 let plan = &self.loaded.input.plan;
-                let Some(block) = eval::evaluate_block(plan, &self.settings.eval, &self.evaluation, k)
-                    .map_err(|e| self.loaded.locate(&e))
-                    .context("evaluating a Monte Carlo block")?
+                let Some(block) =
+                    eval::evaluate_block(plan, &self.settings.eval, &self.evaluation, k)
+                        .map_err(|e| self.loaded.locate(&e))
+                        .context("evaluating a Monte Carlo block")?
                 else {
                     break;
                 };
                 let part = draw::particle_part(&self.evaluation, &block, k, &self.settings.draw);
                 drop(block);
-                outcome = sink::log_part_cancellable(rec, &part, cancel).context("logging a Monte Carlo block")?;
+                outcome = sink::log_part_cancellable(rec, &part, cancel)
+                    .context("logging a Monte Carlo block")?;
                 drop(part);
                 // Hands the block to the sink's writer before the next one is simulated.
                 rec.flush_blocking()
@@ -149,7 +156,9 @@ impl Session {
         }
         if let LogOutcome::Cancelled { next_step } = outcome {
             match next_step {
-                Some(k) => eprintln!("Interrupted: recorded the static items and steps before {k}."),
+                Some(k) => {
+                    eprintln!("Interrupted: recorded the static items and steps before {k}.")
+                }
                 None => eprintln!("Interrupted: recorded part of the static items."),
             }
         }
@@ -203,7 +212,11 @@ pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> anyhow::Result<u
     if options.watch {
         return watch(options, cancel);
     }
-    let session = Session::start(&options.scenario, &options.overrides, Some(Arc::clone(cancel)))?;
+    let session = Session::start(
+        &options.scenario,
+        &options.overrides,
+        Some(Arc::clone(cancel)),
+    )?;
     let ids = session.ids(&options.scenario);
     if let Some((png, size)) = &options.png {
         return render(options, &session, &ids, png, *size, cancel);
@@ -242,13 +255,17 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> anyhow::Result<u8> {
         );
     }
     if matches!(options.sink, Some(Sink::Stdout)) || options.png.is_some() {
-        bail!("--watch streams to a viewer or rewrites a --save file; it does not combine with --stdout or --png");
+        bail!(
+            "--watch streams to a viewer or rewrites a --save file; it does not combine with --stdout or --png"
+        );
     }
     let first_sink = choose_sink(options)?;
     // Later generations connect to the viewer the first one reached.
     let next_sink = match &first_sink {
         Sink::Spawn => Sink::Connect(rerun::DEFAULT_CONNECT_URL.to_owned()),
-        Sink::Serve { grpc_port, .. } => Sink::Connect(format!("rerun+http://127.0.0.1:{grpc_port}/proxy")),
+        Sink::Serve { grpc_port, .. } => {
+            Sink::Connect(format!("rerun+http://127.0.0.1:{grpc_port}/proxy"))
+        }
         other => other.clone(),
     };
     let mut keep_alive: Option<(rerun::RecordingStream, SinkGuard)> = None;
@@ -259,19 +276,28 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> anyhow::Result<u8> {
         if modified != last_seen {
             last_seen = modified;
             match Session::start(&options.scenario, &options.overrides, None) {
-                Err(err) => eprintln!("error: {err}\n(waiting for the next change of {})", path.display()),
+                Err(err) => eprintln!(
+                    "error: {err}\n(waiting for the next change of {})",
+                    path.display()
+                ),
                 Ok(session) => {
                     let mut ids = session.ids(&options.scenario);
                     ids.recording_id = format!("{}/gen-{generation}", ids.recording_id);
-                    let sink = if generation == 0 { &first_sink } else { &next_sink };
-                    let (rec, guard) = open_stream(sink, &ids, &session.scene).context("opening the recording")?;
+                    let sink = if generation == 0 {
+                        &first_sink
+                    } else {
+                        &next_sink
+                    };
+                    let (rec, guard) =
+                        open_stream(sink, &ids, &session.scene).context("opening the recording")?;
                     if let Some(url) = guard.viewer_url() {
                         println!("Web viewer: {url}");
                     }
                     session.log(&rec, cancel)?;
                     if matches!(sink, Sink::Serve { .. }) {
                         // The served viewer lives as long as this first stream's guard.
-                        rec.flush_blocking().map_err(|e| anyhow::anyhow!("flushing: {e}"))?;
+                        rec.flush_blocking()
+                            .map_err(|e| anyhow::anyhow!("flushing: {e}"))?;
                         keep_alive = Some((rec, guard));
                     } else {
                         guard.finish(rec).context("finishing the recording")?;
@@ -297,7 +323,12 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> anyhow::Result<u8> {
     Ok(0)
 }
 
-fn finish(guard: SinkGuard, rec: rerun::RecordingStream, sink: &Sink, outcome: LogOutcome) -> anyhow::Result<u8> {
+fn finish(
+    guard: SinkGuard,
+    rec: rerun::RecordingStream,
+    sink: &Sink,
+    outcome: LogOutcome,
+) -> anyhow::Result<u8> {
     guard.finish(rec).context("finishing the recording")?;
     if let Sink::Save(path) = sink {
         eprintln!("Wrote {}", path.display());
@@ -355,7 +386,10 @@ fn render(
     let viewer = find_native_viewer().context("--png renders with the native viewer")?;
     let (rrd, temporary) = match &options.sink {
         Some(Sink::Save(path)) => (path.clone(), false),
-        _ => (std::env::temp_dir().join(format!("posecov-{}.rrd", std::process::id())), true),
+        _ => (
+            std::env::temp_dir().join(format!("posecov-{}.rrd", std::process::id())),
+            true,
+        ),
     };
     let sink = Sink::Save(rrd.clone());
     let (rec, guard) = open_stream(&sink, ids, &session.scene).context("opening the recording")?;

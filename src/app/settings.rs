@@ -92,7 +92,10 @@ pub fn resolve(
             expected: format!("use 1 ..= {}", limits::MAX_SAMPLES),
         });
     }
-    let samples = overrides.samples.or(file.samples).unwrap_or(DEFAULT_SAMPLES);
+    let samples = overrides
+        .samples
+        .or(file.samples)
+        .unwrap_or(DEFAULT_SAMPLES);
     let confidence = overrides
         .confidence
         .or(file.confidence)

@@ -131,7 +131,11 @@ fn part_of<G: LieGroup<N>, const N: usize>(
     // A part is logged after the main scene: its items only, no description.
     let mut p = Painter::new(main, settings, String::new());
     let shown = Shown::new(main, &settings.choices);
-    for node in block.nodes.iter().filter(|n| n.role != Role::Fixed && shown.node(n)) {
+    for node in block
+        .nodes
+        .iter()
+        .filter(|n| n.role != Role::Fixed && shown.node(n))
+    {
         if let Some(particles) = node.particles.as_ref().filter(|_| p.detailed(node)) {
             draw_particles(&mut p, node, particles, Some(part));
         }
@@ -160,7 +164,10 @@ struct Shown<'a> {
 }
 
 impl<'a> Shown<'a> {
-    fn new<G: LieGroup<N>, const N: usize>(e: &'a Evaluation<G, N>, choices: &'a DrawChoices) -> Self {
+    fn new<G: LieGroup<N>, const N: usize>(
+        e: &'a Evaluation<G, N>,
+        choices: &'a DrawChoices,
+    ) -> Self {
         let root = e
             .nodes
             .iter()
@@ -196,13 +203,20 @@ struct Painter<'s> {
 }
 
 impl<'s> Painter<'s> {
-    fn new<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &'s DrawSettings, description: String) -> Self {
+    fn new<G: LieGroup<N>, const N: usize>(
+        e: &Evaluation<G, N>,
+        settings: &'s DrawSettings,
+        description: String,
+    ) -> Self {
         let extent = scene_extent(e);
-        let axis_length = settings.choices.axis_length.unwrap_or(if G::KIND.is_rotation_only() {
-            1.0
-        } else {
-            (0.12 * extent).clamp(0.05, 2.0)
-        });
+        let axis_length = settings
+            .choices
+            .axis_length
+            .unwrap_or(if G::KIND.is_rotation_only() {
+                1.0
+            } else {
+                (0.12 * extent).clamp(0.05, 2.0)
+            });
         Painter {
             scene: Scene::new(settings.about.title.clone(), description),
             settings,
@@ -246,7 +260,11 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
                     Method::MonteCarlo.color(),
                 ),
             };
-            let strip: Vec<Vec3> = path.poses.iter().map(|x| v3(x.to_se3().translation())).collect();
+            let strip: Vec<Vec3> = path
+                .poses
+                .iter()
+                .map(|x| v3(x.to_se3().translation()))
+                .collect();
             p.push(
                 name,
                 None,
@@ -281,13 +299,17 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
             );
         }
     }
-    let last_frame: BTreeMap<&str, u64> = e.matrix_frames.iter().fold(BTreeMap::new(), |mut m, f| {
-        let last = m.entry(f.output.as_str()).or_insert(0);
-        *last = (*last).max(f.step);
-        m
-    });
+    let last_frame: BTreeMap<&str, u64> =
+        e.matrix_frames.iter().fold(BTreeMap::new(), |mut m, f| {
+            let last = m.entry(f.output.as_str()).or_insert(0);
+            *last = (*last).max(f.step);
+            m
+        });
     for frame in &e.matrix_frames {
-        let last = last_frame.get(frame.output.as_str()).copied().unwrap_or(frame.step);
+        let last = last_frame
+            .get(frame.output.as_str())
+            .copied()
+            .unwrap_or(frame.step);
         if !settings.steps.detailed(frame.step, last) {
             continue;
         }
@@ -335,13 +357,20 @@ fn scene_extent<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> f64 {
         .nodes
         .iter()
         .map(|n| *n.nominal.to_se3().translation())
-        .chain(e.paths.iter().flat_map(|p| p.poses.iter().map(|x| *x.to_se3().translation())))
+        .chain(
+            e.paths
+                .iter()
+                .flat_map(|p| p.poses.iter().map(|x| *x.to_se3().translation())),
+        )
         .collect();
     if points.is_empty() {
         return 1.0;
     }
     let centroid = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
-    let extent = points.iter().map(|p| (p - centroid).norm()).fold(0.0, f64::max);
+    let extent = points
+        .iter()
+        .map(|p| (p - centroid).norm())
+        .fold(0.0, f64::max);
     if extent > 0.0 { extent } else { 1.0 }
 }
 
@@ -356,8 +385,12 @@ fn primary_method<G: LieGroup<N>, const N: usize>(node: &Node<G, N>) -> Option<M
 
 fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>) {
     let choices = &p.settings.choices;
-    let (axes, ellipsoids, bananas, orientation) =
-        (choices.axes, choices.ellipsoids, choices.bananas, choices.orientation);
+    let (axes, ellipsoids, bananas, orientation) = (
+        choices.axes,
+        choices.ellipsoids,
+        choices.bananas,
+        choices.orientation,
+    );
     let pose3 = node.nominal.to_se3();
     if axes {
         p.push(
@@ -379,11 +412,20 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
     if !p.detailed(node) {
         // Between detailed steps only the (light) frame and the primary ellipsoid are logged,
         // so the step slider still shows the growth.
-        if let Some(e) = node.estimates.iter().find(|e| Some(e.result.method) == primary)
+        if let Some(e) = node
+            .estimates
+            .iter()
+            .find(|e| Some(e.result.method) == primary)
             && ellipsoids
             && !rotation_only
         {
-            shapes::position_ellipsoid(p, &format!("world/{}/{}", node.name, e.result.method.slug()), node.step, &e.result.pose, e.result.method.color());
+            shapes::position_ellipsoid(
+                p,
+                &format!("world/{}/{}", node.name, e.result.method.slug()),
+                node.step,
+                &e.result.pose,
+                e.result.method.color(),
+            );
         }
         return;
     }
@@ -412,7 +454,14 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
             if is_primary {
                 shapes::banana(p, &base, node.step, &pose, color, point_of);
             } else {
-                shapes::outlines(p, &format!("{base}/banana_outline"), node.step, &pose, color, point_of);
+                shapes::outlines(
+                    p,
+                    &format!("{base}/banana_outline"),
+                    node.step,
+                    &pose,
+                    color,
+                    point_of,
+                );
             }
         }
         if orientation && rotation_only {
@@ -479,7 +528,10 @@ fn draw_particles<G: LieGroup<N>, const N: usize>(
             node.step,
             ItemKind::Triads(Triads {
                 translations: subsample.iter().map(|x| v3(x.translation())).collect(),
-                rotations: subsample.iter().map(|x| x.rotation().to_quaternion_xyzw()).collect(),
+                rotations: subsample
+                    .iter()
+                    .map(|x| x.rotation().to_quaternion_xyzw())
+                    .collect(),
                 axis_length: 0.35 * p.axis_length,
                 line_radius: 0.0015 * p.axis_length / 0.15,
             }),
@@ -489,7 +541,10 @@ fn draw_particles<G: LieGroup<N>, const N: usize>(
         for (k, name) in ["spray_x", "spray_y", "spray_z"].iter().enumerate() {
             let tips = poses
                 .iter()
-                .map(|x| v3(&(x.translation() + x.rotation().act(&(Vector3::ith(k, 1.0) * p.axis_length)))))
+                .map(|x| {
+                    v3(&(x.translation()
+                        + x.rotation().act(&(Vector3::ith(k, 1.0) * p.axis_length))))
+                })
                 .collect();
             p.push(
                 format!("{base}/{name}{suffix}"),

@@ -50,9 +50,17 @@ pub(super) struct Line {
 }
 
 /// Adds each method's value at `step` to its line (a new line per method).
-fn add(lines: &mut Vec<Line>, kind: PlotKind, step: i64, values: impl IntoIterator<Item = (Method, f64)>) {
+fn add(
+    lines: &mut Vec<Line>,
+    kind: PlotKind,
+    step: i64,
+    values: impl IntoIterator<Item = (Method, f64)>,
+) {
     for (method, value) in values {
-        match lines.iter_mut().find(|l| l.kind == kind && l.method == Some(method)) {
+        match lines
+            .iter_mut()
+            .find(|l| l.kind == kind && l.method == Some(method))
+        {
             Some(line) => line.points.push((step, value)),
             None => lines.push(Line {
                 kind,
@@ -78,12 +86,18 @@ fn steps_of<'e, G: LieGroup<N>, const N: usize>(
     e: &'e Evaluation<G, N>,
     name: &'e str,
 ) -> impl Iterator<Item = &'e Node<G, N>> {
-    e.nodes.iter().filter(move |n| n.name == name && n.step.is_some())
+    e.nodes
+        .iter()
+        .filter(move |n| n.name == name && n.step.is_some())
 }
 
 /// Trace of the position covariance (rotation groups: of the rotation covariance), right
 /// form, per method and step.
-fn trace_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, name: &str, lines: &mut Vec<Line>) {
+fn trace_lines<G: LieGroup<N>, const N: usize>(
+    e: &Evaluation<G, N>,
+    name: &str,
+    lines: &mut Vec<Line>,
+) {
     let rot = G::rotation_range();
     let (kind, block) = if G::KIND.is_rotation_only() {
         (TRACE_ROTATION, rot)
@@ -102,7 +116,10 @@ fn trace_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, name: &str,
 /// Σ_ρxρx in the left (world) form per method and step: the along-track variance that
 /// second-order compounding misses (Barfoot & Furgale 2014, Fig. 2). Monte Carlo is the
 /// uncentred E[ξξᵀ] about the propagated mean, as in their experiments.
-pub(super) fn along_track_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, name: &str) -> Vec<Line> {
+pub(super) fn along_track_lines<G: LieGroup<N>, const N: usize>(
+    e: &Evaluation<G, N>,
+    name: &str,
+) -> Vec<Line> {
     let mut lines = Vec::new();
     if G::KIND.is_rotation_only() {
         return lines;
@@ -117,15 +134,28 @@ pub(super) fn along_track_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G
             .monte_carlo
             .and_then(|mc| mc.uncentred_left)
             .map(|c| (Method::MonteCarlo, c[(0, 0)]));
-        add(&mut lines, ALONG_TRACK, node.step.unwrap_or(0) as i64, analytic.chain(monte_carlo));
+        add(
+            &mut lines,
+            ALONG_TRACK,
+            node.step.unwrap_or(0) as i64,
+            analytic.chain(monte_carlo),
+        );
     }
     lines
 }
 
 /// max |RᵀR − I| per step of the Euler matrices and of the Exp rotations.
-fn orthogonality_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, name: &str, lines: &mut Vec<Line>) {
-    let drift = |m: &nalgebra::Matrix3<f64>| (m.transpose() * m - nalgebra::Matrix3::identity()).amax();
-    let frames = e.matrix_frames.iter().filter(|f| name.strip_suffix("_exp") == Some(f.output.as_str()));
+fn orthogonality_lines<G: LieGroup<N>, const N: usize>(
+    e: &Evaluation<G, N>,
+    name: &str,
+    lines: &mut Vec<Line>,
+) {
+    let drift =
+        |m: &nalgebra::Matrix3<f64>| (m.transpose() * m - nalgebra::Matrix3::identity()).amax();
+    let frames = e
+        .matrix_frames
+        .iter()
+        .filter(|f| name.strip_suffix("_exp") == Some(f.output.as_str()));
     lines.push(Line {
         kind: ORTHOGONALITY,
         method: None,
@@ -137,22 +167,30 @@ fn orthogonality_lines<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, nam
         method: Some(Method::Exact),
         label: "exponential map R·Exp(ωdt)".to_owned(),
         points: steps_of(e, name)
-            .map(|n| (n.step.unwrap_or(0) as i64, drift(&n.nominal.to_se3().rotation().to_matrix())))
+            .map(|n| {
+                (
+                    n.step.unwrap_or(0) as i64,
+                    drift(&n.nominal.to_se3().rotation().to_matrix()),
+                )
+            })
             .collect(),
     });
 }
 
 /// Every plot of an evaluation and its lines, in evaluation order.
-pub(super) fn plots<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> (Vec<Plot>, Vec<ScalarSeries>) {
+pub(super) fn plots<G: LieGroup<N>, const N: usize>(
+    e: &Evaluation<G, N>,
+) -> (Vec<Plot>, Vec<ScalarSeries>) {
     let mut lines = Vec::new();
-    let mut order: Vec<(usize, &str, OpKind)> = [OpKind::Odometry, OpKind::Compound, OpKind::EulerVsExp]
-        .into_iter()
-        .flat_map(|op| propagations(e, op).into_iter().map(move |name| (op, name)))
-        .map(|(op, name)| {
-            let first = e.nodes.iter().position(|n| n.name == name).unwrap_or(0);
-            (first, name, op)
-        })
-        .collect();
+    let mut order: Vec<(usize, &str, OpKind)> =
+        [OpKind::Odometry, OpKind::Compound, OpKind::EulerVsExp]
+            .into_iter()
+            .flat_map(|op| propagations(e, op).into_iter().map(move |name| (op, name)))
+            .map(|(op, name)| {
+                let first = e.nodes.iter().position(|n| n.name == name).unwrap_or(0);
+                (first, name, op)
+            })
+            .collect();
     order.sort_by_key(|(first, ..)| *first);
     for (_, name, op) in order {
         match op {

@@ -5,7 +5,9 @@ use nalgebra::{DMatrix, Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vect
 
 use super::{Painter, v3};
 use crate::lie::{LieGroup, Tangent, TangentMatrix};
-use crate::scene::{self, Color, Ellipsoid, Ellipsoids, FillMode, ItemKind, LineStrips, Surface, Vec3};
+use crate::scene::{
+    self, Color, Ellipsoid, Ellipsoids, FillMode, ItemKind, LineStrips, Surface, Vec3,
+};
 use crate::uncertain::{Side, UncertainPose};
 
 /// Sphere-mesh resolution of banana surfaces (latitude bands, meridians).
@@ -39,7 +41,11 @@ pub(super) fn ellipsoid_of(center: &Vector3<f64>, cov: &Matrix3<f64>, radius: f6
     if axes.determinant() < 0.0 {
         axes.set_column(2, &(-axes.column(2)));
     }
-    let half: Vec<f64> = eig.eigenvalues.iter().map(|l| radius * l.max(0.0).sqrt()).collect();
+    let half: Vec<f64> = eig
+        .eigenvalues
+        .iter()
+        .map(|l| radius * l.max(0.0).sqrt())
+        .collect();
     let floor = half.iter().copied().fold(0.0, f64::max) * 0.01;
     let rotation = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(axes));
     Ellipsoid {
@@ -62,7 +68,11 @@ pub(super) fn position_ellipsoid<G: LieGroup<N>, const N: usize>(
         return;
     };
     let d = G::KIND.position_dims().max(1);
-    let shape = ellipsoid_of(pose.mean().to_se3().translation(), &cov, chi2_radius(p.confidence(), d));
+    let shape = ellipsoid_of(
+        pose.mean().to_se3().translation(),
+        &cov,
+        chi2_radius(p.confidence(), d),
+    );
     p.push(
         format!("{base}/ellipsoid"),
         step,
@@ -101,7 +111,11 @@ impl<const N: usize> PrincipalFrame<N> {
         // A Gaussian of rank k < N lives in a k-dimensional subspace: its p-region has the χ²_k
         // radius, not χ²_N (a yaw-only noise would otherwise be drawn far too wide).
         let largest = values.first().copied().unwrap_or(0.0);
-        let rank = values.iter().filter(|l| **l > RANK_TOLERANCE * largest).count().max(1);
+        let rank = values
+            .iter()
+            .filter(|l| **l > RANK_TOLERANCE * largest)
+            .count()
+            .max(1);
         let r = chi2_radius(confidence, rank);
         let column = |i: usize| match (values.get(i), vectors.get(i)) {
             (Some(l), Some(v)) => v * (r * l.sqrt()),
@@ -145,7 +159,14 @@ pub(super) fn banana<G: LieGroup<N>, const N: usize>(
     }
     .with_computed_normals();
     p.push(format!("{base}/banana"), step, ItemKind::Surface(surface));
-    outlines(p, &format!("{base}/banana_outline"), step, pose, color, point_of);
+    outlines(
+        p,
+        &format!("{base}/banana_outline"),
+        step,
+        pose,
+        color,
+        point_of,
+    );
 }
 
 /// Images of the three principal great circles of the tangent ellipsoid.

@@ -13,7 +13,10 @@ use crate::plan::OpKind;
 use crate::uncertain::Method;
 
 /// The Markdown of the text panel.
-pub(super) fn description<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSettings) -> String {
+pub(super) fn description<G: LieGroup<N>, const N: usize>(
+    e: &Evaluation<G, N>,
+    settings: &DrawSettings,
+) -> String {
     let about = &settings.about;
     let mut s = format!("# {}\n\n", about.title);
     if !about.source.is_empty() {
@@ -44,7 +47,12 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, 
     errors_table(&mut s, e);
     for name in compounds(e) {
         let lines = along_track_lines(e, name);
-        let last = e.nodes.iter().rev().find(|n| n.name == name).and_then(|n| n.step);
+        let last = e
+            .nodes
+            .iter()
+            .rev()
+            .find(|n| n.name == name)
+            .and_then(|n| n.step);
         if let (Some(step), false) = (last, lines.is_empty()) {
             let summary: Vec<String> = lines
                 .iter()
@@ -84,13 +92,20 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
     if with_errors.is_empty() {
         return;
     }
-    let _ = writeln!(s, "**Error against Monte Carlo** (‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F, right side):\n");
+    let _ = writeln!(
+        s,
+        "**Error against Monte Carlo** (‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F, right side):\n"
+    );
     let _ = writeln!(s, "| pose | method | error |\n|---|---|---|");
     for node in with_errors {
         let label = node
             .step
             .map_or(node.name.clone(), |k| format!("{} (step {k})", node.name));
-        for est in node.estimates.iter().filter(|x| x.result.method != Method::MonteCarlo) {
+        for est in node
+            .estimates
+            .iter()
+            .filter(|x| x.result.method != Method::MonteCarlo)
+        {
             let Some(err) = est.error_vs_monte_carlo else {
                 continue;
             };
@@ -134,7 +149,12 @@ fn finding_text(f: &Finding) -> String {
             cartesian_mean,
         } => format!(
             "`{output}` (D = {diffusion}): nominal end ({:.3}, {:.3}); **Lie mean** of the samples ({:.3}, {:.3}); **Cartesian mean** of their positions ({:.3}, {:.3}) — it retreats inside the banana.",
-            nominal_end[0], nominal_end[1], lie_mean[0], lie_mean[1], cartesian_mean[0], cartesian_mean[1]
+            nominal_end[0],
+            nominal_end[1],
+            lie_mean[0],
+            lie_mean[1],
+            cartesian_mean[0],
+            cartesian_mean[1]
         ),
         Finding::EulerDrift {
             output: _,
@@ -150,7 +170,11 @@ fn finding_text(f: &Finding) -> String {
             step,
             method,
             reason,
-        } => format!("*{} gave no estimate for `{output}`{}: {reason}.*", method.label(), at(step)),
+        } => format!(
+            "*{} gave no estimate for `{output}`{}: {reason}.*",
+            method.label(),
+            at(step)
+        ),
         Finding::NotPositiveSemiDefinite {
             output,
             step,
@@ -169,7 +193,9 @@ fn finding_text(f: &Finding) -> String {
         } => format!(
             "`{output}` has {steps} steps: {recorded} evenly spaced ones (and the last) are recorded and drawn, to bound memory."
         ),
-        Finding::Interrupted => "*Evaluation interrupted: later operations or steps were not evaluated.*".to_owned(),
+        Finding::Interrupted => {
+            "*Evaluation interrupted: later operations or steps were not evaluated.*".to_owned()
+        }
     }
 }
 

@@ -104,7 +104,13 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
     }
 
     /// Adds one block's particles of node `index` (`first_pass`: also the one-pass sums).
-    pub(super) fn add_node(&mut self, index: usize, node: &Node<G, N>, particles: &[G], first_pass: bool) {
+    pub(super) fn add_node(
+        &mut self,
+        index: usize,
+        node: &Node<G, N>,
+        particles: &[G],
+        first_pass: bool,
+    ) {
         let Some(Some(sums)) = self.nodes.get_mut(index) else {
             return;
         };

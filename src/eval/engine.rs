@@ -170,7 +170,11 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                         pose,
                         method: Method::Exact,
                     };
-                    self.push(&def.name, Role::Input, Draft::single(vec![estimate], particles))?;
+                    self.push(
+                        &def.name,
+                        Role::Input,
+                        Draft::single(vec![estimate], particles),
+                    )?;
                     self.defined.push(Some(self.out.nodes.len() - 1));
                 }
             }
@@ -218,10 +222,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
     }
 
     /// The Gaussian (the primary estimate) and the particles of an operand.
-    pub(super) fn gaussian(
-        &self,
-        operand: Operand<G>,
-    ) -> Result<Gaussian<G, N>, EvalError> {
+    pub(super) fn gaussian(&self, operand: Operand<G>) -> Result<Gaussian<G, N>, EvalError> {
         match operand {
             Operand::Known(g) => Ok((UncertainPose::certain(g), None)),
             Operand::Defined(k) => {
@@ -268,7 +269,12 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
     /// any other non-finite estimate is dropped with a finding, an indefinite covariance is
     /// reported), with its Monte Carlo statistics and errors against them. Steps that the
     /// [`StepPolicy`](crate::plan::StepPolicy) does not record are skipped.
-    pub(super) fn push(&mut self, name: &str, role: Role, draft: Draft<'_, G, N>) -> Result<(), EvalError> {
+    pub(super) fn push(
+        &mut self,
+        name: &str,
+        role: Role,
+        draft: Draft<'_, G, N>,
+    ) -> Result<(), EvalError> {
         let policy = self.settings.steps;
         if let (Some(k), Some(last)) = (draft.step, draft.last_step)
             && !policy.records(k, last)
@@ -286,7 +292,11 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                         method: result.method.label(),
                     });
                 }
-                self.method_failed(draft.step, result.method, "the result is not finite (overflow)".to_owned());
+                self.method_failed(
+                    draft.step,
+                    result.method,
+                    "the result is not finite (overflow)".to_owned(),
+                );
                 continue;
             }
             self.check_psd(name, draft.step, result.method, result.pose.cov());
@@ -295,7 +305,9 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 error_vs_monte_carlo: None,
             });
         }
-        let nominal = estimates.first().map_or_else(G::identity, |e| *e.result.pose.mean());
+        let nominal = estimates
+            .first()
+            .map_or_else(G::identity, |e| *e.result.pose.mean());
         let index = self.out.nodes.len();
         let mut node = Node {
             name: name.to_owned(),
@@ -334,7 +346,8 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 Some(Ok(mc)) => {
                     for e in &mut node.estimates {
                         // Undefined (not reported) when the Monte Carlo covariance is zero.
-                        let error = relative_frobenius_error(&e.result.pose.cov_right(), &mc.stats.cov);
+                        let error =
+                            relative_frobenius_error(&e.result.pose.cov_right(), &mc.stats.cov);
                         e.error_vs_monte_carlo = error.is_finite().then_some(error);
                     }
                     node.estimates.push(Estimate {
@@ -344,6 +357,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                         },
                         error_vs_monte_carlo: Some(0.0),
                     });
+                    self.check_psd(name, draft.step, Method::MonteCarlo, &mc.stats.cov);
                     node.monte_carlo = Some(mc);
                 }
                 Some(Err(e)) => {
@@ -377,19 +391,21 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
         extras: Extras,
     ) -> Option<Result<McSummary<G, N>, MeanError<G>>> {
         match &mut self.stats {
-            StatsMode::Own => Some(sample_statistics(particles, Side::Right).map(|stats| McSummary {
-                stats,
-                uncentred_left: extras
-                    .uncentred_left
-                    .then(|| uncentred_covariance(particles, &node.nominal, Side::Left).ok())
-                    .flatten(),
-                position_mean: extras.position_mean.then(|| {
-                    particles
-                        .iter()
-                        .map(|g| *g.to_se3().translation())
-                        .sum::<Vector3<f64>>()
-                        / particles.len() as f64
-                }),
+            StatsMode::Own => Some(sample_statistics(particles, Side::Right).map(|stats| {
+                McSummary {
+                    stats,
+                    uncentred_left: extras
+                        .uncentred_left
+                        .then(|| uncentred_covariance(particles, &node.nominal, Side::Left).ok())
+                        .flatten(),
+                    position_mean: extras.position_mean.then(|| {
+                        particles
+                            .iter()
+                            .map(|g| *g.to_se3().translation())
+                            .sum::<Vector3<f64>>()
+                            / particles.len() as f64
+                    }),
+                }
             })),
             StatsMode::Skip => None,
             StatsMode::Collect(stats, first_pass) => {
@@ -439,7 +455,11 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 if m.iter().chain(c.iter()).all(|v| v.is_finite()) {
                     estimates.push((Method::MonteCarlo, m, c));
                 } else {
-                    self.method_failed(None, Method::MonteCarlo, "the sample statistics are not finite".to_owned());
+                    self.method_failed(
+                        None,
+                        Method::MonteCarlo,
+                        "the sample statistics are not finite".to_owned(),
+                    );
                 }
             }
         }
@@ -475,7 +495,18 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
 /// computed on and drawn ([`limits::OVERFLOW_COORDINATE`], [`limits::OVERFLOW_VARIANCE`]).
 fn finite_pose<G: LieGroup<N>, const N: usize>(result: &Propagated<G, N>) -> bool {
     let mean = result.pose.mean().to_se3();
-    result.pose.cov().iter().all(|v| v.abs() <= limits::OVERFLOW_VARIANCE)
-        && mean.translation().iter().all(|v| v.abs() <= limits::OVERFLOW_COORDINATE)
-        && mean.rotation().to_quaternion_xyzw().iter().all(|v| v.is_finite())
+    result
+        .pose
+        .cov()
+        .iter()
+        .all(|v| v.abs() <= limits::OVERFLOW_VARIANCE)
+        && mean
+            .translation()
+            .iter()
+            .all(|v| v.abs() <= limits::OVERFLOW_COORDINATE)
+        && mean
+            .rotation()
+            .to_quaternion_xyzw()
+            .iter()
+            .all(|v| v.is_finite())
 }

@@ -5,18 +5,20 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
+use super::EvalError;
 use super::engine::{Draft, Engine, Extras, Particles};
 use super::groups::EvalGroup;
 use super::model::{Finding, MatrixFrame, Node, PathKind, PosePath, Role};
-use super::EvalError;
 use crate::lie::{LieGroup, Tangent, TangentMatrix};
-use crate::plan::{Control, DiffDriveMotion, FrameSide, OdometryModel, Op, OpKind, Operand, limits};
+use crate::plan::{
+    Control, DiffDriveMotion, FrameSide, OdometryModel, Op, OpKind, Operand, limits,
+};
+use crate::propagate::Propagated;
 use crate::propagate::first_order::{self, CorrelatedPair};
 use crate::propagate::fourth_order::Order;
 use crate::propagate::fusion::{FusionOptions, fuse};
 use crate::propagate::odometry::{InputNoise, propagate_increments, propagate_tangent_inputs};
 use crate::propagate::sigma_point::{self, Unscented};
-use crate::propagate::Propagated;
 use crate::sample::{Sampler, fill_par_from, standard_normal};
 use crate::uncertain::{Method, Side, UncertainPose};
 
@@ -42,8 +44,16 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         match op {
             Op::Inverse { input } => self.inverse(*input),
             Op::ChangeFrame { input, by, side } => self.change_frame(*input, *by, *side),
-            Op::Compose { lhs, rhs, cross_cov } => self.pair(*lhs, *rhs, cross_cov.as_ref(), Pair::Compose),
-            Op::Between { lhs, rhs, cross_cov } => self.pair(*lhs, *rhs, cross_cov.as_ref(), Pair::Between),
+            Op::Compose {
+                lhs,
+                rhs,
+                cross_cov,
+            } => self.pair(*lhs, *rhs, cross_cov.as_ref(), Pair::Compose),
+            Op::Between {
+                lhs,
+                rhs,
+                cross_cov,
+            } => self.pair(*lhs, *rhs, cross_cov.as_ref(), Pair::Between),
             Op::Odometry {
                 input,
                 model,
@@ -92,7 +102,11 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
     }
 
     /// The Smith–Self–Cheeseman compose X·Y in vector coordinates, where requested and defined.
-    fn vector_space(&mut self, x: &UncertainPose<G, N>, y: &UncertainPose<G, N>) -> Option<Propagated<G, N>> {
+    fn vector_space(
+        &mut self,
+        x: &UncertainPose<G, N>,
+        y: &UncertainPose<G, N>,
+    ) -> Option<Propagated<G, N>> {
         if !self.wants(Method::VectorSpace) {
             return None;
         }
@@ -105,7 +119,11 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         }
     }
 
-    fn single(&mut self, estimates: Vec<Propagated<G, N>>, particles: Option<Arc<Vec<G>>>) -> Result<(), EvalError> {
+    fn single(
+        &mut self,
+        estimates: Vec<Propagated<G, N>>,
+        particles: Option<Arc<Vec<G>>>,
+    ) -> Result<(), EvalError> {
         let name = self.output();
         self.push(&name, Role::Output, Draft::single(estimates, particles))
     }
@@ -128,11 +146,22 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             FrameSide::Right => g.compose(&by),
         };
         let (first, extra) = match side {
-            FrameSide::Left => (first_order::change_frame_left(&by, &x), self.vector_space(&known, &x)),
-            FrameSide::Right => (first_order::change_frame_right(&x, &by), self.vector_space(&x, &known)),
+            FrameSide::Left => (
+                first_order::change_frame_left(&by, &x),
+                self.vector_space(&known, &x),
+            ),
+            FrameSide::Right => (
+                first_order::change_frame_right(&x, &by),
+                self.vector_space(&x, &known),
+            ),
         };
         let particles = px.map(|p| Arc::new(p.iter().map(&map).collect()));
-        let estimates = self.estimates(first, extra.into_iter().collect(), |g: &[G]| map(&g[0]), &[x]);
+        let estimates = self.estimates(
+            first,
+            extra.into_iter().collect(),
+            |g: &[G]| map(&g[0]),
+            &[x],
+        );
         self.single(estimates, particles)
     }
 
@@ -169,11 +198,19 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let particles = (self.monte_carlo && (px.is_some() || py.is_some())).then(|| {
             let px = self.particles_of(&x, px);
             let py = self.particles_of(&y, py);
-            Arc::new(px.iter().zip(py.iter()).map(|(a, b)| pair.apply(a, b)).collect())
+            Arc::new(
+                px.iter()
+                    .zip(py.iter())
+                    .map(|(a, b)| pair.apply(a, b))
+                    .collect(),
+            )
         });
         let mut extra = Vec::new();
         if pair == Pair::Compose {
-            for (order, method) in [(Order::Second, Method::SecondOrder), (Order::Fourth, Method::FourthOrder)] {
+            for (order, method) in [
+                (Order::Second, Method::SecondOrder),
+                (Order::Fourth, Method::FourthOrder),
+            ] {
                 if self.wants(method) {
                     extra.extend(G::compound(&x, &y, order));
                 }
@@ -192,20 +229,27 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let (mx, my) = joint.means();
         let side = joint.side();
         let mut out = vec![mx; self.block.len()];
-        fill_par_from(&mut out, self.settings.seed, family, self.first_chunk(), |rng, chunk| {
-            for z in chunk.iter_mut() {
-                let a = standard_normal::<N, _>(rng);
-                let b = standard_normal::<N, _>(rng);
-                let e = &factor * DVector::from_iterator(2 * N, a.iter().chain(b.iter()).copied());
-                let ex = Tangent::<N>::from_iterator(e.rows(0, N).iter().copied());
-                let ey = Tangent::<N>::from_iterator(e.rows(N, N).iter().copied());
-                let (x, y) = match side {
-                    Side::Right => (mx.rplus(&ex), my.rplus(&ey)),
-                    Side::Left => (mx.lplus(&ex), my.lplus(&ey)),
-                };
-                *z = pair.apply(&x, &y);
-            }
-        });
+        fill_par_from(
+            &mut out,
+            self.settings.seed,
+            family,
+            self.first_chunk(),
+            |rng, chunk| {
+                for z in chunk.iter_mut() {
+                    let a = standard_normal::<N, _>(rng);
+                    let b = standard_normal::<N, _>(rng);
+                    let e =
+                        &factor * DVector::from_iterator(2 * N, a.iter().chain(b.iter()).copied());
+                    let ex = Tangent::<N>::from_iterator(e.rows(0, N).iter().copied());
+                    let ey = Tangent::<N>::from_iterator(e.rows(N, N).iter().copied());
+                    let (x, y) = match side {
+                        Side::Right => (mx.rplus(&ex), my.rplus(&ey)),
+                        Side::Left => (mx.lplus(&ex), my.lplus(&ey)),
+                    };
+                    *z = pair.apply(&x, &y);
+                }
+            },
+        );
         out
     }
 
@@ -223,19 +267,29 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let increments: Vec<G> = controls.iter().map(|c| c.increment).collect();
         let mut tracks: Vec<Vec<Propagated<G, N>>> = Vec::new();
         match model {
-            OdometryModel::Increment => {
-                tracks.push(propagate_increments(&start_right, &increments, noise).map_err(|e| self.math(e))?)
-            }
+            OdometryModel::Increment => tracks.push(
+                propagate_increments(&start_right, &increments, noise).map_err(|e| self.math(e))?,
+            ),
             OdometryModel::Exp => {
                 let inputs: Vec<Tangent<N>> = controls.iter().map(|c| c.tangent).collect();
                 tracks.push(
-                    propagate_tangent_inputs(&start_right, &inputs, noise, InputNoise::RightJacobian)
-                        .map_err(|e| self.math(e))?,
+                    propagate_tangent_inputs(
+                        &start_right,
+                        &inputs,
+                        noise,
+                        InputNoise::RightJacobian,
+                    )
+                    .map_err(|e| self.math(e))?,
                 );
                 if self.wants(Method::LectureNoJr) {
                     tracks.push(
-                        propagate_tangent_inputs(&start_right, &inputs, noise, InputNoise::LectureNoJr)
-                            .map_err(|e| self.math(e))?,
+                        propagate_tangent_inputs(
+                            &start_right,
+                            &inputs,
+                            noise,
+                            InputNoise::LectureNoJr,
+                        )
+                        .map_err(|e| self.math(e))?,
                     );
                 }
             }
@@ -255,8 +309,12 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let mut current: Option<Vec<G>> = self
             .monte_carlo
             .then(|| self.particles_of(&start, start_particles).as_ref().clone());
-        let sampler = Sampler::new(&UncertainPose::new_unchecked(G::identity(), *noise, Side::Right))
-            .map_err(|e| self.math(e))?;
+        let sampler = Sampler::new(&UncertainPose::new_unchecked(
+            G::identity(),
+            *noise,
+            Side::Right,
+        ))
+        .map_err(|e| self.math(e))?;
         self.push_step(&name, 0, last, step_estimates(0), current.as_deref())?;
         for (k, control) in controls.iter().enumerate() {
             if self.settings.cancelled() {
@@ -274,7 +332,13 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                     }
                 });
             }
-            self.push_step(&name, k as u64 + 1, last, step_estimates(k + 1), current.as_deref())?;
+            self.push_step(
+                &name,
+                k as u64 + 1,
+                last,
+                step_estimates(k + 1),
+                current.as_deref(),
+            )?;
         }
         self.nominal_path(tracks[0].iter().map(|r| *r.pose.mean()).collect());
         self.thinned(last);
@@ -315,7 +379,9 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
 
     /// Says when a long propagation recorded only some steps.
     fn thinned(&mut self, last: u64) {
-        let recorded = (0..=last).filter(|k| self.settings.steps.records(*k, last)).count() as u64;
+        let recorded = (0..=last)
+            .filter(|k| self.settings.steps.records(*k, last))
+            .count() as u64;
         if recorded < last + 1 {
             self.out.findings.push(Finding::StepsThinned {
                 output: self.output(),
@@ -336,10 +402,13 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
     ) -> Result<(), EvalError> {
         let (start, start_particles) = self.gaussian(input)?;
         let increment = UncertainPose::new_unchecked(step_mean, *noise, noise_side);
-        let orders: Vec<(Order, Method)> = [(Order::Second, Method::SecondOrder), (Order::Fourth, Method::FourthOrder)]
-            .into_iter()
-            .filter(|(_, m)| self.wants(*m))
-            .collect();
+        let orders: Vec<(Order, Method)> = [
+            (Order::Second, Method::SecondOrder),
+            (Order::Fourth, Method::FourthOrder),
+        ]
+        .into_iter()
+        .filter(|(_, m)| self.wants(*m))
+        .collect();
         let mut first = Propagated {
             pose: start.to_side(noise_side),
             method: Method::FirstOrder,
@@ -377,9 +446,13 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             if let Some(particles) = current.as_mut() {
                 let family = self.next_family();
                 let first_chunk = self.first_chunk();
-                fill_par_map(particles, self.settings.seed, family, first_chunk, |rng, x| {
-                    sampler.draw(rng).compose(x)
-                });
+                fill_par_map(
+                    particles,
+                    self.settings.seed,
+                    family,
+                    first_chunk,
+                    |rng, x| sampler.draw(rng).compose(x),
+                );
             }
             nominal.push(*first.pose.mean());
             self.push_step(&name, k, steps, all(&first, &higher), current.as_deref())?;
@@ -408,7 +481,8 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             fill_par_from(&mut points, seed, family, first_chunk, |rng, chunk| {
                 for q in chunk.iter_mut() {
                     let z = standard_normal::<3, _>(rng);
-                    let noise = &factor * DVector::from_iterator(dims, z.iter().take(dims).copied());
+                    let noise =
+                        &factor * DVector::from_iterator(dims, z.iter().take(dims).copied());
                     let mut p = *point;
                     for (i, n) in noise.iter().enumerate() {
                         p[i] += n;
@@ -470,7 +544,11 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
 
     /// A differential-drive robot from a known start (Long et al. 2012).
     fn diff_drive(&mut self, start: G, motion: &DiffDriveMotion) -> Result<(), EvalError> {
-        let samples = if self.monte_carlo { self.block.len() } else { 0 };
+        let samples = if self.monte_carlo {
+            self.block.len()
+        } else {
+            0
+        };
         let seed = self.settings.seed.wrapping_add(self.next_family());
         let integral = self.wants(Method::NumericIntegral);
         let outcome = match G::diff_drive(motion, integral, samples, self.first_chunk(), seed) {
@@ -558,7 +636,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                 step: k,
                 columns: *euler,
             });
-// A rotation known exactly: a node with no estimate, drawn as its frame.
+            // A rotation known exactly: a node with no estimate, drawn as its frame.
             self.out.nodes.push(Node {
                 name: name.clone(),
                 role: Role::Output,

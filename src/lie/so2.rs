@@ -204,7 +204,10 @@ impl LieGroup<1> for So2 {
     }
 
     fn to_se3(&self) -> super::Se3 {
-        super::Se3::from_parts(nalgebra::Vector3::zeros(), super::So3::from_rpy(0.0, 0.0, self.angle()))
+        super::Se3::from_parts(
+            nalgebra::Vector3::zeros(),
+            super::So3::from_rpy(0.0, 0.0, self.angle()),
+        )
     }
 }
 

@@ -94,7 +94,7 @@ pub fn log_scene_cancellable(
 }
 
 /// Logs the items of a part scene (a later block of a large Monte Carlo sample, from
-/// [`crate::draw::particle_parts`]) after the main scene: validated, then its items in log
+/// [`crate::draw::particle_part`]) after the main scene: validated, then its items in log
 /// order, nothing else (no name, view coordinates, description or series). `cancel` as in
 /// [`log_scene_cancellable`].
 ///

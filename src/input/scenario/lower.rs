@@ -17,9 +17,7 @@ use super::values::{SpecGroup, control_for, cov_for, fixed_matrix, mean_for};
 use super::{Scenario, ScenarioError};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{GroupKind, LieGroup, Se2, Se3, So2, So3, TangentMatrix};
-use crate::plan::{
-    AnyPlan, DiffDriveMotion, FrameSide, Op, OdometryModel, Operand, Plan, limits,
-};
+use crate::plan::{AnyPlan, DiffDriveMotion, FrameSide, OdometryModel, Op, Operand, Plan, limits};
 use crate::propagate::first_order::CorrelatedPair;
 use crate::uncertain::{Side, UncertainPose};
 
@@ -33,7 +31,11 @@ pub const OPERATION_KINDS: &[(&str, &[&str], &[&str])] = &[
     ("between", &["lhs", "rhs"], &[]),
     ("compose_correlated", &["lhs", "rhs", "cross_cov"], &[]),
     ("between_correlated", &["lhs", "rhs", "cross_cov"], &[]),
-    ("odometry", &["input", "controls", "noise", "model"], &["steps"]),
+    (
+        "odometry",
+        &["input", "controls", "noise", "model"],
+        &["steps"],
+    ),
     ("compound", &["input", "by", "noise", "steps"], &[]),
     (
         "diff_drive",
@@ -163,12 +165,13 @@ impl Lowering<'_> {
     fn draw_choices(&self, spec: &DrawSpec) -> Result<DrawChoices, ScenarioError> {
         if let Some(len) = &spec.axis_length {
             let v = *len.get_ref();
-            if !(v.is_finite() && v > 0.0 && v <= limits::MAX_AXIS_LENGTH) {
+            if !(limits::MIN_AXIS_LENGTH..=limits::MAX_AXIS_LENGTH).contains(&v) {
                 return Err(self.err(
                     len.span(),
                     "draw.axis_length",
                     format!(
-                        "{v} is out of range: a length in metres, > 0 and ≤ {}",
+                        "{v} is out of range: a length in metres, {} ..= {}",
+                        limits::MIN_AXIS_LENGTH,
                         limits::MAX_AXIS_LENGTH
                     ),
                 ));
@@ -229,8 +232,14 @@ impl Lowering<'_> {
             let is_point = matches!(lowered, Op::PointThroughPose { .. });
             let k = t.plan.definitions();
             t.plan.operation(&output, lowered);
-            t.names
-                .insert(output, if is_point { Named::Point } else { Named::Pose(k) });
+            t.names.insert(
+                output,
+                if is_point {
+                    Named::Point
+                } else {
+                    Named::Pose(k)
+                },
+            );
         }
         Ok(t.plan)
     }
@@ -268,7 +277,10 @@ impl Lowering<'_> {
             return Err(self.err(
                 op.kind.span(),
                 &format!("{field}.kind"),
-                format!("unknown operation `{kind}`; expected one of {}", kinds.join(", ")),
+                format!(
+                    "unknown operation `{kind}`; expected one of {}",
+                    kinds.join(", ")
+                ),
             ));
         };
         let set = op.keys_set();
@@ -412,7 +424,11 @@ impl Lowering<'_> {
         key: &str,
         bounds: Bounds,
     ) -> Result<f64, ScenarioError> {
-        let Bounds { low, open_low, high } = bounds;
+        let Bounds {
+            low,
+            open_low,
+            high,
+        } = bounds;
         let v = self.need(value, op, field, key)?;
         let x = *v.get_ref();
         let above = if open_low { x > low } else { x >= low };
@@ -437,9 +453,10 @@ impl Lowering<'_> {
     ) -> Result<Op<G, N>, ScenarioError> {
         let kind = op.kind.get_ref().as_str();
         let f = |k: &str| format!("{field}.{k}");
-        let pose = |value: &Option<Spanned<String>>, key: &str| -> Result<Operand<G>, ScenarioError> {
-            self.operand(t, self.need(value, op, field, key)?, &f(key), kind)
-        };
+        let pose =
+            |value: &Option<Spanned<String>>, key: &str| -> Result<Operand<G>, ScenarioError> {
+                self.operand(t, self.need(value, op, field, key)?, &f(key), kind)
+            };
         let known = |value: &Option<Spanned<String>>, key: &str| -> Result<G, ScenarioError> {
             self.known(t, self.need(value, op, field, key)?, &f(key))
         };
@@ -490,7 +507,9 @@ impl Lowering<'_> {
                 }
             }
             "diff_drive" => self.diff_drive(op, field, t)?,
-            "point_through_pose" => self.point_through_pose(op, field, pose(&op.input, "input")?)?,
+            "point_through_pose" => {
+                self.point_through_pose(op, field, pose(&op.input, "input")?)?
+            }
             "fuse" => {
                 let inputs = op.inputs.as_deref().unwrap_or(&[]);
                 if inputs.len() < 2 {
@@ -519,7 +538,9 @@ impl Lowering<'_> {
                     ));
                 }
                 if let Some(input) = &op.input
-                    && !self.known(t, input, &f("input"))?.is_approx(&G::identity(), 1e-12)
+                    && !self
+                        .known(t, input, &f("input"))?
+                        .is_approx(&G::identity(), 1e-12)
                 {
                     return Err(self.err(
                         input.span(),
@@ -538,7 +559,17 @@ impl Lowering<'_> {
                 }
                 Op::EulerVsExp {
                     rate: Vector3::new(rate[0], rate[1], rate[2]),
-                    dt: self.number(&op.dt, op, field, "dt", Bounds { low: 0.0, open_low: true, high: 1e3 })?,
+                    dt: self.number(
+                        &op.dt,
+                        op,
+                        field,
+                        "dt",
+                        Bounds {
+                            low: 0.0,
+                            open_low: true,
+                            high: 1e3,
+                        },
+                    )?,
                     steps: self.steps(op, field)?.unwrap_or(1),
                 }
             }
@@ -578,9 +609,7 @@ impl Lowering<'_> {
             let mut joint = DMatrix::zeros(2 * N, 2 * N);
             joint.view_mut((0, 0), (N, N)).copy_from(x.cov());
             joint.view_mut((0, N), (N, N)).copy_from(&cross);
-            joint
-                .view_mut((N, 0), (N, N))
-                .copy_from(&cross.transpose());
+            joint.view_mut((N, 0), (N, N)).copy_from(&cross.transpose());
             joint.view_mut((N, N), (N, N)).copy_from(y.cov());
             CorrelatedPair::try_new(*x.mean(), *y.mean(), &joint, x.side()).map_err(|e| {
                 at(format!(
@@ -610,7 +639,8 @@ impl Lowering<'_> {
             }
         };
         let noise_spec = self.need(&op.noise, op, field, "noise")?;
-        let (noise, side) = self.cov::<G, N>(noise_spec, &G::identity(), &format!("{field}.noise"))?;
+        let (noise, side) =
+            self.cov::<G, N>(noise_spec, &G::identity(), &format!("{field}.noise"))?;
         if side != Side::Right {
             return Err(self.err(
                 noise_spec.span(),
@@ -621,13 +651,14 @@ impl Lowering<'_> {
         let controls_spec = self.need(&op.controls, op, field, "controls")?;
         let mut controls = Vec::new();
         for (i, c) in controls_spec.get_ref().iter().enumerate() {
-            let control = control_for::<G, N>(c, model == OdometryModel::Increment).map_err(|e| {
-                self.err(
-                    controls_spec.span(),
-                    &format!("{field}.controls[{i}]"),
-                    e.to_string(),
-                )
-            })?;
+            let control =
+                control_for::<G, N>(c, model == OdometryModel::Increment).map_err(|e| {
+                    self.err(
+                        controls_spec.span(),
+                        &format!("{field}.controls[{i}]"),
+                        e.to_string(),
+                    )
+                })?;
             controls.push(control);
         }
         if controls.is_empty() {
@@ -641,7 +672,11 @@ impl Lowering<'_> {
             return Err(self.err(
                 controls_spec.span(),
                 &format!("{field}.controls"),
-                format!("{} controls: at most {} steps", controls.len(), limits::MAX_STEPS),
+                format!(
+                    "{} controls: at most {} steps",
+                    controls.len(),
+                    limits::MAX_STEPS
+                ),
             ));
         }
         if let Some(steps) = self.steps(op, field)? {
@@ -683,7 +718,17 @@ impl Lowering<'_> {
             None => G::identity(),
         };
         let n = |key: &str, value: &Option<Spanned<f64>>, low: f64, open_low: bool, high: f64| {
-            self.number(value, op, field, key, Bounds { low, open_low, high })
+            self.number(
+                value,
+                op,
+                field,
+                key,
+                Bounds {
+                    low,
+                    open_low,
+                    high,
+                },
+            )
         };
         let big = limits::MAX_DIFF_DRIVE_VALUE;
         let dt = match &op.dt {
@@ -714,10 +759,7 @@ impl Lowering<'_> {
         }
         let euler_steps = motion.duration / motion.dt;
         if euler_steps > limits::MAX_STEPS as f64 {
-            let span = op
-                .dt
-                .as_ref()
-                .map_or_else(|| op.kind.span(), Spanned::span);
+            let span = op.dt.as_ref().map_or_else(|| op.kind.span(), Spanned::span);
             return Err(self.err(
                 span,
                 &format!("{field}.dt"),
@@ -739,7 +781,10 @@ impl Lowering<'_> {
         let point = self.need(&op.point, op, field, "point")?;
         let dims = G::KIND.space_dims();
         let p = point.get_ref();
-        if p.len() != dims || p.iter().any(|v| !v.is_finite() || v.abs() > limits::MAX_COORDINATE) {
+        if p.len() != dims
+            || p.iter()
+                .any(|v| !v.is_finite() || v.abs() > limits::MAX_COORDINATE)
+        {
             return Err(self.err(
                 point.span(),
                 &format!("{field}.point"),
@@ -754,11 +799,13 @@ impl Lowering<'_> {
         if let Some(cov) = &op.point_cov {
             let at = |m: String| self.err(cov.span(), &format!("{field}.point_cov"), m);
             let dyn_cov = if dims == 2 {
-                let c = fixed_matrix::<2, 2>("point_cov", cov.get_ref()).map_err(|e| at(e.to_string()))?;
+                let c = fixed_matrix::<2, 2>("point_cov", cov.get_ref())
+                    .map_err(|e| at(e.to_string()))?;
                 point_cov.fixed_view_mut::<2, 2>(0, 0).copy_from(&c);
                 DMatrix::from_iterator(2, 2, c.iter().copied())
             } else {
-                point_cov = fixed_matrix::<3, 3>("point_cov", cov.get_ref()).map_err(|e| at(e.to_string()))?;
+                point_cov = fixed_matrix::<3, 3>("point_cov", cov.get_ref())
+                    .map_err(|e| at(e.to_string()))?;
                 DMatrix::from_iterator(3, 3, point_cov.iter().copied())
             };
             if dyn_cov.amax() > limits::MAX_VARIANCE {

@@ -94,7 +94,6 @@ impl fmt::Display for ScenarioError {
     }
 }
 
-
 /// Maps byte spans of one source text to `line:column` errors.
 #[derive(Debug, Clone)]
 pub struct Locator {
@@ -225,14 +224,19 @@ impl Scenario {
     /// ```
     /// use posecov::input::scenario::Scenario;
     /// let s = Scenario::parse("[scenario]\ntitle='t'\ngroup='so3'\n[[operation]]\nkind='euler_vs_exp'\noutput='r'\nrate=[0,0,1]\ndt=0.1\nsteps=3\n", "t.toml").unwrap();
-    /// assert!(s.operation_error(Some(0), "too big").to_string().starts_with("t.toml:5:8: operation[0]: too big"));
+    /// assert!(s.operation_error(Some(0), "too big").to_string().starts_with("t.toml:5:6: operation[0]: too big"));
     /// assert!(s.operation_error(None, "odd").to_string().starts_with("t.toml:1:1: file: odd"));
     /// ```
-    pub fn operation_error(&self, index: Option<usize>, message: impl Into<String>) -> ScenarioError {
+    pub fn operation_error(
+        &self,
+        index: Option<usize>,
+        message: impl Into<String>,
+    ) -> ScenarioError {
         match index.and_then(|i| self.file.operations.get(i).map(|op| (i, op))) {
-            Some((i, op)) => self
-                .locator
-                .error(op.kind.span(), &format!("operation[{i}]"), message),
+            Some((i, op)) => {
+                self.locator
+                    .error(op.kind.span(), &format!("operation[{i}]"), message)
+            }
             None => self.locator.error(0..0, "file", message),
         }
     }

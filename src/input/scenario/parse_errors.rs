@@ -39,7 +39,11 @@ pub(crate) fn key_at(text: &str, offset: usize) -> String {
                 parts.push(table);
             }
             parts.extend(keys);
-            return if parts.is_empty() { "file".to_owned() } else { parts.join(".") };
+            return if parts.is_empty() {
+                "file".to_owned()
+            } else {
+                parts.join(".")
+            };
         }
         if !header && starts_with_key(trimmed) {
             last_key = keys_before(line, line.len()).into_iter().next();
@@ -80,13 +84,18 @@ fn header_path(header: &str, counts: &mut Vec<(String, usize)>) -> Option<String
 }
 
 fn is_bare_key(s: &str) -> bool {
-    !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
 
 /// Whether a line starts with `key =` (not the continuation of a value).
 fn starts_with_key(line: &str) -> bool {
-    line.split_once('=')
-        .is_some_and(|(k, _)| k.trim().split('.').all(|s| is_bare_key(s.trim().trim_matches('"'))))
+    line.split_once('=').is_some_and(|(k, _)| {
+        k.trim()
+            .split('.')
+            .all(|s| is_bare_key(s.trim().trim_matches('"')))
+    })
 }
 
 /// Keys assigned on `line` before byte `column`: the first one, and the last one inside an
@@ -143,7 +152,11 @@ pub(crate) fn in_file_words(message: &str) -> String {
     if let Some(rest) = message.strip_prefix("invalid type: ")
         && let Some((found, expected)) = rest.split_once(", expected ")
     {
-        return format!("expected {}, found {}", type_words(expected), type_words(found));
+        return format!(
+            "expected {}, found {}",
+            type_words(expected),
+            type_words(found)
+        );
     }
     let mut out = message.to_owned();
     for (rust, words) in WORDS {
@@ -154,8 +167,14 @@ pub(crate) fn in_file_words(message: &str) -> String {
 
 /// Rust and serde type names, as a scenario file's author says them.
 const WORDS: &[(&str, &str)] = &[
-    ("struct MeanSpec", "a mean table such as { xy_theta = [x, y, θ] }"),
-    ("struct CovSpec", "a covariance table such as { std = [σ, …] }"),
+    (
+        "struct MeanSpec",
+        "a mean table such as { xy_theta = [x, y, θ] }",
+    ),
+    (
+        "struct CovSpec",
+        "a covariance table such as { std = [σ, …] }",
+    ),
     ("struct PoseSpec", "a [[pose]] table"),
     ("struct OperationSpec", "an [[operation]] table"),
     ("struct DrawSpec", "a [draw] table"),
@@ -208,6 +227,9 @@ mod tests {
             in_file_words("invalid type: string \"x\", expected f64"),
             "expected a number, found string \"x\""
         );
-        assert!(!in_file_words("invalid type: integer `3`, expected struct MeanSpec").contains("struct"));
+        assert!(
+            !in_file_words("invalid type: integer `3`, expected struct MeanSpec")
+                .contains("struct")
+        );
     }
 }

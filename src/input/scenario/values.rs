@@ -203,7 +203,11 @@ pub(crate) fn check_values(what: &str, values: &[f64]) -> Result<()> {
 }
 
 /// Exactly `N` finite numbers as a tangent vector.
-pub(crate) fn tangent_of<const N: usize>(what: &str, values: &[f64], why: &str) -> Result<Tangent<N>> {
+pub(crate) fn tangent_of<const N: usize>(
+    what: &str,
+    values: &[f64],
+    why: &str,
+) -> Result<Tangent<N>> {
     check_values(what, values)?;
     if values.len() != N {
         return Err(ValueError::WrongCount {
