@@ -883,21 +883,13 @@ const INT_EDGES: &[i64] = &[
     i64::MIN,
 ];
 
-const KINDS: &[&str] = &[
-    "inverse",
-    "change_frame_left",
-    "change_frame_right",
-    "compose",
-    "between",
-    "compose_correlated",
-    "between_correlated",
-    "odometry",
-    "compound",
-    "diff_drive",
-    "point_through_pose",
-    "fuse",
-    "euler_vs_exp",
-];
+/// Every operation kind, from the library's one table of operation keys.
+fn kinds() -> Vec<&'static str> {
+    posecov::input::scenario::OPERATION_KINDS
+        .iter()
+        .map(|(k, ..)| *k)
+        .collect()
+}
 
 const METHODS: &[&str] = &[
     "exact",
@@ -1398,7 +1390,8 @@ impl Generator {
                     .map_or(0, Vec::len);
                 if n > 0 && rng.random_bool(0.5) {
                     let i = rng.random_range(0..n);
-                    let k = KINDS[rng.random_range(0..KINDS.len())];
+                    let kinds = kinds();
+                    let k = kinds[rng.random_range(0..kinds.len())];
                     if let Some(Value::Table(t)) =
                         at_mut(doc, &[Seg::Key("operation".into()), Seg::Idx(i)])
                     {
@@ -1677,7 +1670,10 @@ fn random_value(rng: &mut ChaCha8Rng, names: &[String], key: &str) -> Value {
                 .map(|_| Value::String(random_name(rng, names)))
                 .collect(),
         ),
-        "kind" => Value::String(KINDS[rng.random_range(0..KINDS.len())].into()),
+        "kind" => {
+            let kinds = kinds();
+            Value::String(kinds[rng.random_range(0..kinds.len())].into())
+        }
         "group" => Value::String(GROUPS[rng.random_range(0..GROUPS.len())].into()),
         "model" => Value::String(["increment", "exp", "euler"][rng.random_range(0..3)].into()),
         "side" => Value::String(["left", "right", "up"][rng.random_range(0..3)].into()),

@@ -37,13 +37,13 @@ fn every_bundled_scenario_evaluates_and_draws() {
             b.name,
             evaluation.findings()
         );
-        // No text shown to users names an internal document.
-        for internal in ["REFERENCE_CASES", "CONVENTIONS", "^T"] {
-            assert!(
-                !scene.description_markdown.contains(internal),
-                "{} shows {internal:?}",
-                b.name
-            );
+        // No text shown to users names an internal document, writes a transpose as `^T`, or
+        // uses a glyph the viewer's font lacks (ᵀ U+1D40, ⊤, ⊺ render as boxes; ᵗ renders).
+        let plot_titles: Vec<String> = scene.plots.iter().map(|p| p.label()).collect();
+        for text in std::iter::once(&scene.description_markdown).chain(&plot_titles) {
+            for bad in ["REFERENCE_CASES", "CONVENTIONS", "^T", "ᵀ", "⊤", "⊺"] {
+                assert!(!text.contains(bad), "{} shows {bad:?}", b.name);
+            }
         }
     }
 }

@@ -43,6 +43,13 @@ pub enum AppError {
     /// The drawing is not valid (a bug: evaluation checks every number it hands on).
     #[error("the scene is not drawable: {0}")]
     Scene(#[from] SceneError),
+    /// The viewer, the file or the stream.
+    #[cfg(feature = "viewer")]
+    #[error(transparent)]
+    Sink(#[from] crate::sink::SinkError),
+    /// `--watch` was given something it cannot watch or a sink it cannot rewrite.
+    #[error("--watch {0}")]
+    Watch(String),
 }
 
 /// An input and the file it came from (to locate evaluation errors in it).

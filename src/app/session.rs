@@ -7,16 +7,22 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use anyhow::{Context as _, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::{AppError, Loaded, Overrides, Settings, load, resolve};
+use super::{AppError, Loaded, Overrides, Settings, SettingsError, load, resolve};
 use crate::draw;
 use crate::eval::{self, AnyEvaluation};
 use crate::scene::Scene;
 use crate::sink::{
-    self, LogOutcome, RecordingIds, Sink, SinkGuard, find_native_viewer, open_stream, render_png,
+    self, LogOutcome, RecordingIds, Sink, SinkError, SinkGuard, find_native_viewer, open_stream,
+    render_png,
 };
+
+/// Hands everything logged so far to the sink (before the next block is simulated).
+fn flush(rec: &rerun::RecordingStream) -> Result<(), AppError> {
+    rec.flush_blocking()
+        .map_err(|e| AppError::Sink(SinkError::Flush(e.to_string())))
+}
 
 /// Exit code after Ctrl-C (128 + SIGINT), as shells expect.
 pub const EXIT_INTERRUPTED: u8 = 130;
@@ -108,9 +114,8 @@ impl Session {
         &self,
         rec: &rerun::RecordingStream,
         cancel: &AtomicBool,
-    ) -> anyhow::Result<LogOutcome> {
-        let mut outcome =
-            sink::log_scene_cancellable(rec, &self.scene, cancel).context("logging the scene")?;
+    ) -> Result<LogOutcome, AppError> {
+        let mut outcome = sink::log_scene_cancellable(rec, &self.scene, cancel)?;
         let later = self.later_blocks();
         if outcome == LogOutcome::Complete && later > 0 {
             let bar = ProgressBar::new(later).with_message("logging Monte Carlo blocks");
@@ -126,19 +131,15 @@ impl Session {
                 let plan = &self.loaded.input.plan;
                 let Some(block) =
                     eval::evaluate_block(plan, &self.settings.eval, &self.evaluation, k)
-                        .map_err(|e| self.loaded.locate(&e))
-                        .context("evaluating a Monte Carlo block")?
+                        .map_err(|e| self.loaded.locate(&e))?
                 else {
                     break;
                 };
                 let part = draw::particle_part(&self.evaluation, &block, k, &self.settings.draw);
                 drop(block);
-                outcome = sink::log_part_cancellable(rec, &part, cancel)
-                    .context("logging a Monte Carlo block")?;
+                outcome = sink::log_part_cancellable(rec, &part, cancel)?;
                 drop(part);
-                // Hands the block to the sink's writer before the next one is simulated.
-                rec.flush_blocking()
-                    .map_err(|e| anyhow::anyhow!("flushing a Monte Carlo block: {e}"))?;
+                flush(rec)?;
                 bar.inc(1);
                 if outcome != LogOutcome::Complete {
                     break;
@@ -208,7 +209,7 @@ fn scenario_name(scenario: &str) -> String {
 
 /// Shows a scenario: in the viewer, a file, stdout or a PNG; with `watch`, again on every
 /// change. Returns the process exit code.
-pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> anyhow::Result<u8> {
+pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppError> {
     if options.watch {
         return watch(options, cancel);
     }
@@ -222,7 +223,7 @@ pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> anyhow::Result<u
         return render(options, &session, &ids, png, *size, cancel);
     }
     let sink = choose_sink(options)?;
-    let (rec, guard) = open_stream(&sink, &ids, &session.scene).context("opening the recording")?;
+    let (rec, guard) = open_stream(&sink, &ids, &session.scene)?;
     if let Some(url) = guard.viewer_url() {
         println!("Web viewer: {url}");
     }
@@ -233,7 +234,7 @@ pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> anyhow::Result<u
     finish(guard, rec, &sink, outcome)
 }
 
-fn serve(options: &ServeOptions, guard: &SinkGuard, cancel: &AtomicBool) -> anyhow::Result<()> {
+fn serve(options: &ServeOptions, guard: &SinkGuard, cancel: &AtomicBool) -> Result<(), AppError> {
     let limit = serve_limit(options)?;
     match limit {
         Some(l) => eprintln!("Serving for {} s (Ctrl-C stops).", l.as_secs()),
@@ -246,18 +247,18 @@ fn serve(options: &ServeOptions, guard: &SinkGuard, cancel: &AtomicBool) -> anyh
 /// `--watch`: evaluate, stream, and again whenever the file changes. Each generation is a new
 /// recording (id suffix `/gen-N`) sent to the same viewer, so nothing stale survives an edit;
 /// errors in the file are printed and the previous picture stays up.
-fn watch(options: &ViewOptions, cancel: &AtomicBool) -> anyhow::Result<u8> {
+fn watch(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, AppError> {
     let path = PathBuf::from(&options.scenario);
     if !path.is_file() {
-        bail!(
-            "--watch needs a scenario file to watch; {:?} is not one (copy a bundled scenario from assets/scenarios/)",
-            path
-        );
+        return Err(AppError::Watch(format!(
+            "needs a scenario file to watch; {path:?} is not one (copy a bundled scenario from assets/scenarios/)"
+        )));
     }
     if matches!(options.sink, Some(Sink::Stdout)) || options.png.is_some() {
-        bail!(
-            "--watch streams to a viewer or rewrites a --save file; it does not combine with --stdout or --png"
-        );
+        return Err(AppError::Watch(
+            "streams to a viewer or rewrites a --save file; it does not combine with --stdout or --png"
+                .to_owned(),
+        ));
     }
     let first_sink = choose_sink(options)?;
     // Later generations connect to the viewer the first one reached.
@@ -288,19 +289,17 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> anyhow::Result<u8> {
                     } else {
                         &next_sink
                     };
-                    let (rec, guard) =
-                        open_stream(sink, &ids, &session.scene).context("opening the recording")?;
+                    let (rec, guard) = open_stream(sink, &ids, &session.scene)?;
                     if let Some(url) = guard.viewer_url() {
                         println!("Web viewer: {url}");
                     }
                     session.log(&rec, cancel)?;
                     if matches!(sink, Sink::Serve { .. }) {
                         // The served viewer lives as long as this first stream's guard.
-                        rec.flush_blocking()
-                            .map_err(|e| anyhow::anyhow!("flushing: {e}"))?;
+                        flush(&rec)?;
                         keep_alive = Some((rec, guard));
                     } else {
-                        guard.finish(rec).context("finishing the recording")?;
+                        guard.finish(rec)?;
                         if let Sink::Save(file) = sink {
                             eprintln!("Wrote {}", file.display());
                         }
@@ -318,7 +317,7 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> anyhow::Result<u8> {
         std::thread::sleep(WATCH_POLL);
     }
     if let Some((rec, guard)) = keep_alive {
-        guard.finish(rec).context("finishing the recording")?;
+        guard.finish(rec)?;
     }
     Ok(0)
 }
@@ -328,8 +327,8 @@ fn finish(
     rec: rerun::RecordingStream,
     sink: &Sink,
     outcome: LogOutcome,
-) -> anyhow::Result<u8> {
-    guard.finish(rec).context("finishing the recording")?;
+) -> Result<u8, AppError> {
+    guard.finish(rec)?;
     if let Sink::Save(path) = sink {
         eprintln!("Wrote {}", path.display());
     }
@@ -340,7 +339,7 @@ fn finish(
 }
 
 /// The sink asked for; without one: a native 0.36 viewer if available, else serve.
-fn choose_sink(options: &ViewOptions) -> anyhow::Result<Sink> {
+fn choose_sink(options: &ViewOptions) -> Result<Sink, AppError> {
     if let Some(sink) = &options.sink {
         return Ok(sink.clone());
     }
@@ -358,16 +357,17 @@ fn choose_sink(options: &ViewOptions) -> anyhow::Result<Sink> {
     })
 }
 
-fn serve_limit(options: &ServeOptions) -> anyhow::Result<Option<Duration>> {
+fn serve_limit(options: &ServeOptions) -> Result<Option<Duration>, AppError> {
     if let Some(s) = options.seconds {
         return Ok(Some(Duration::from_secs(s)));
     }
     match std::env::var(SERVE_SECONDS_ENV) {
         Ok(s) => {
-            let secs: u64 = s
-                .trim()
-                .parse()
-                .with_context(|| format!("${SERVE_SECONDS_ENV}={s:?} is not a whole number"))?;
+            let secs: u64 = s.trim().parse().map_err(|_| SettingsError {
+                flag: "$POSECOV_SERVE_SECONDS",
+                value: format!("{s:?}"),
+                expected: "a whole number of seconds".to_owned(),
+            })?;
             Ok(Some(Duration::from_secs(secs)))
         }
         Err(_) => Ok(None),
@@ -382,8 +382,8 @@ fn render(
     png: &Path,
     size: (u32, u32),
     cancel: &AtomicBool,
-) -> anyhow::Result<u8> {
-    let viewer = find_native_viewer().context("--png renders with the native viewer")?;
+) -> Result<u8, AppError> {
+    let viewer = find_native_viewer()?;
     let (rrd, temporary) = match &options.sink {
         Some(Sink::Save(path)) => (path.clone(), false),
         _ => (
@@ -392,9 +392,9 @@ fn render(
         ),
     };
     let sink = Sink::Save(rrd.clone());
-    let (rec, guard) = open_stream(&sink, ids, &session.scene).context("opening the recording")?;
+    let (rec, guard) = open_stream(&sink, ids, &session.scene)?;
     let outcome = session.log(&rec, cancel)?;
-    guard.finish(rec).context("finishing the recording")?;
+    guard.finish(rec)?;
     if outcome != LogOutcome::Complete {
         return Ok(EXIT_INTERRUPTED);
     }
@@ -402,7 +402,7 @@ fn render(
     if temporary {
         std::fs::remove_file(&rrd).ok();
     }
-    rendered.with_context(|| format!("rendering {}", png.display()))?;
+    rendered?;
     eprintln!("Wrote {}", png.display());
     Ok(0)
 }

@@ -18,13 +18,11 @@
 //!   children `…/cloud/block_k`.
 //!
 //! ```
+//! use posecov::app::{Overrides, load_text, pipeline};
 //! use posecov::draw::{DrawSettings, scene};
-//! use posecov::eval::{EvalSettings, evaluate};
-//! use posecov::input::scenario::{Scenario, lower};
-//! use posecov::uncertain::Method;
-//! let input = lower(&Scenario::parse("[scenario]\ntitle='t'\ngroup='se2'\n[[pose]]\nname='a'\nmean={xy_theta=[1,2,0]}\ncov={std=[0.1,0.1,0.3]}\n", "t.toml").unwrap()).unwrap();
-//! let e = evaluate(&input.plan, &EvalSettings { methods: vec![Method::FirstOrder], ..Default::default() }).unwrap();
-//! let s = scene(&e, &DrawSettings::from_input(&input, 0.95));
+//! let loaded = load_text("[scenario]\ntitle='t'\ngroup='se2'\nmethods=['first_order']\n[[pose]]\nname='a'\nmean={xy_theta=[1,2,0]}\ncov={std=[0.1,0.1,0.3]}\n", "t.toml").unwrap();
+//! let (evaluation, _) = pipeline(&loaded, &Overrides::default(), None).unwrap();
+//! let s = scene(&evaluation, &DrawSettings::from_input(&loaded.input, 0.95));
 //! assert!(s.items.iter().any(|i| i.path == "world/a/given/banana"));
 //! assert!(s.validate().is_ok());
 //! ```
@@ -96,15 +94,16 @@ pub fn scene(evaluation: &AnyEvaluation, settings: &DrawSettings) -> Scene {
 /// main scene and drop it: memory stays bounded.
 ///
 /// ```
-/// use posecov::draw::{DrawSettings, particle_part};
-/// use posecov::eval::{EvalSettings, evaluate, evaluate_block};
-/// use posecov::input::scenario::{Scenario, lower};
-/// use posecov::uncertain::Method;
-/// let input = lower(&Scenario::load_any("camera_on_robot").unwrap()).unwrap();
-/// let settings = EvalSettings { samples: 3000, block_samples: Some(1024), methods: vec![Method::MonteCarlo], ..Default::default() };
-/// let main = evaluate(&input.plan, &settings).unwrap();
-/// let block = evaluate_block(&input.plan, &settings, &main, 2).unwrap().unwrap();
-/// let part = particle_part(&main, &block, 2, &DrawSettings::from_input(&input, 0.95));
+/// use posecov::app::{Overrides, load, resolve};
+/// use posecov::draw::particle_part;
+/// // The caller evaluates (here as `app::session` does); drawing only draws.
+/// use posecov::eval::{evaluate as run, evaluate_block as run_block};
+/// let loaded = load("camera_on_robot").unwrap();
+/// let overrides = Overrides { samples: Some(3000), block_samples: Some(1024), ..Default::default() };
+/// let settings = resolve(&loaded.input, &overrides, None).unwrap();
+/// let main = run(&loaded.input.plan, &settings.eval).unwrap();
+/// let block = run_block(&loaded.input.plan, &settings.eval, &main, 2).unwrap().unwrap();
+/// let part = particle_part(&main, &block, 2, &settings.draw);
 /// assert!(part.items.iter().any(|i| i.path.ends_with("/cloud/block_2")));
 /// ```
 pub fn particle_part(

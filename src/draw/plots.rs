@@ -34,7 +34,7 @@ const ALONG_TRACK: PlotKind = PlotKind {
 };
 const ORTHOGONALITY: PlotKind = PlotKind {
     id: "orthogonality_error_max_r_t_r_i",
-    title: "orthogonality error max |RᵀR − I|",
+    title: "orthogonality error max |RᵗR − I|",
     unit: "",
 };
 

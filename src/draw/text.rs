@@ -139,7 +139,7 @@ fn finding_text(f: &Finding) -> String {
             cost,
             iterations,
         } => format!(
-            "Fusion of {inputs} estimates into `{output}`: final cost V = ½ Σ eᵢᵀ Σᵢ⁻¹ eᵢ = {cost:.4} after {iterations} Gauss–Newton iterations."
+            "Fusion of {inputs} estimates into `{output}`: final cost V = ½ Σ eᵢᵗ Σᵢ⁻¹ eᵢ = {cost:.4} after {iterations} Gauss–Newton iterations."
         ),
         Finding::DiffDriveMeans {
             output,
@@ -163,7 +163,7 @@ fn finding_text(f: &Finding) -> String {
             euler,
             exp,
         } => format!(
-            "After {steps} steps of dt = {dt} s: Euler max |RᵀR − I| = **{euler:.3}**; exponential map {exp:.1e}. The Euler frame (the columns of its matrix, drawn as arrows) stretches; the Exp frame stays a rotation."
+            "After {steps} steps of dt = {dt} s: Euler max |RᵗR − I| = **{euler:.3}**; exponential map {exp:.1e}. The Euler frame (the columns of its matrix, drawn as arrows) stretches; the Exp frame stays a rotation."
         ),
         Finding::MethodFailed {
             output,
