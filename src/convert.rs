@@ -7,7 +7,7 @@
 use glam::{Affine3A, Quat, Vec3};
 use nalgebra::{Isometry2, Isometry3, UnitComplex, UnitQuaternion, Vector3};
 
-use crate::lie::{Se2, Se3, So2, So3};
+use crate::lie::{LieGroup, Se2, Se3, So2, So3};
 
 impl From<UnitQuaternion<f64>> for So3 {
     fn from(q: UnitQuaternion<f64>) -> Self {
@@ -115,7 +115,8 @@ pub fn se2_to_glam(x: &Se2) -> (Vec3, Quat) {
     )
 }
 
-/// Lifts a planar pose to SE(3): (x, y, 0) and a rotation θ about z.
+/// Lifts a planar pose to SE(3): (x, y, 0) and a rotation θ about z
+/// ([`LieGroup::to_se3`](crate::lie::LieGroup::to_se3) of [`Se2`]).
 ///
 /// ```
 /// use posecov::{convert::se2_to_se3, lie::Se2};
@@ -123,9 +124,5 @@ pub fn se2_to_glam(x: &Se2) -> (Vec3, Quat) {
 /// assert!((x3.rotation().to_rpy()[2] - 0.5).abs() < 1e-15);
 /// ```
 pub fn se2_to_se3(x: &Se2) -> Se3 {
-    let t = x.translation();
-    Se3::from_parts(
-        Vector3::new(t.x, t.y, 0.0),
-        So3::from_rpy(0.0, 0.0, x.theta()),
-    )
+    x.to_se3()
 }

@@ -39,31 +39,16 @@ point = [1.0, 0.0]
 output = "landmark"
 "#;
 
-const POINT: &str = r#"
-[scenario]
-title = "point"
-group = "se2"
-methods = ["first_order", "monte_carlo"]
-[[pose]]
-name = "world_from_robot"
-mean = { xy_theta = [1.0, 0.0, 0.3] }
-cov = { std = [0.1, 0.1, 0.1] }
-[[operation]]
-kind = "point_through_pose"
-input = "world_from_robot"
-point = [1.0, 0.0]
-output = "landmark"
-[[operation]]
-kind = "inverse"
-input = "landmark"
-output = "oops"
-"#;
+/// The point of [`POINT_OK`] used as a pose by a second operation (lines 15–18).
+fn point_used_as_pose() -> String {
+    format!("{POINT_OK}[[operation]]\nkind = \"inverse\"\ninput = \"landmark\"\noutput = \"oops\"\n")
+}
 
 /// A point used as a pose was silently the identity; now it is an error naming the operation
 /// and the field.
 #[test]
 fn a_point_is_not_a_pose() {
-    let e = error(POINT);
+    let e = error(&point_used_as_pose());
     assert!(
         e.starts_with("case.toml:17:9: operation[1].input: `landmark` is a point"),
         "{e}"

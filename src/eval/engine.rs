@@ -160,9 +160,12 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                     self.defined.push(None);
                 }
                 PoseValue::Uncertain(pose) => {
-                    self.current = (usize::MAX, def.name.clone());
                     let particles = if self.monte_carlo {
-                        Some(Arc::new(self.sample(&pose)?))
+                        let sampled = self.sample(&pose).map_err(|source| EvalError::Pose {
+                            pose: def.name.clone(),
+                            source,
+                        })?;
+                        Some(Arc::new(sampled))
                     } else {
                         None
                     };
@@ -213,10 +216,10 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
     }
 
     /// n particles of `pose` for this run's block.
-    pub(super) fn sample(&mut self, pose: &UncertainPose<G, N>) -> Result<Vec<G>, EvalError> {
+    pub(super) fn sample(&mut self, pose: &UncertainPose<G, N>) -> crate::Result<Vec<G>> {
         let family = self.next_family();
         let mut out = vec![*pose.mean(); self.block.len()];
-        let sampler = Sampler::new(pose).map_err(|e| self.math(e))?;
+        let sampler = Sampler::new(pose)?;
         sampler.fill_par_from(&mut out, self.settings.seed, family, self.first_chunk());
         Ok(out)
     }

@@ -48,7 +48,7 @@ pub use model::{
 };
 
 use crate::lie::{Se2, Se3, So2, So3};
-use crate::plan::{AnyPlan, Op, Plan, StepPolicy, limits};
+use crate::plan::{AnyPlan, Op, Plan, PoseValue, StepPolicy, limits};
 use crate::sample::CHUNK_SIZE;
 use crate::uncertain::Method;
 use blocked::BlockedStats;
@@ -120,6 +120,14 @@ pub enum EvalError {
         value: String,
         /// What is accepted.
         expected: String,
+    },
+    /// An input pose cannot be sampled (its covariance has no square root).
+    #[error("pose `{pose}`: {source}")]
+    Pose {
+        /// The pose's name.
+        pose: String,
+        /// The library's error.
+        source: crate::Error,
     },
     /// An operand refers to a definition that does not exist yet, or is not a pose.
     #[error("operation[{operation}] (`{output}`): operand {definition} is not an earlier pose")]
@@ -213,7 +221,7 @@ impl EvalError {
     /// ```
     pub fn operation(&self) -> Option<usize> {
         match self {
-            EvalError::Setting { .. } => None,
+            EvalError::Setting { .. } | EvalError::Pose { .. } => None,
             EvalError::Undefined { operation, .. }
             | EvalError::WrongGroup { operation, .. }
             | EvalError::TooMuchWork { operation, .. }
@@ -350,7 +358,7 @@ fn run<G: EvalGroup<N>, const N: usize>(
 }
 
 /// Particles per block: the settings', else as many as fit the budget given how many
-/// particle sets are held at once (counted by an evaluation without Monte Carlo), within
+/// particle sets are held at once (counted from the plan), within
 /// [`MIN_BLOCK_SAMPLES`] ..= [`MAX_BLOCK_SAMPLES`]; always a multiple of [`CHUNK_SIZE`].
 fn block_samples<G: EvalGroup<N>, const N: usize>(
     plan: &Plan<G, N>,
@@ -363,20 +371,29 @@ fn block_samples<G: EvalGroup<N>, const N: usize>(
     if !settings.monte_carlo() {
         return Ok(0);
     }
-    let mut dry = settings.clone();
-    dry.methods.retain(|m| *m != Method::MonteCarlo);
-    let shape = Engine::<G, N>::run(plan, &dry, 0..0, StatsMode::Skip)?;
-    let held = shape
-        .nodes
+    // Particle sets held at once: one per uncertain input and single result, the detailed
+    // steps of each propagation, and the step in flight.
+    let policy = settings.steps;
+    let uncertain = plan
+        .poses
         .iter()
-        .filter(|n| {
-            n.role != Role::Fixed
-                && n.step
-                    .is_none_or(|k| settings.steps.detailed(k, n.last_step.unwrap_or(k)))
+        .filter(|p| matches!(p.value, PoseValue::Uncertain(_)))
+        .count();
+    let results: usize = plan
+        .operations
+        .iter()
+        .map(|o| match o.op.steps() {
+            0 => 1,
+            last => (0..=last).filter(|k| policy.detailed(*k, last)).count(),
         })
-        .count()
-        + 1; // the propagation step in flight
-    let bytes = held * std::mem::size_of::<G>() + shape.points.len() * 24;
+        .sum();
+    let held = uncertain + results + 1;
+    let points = plan
+        .operations
+        .iter()
+        .filter(|o| matches!(o.op, Op::PointThroughPose { .. }))
+        .count();
+    let bytes = held * std::mem::size_of::<G>() + points * 24;
     let fit = PARTICLE_MEMORY_BUDGET / bytes.max(1);
     Ok(fit.clamp(MIN_BLOCK_SAMPLES, MAX_BLOCK_SAMPLES) / CHUNK_SIZE * CHUNK_SIZE)
 }

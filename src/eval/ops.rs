@@ -535,7 +535,8 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         // Fusion has no sampled counterpart: Monte Carlo downstream continues from samples
         // of the fused Gaussian (not from its mean, which would lose the uncertainty).
         let particles = if self.monte_carlo {
-            Some(Arc::new(self.sample(&fused.result.pose)?))
+            let sampled = self.sample(&fused.result.pose).map_err(|e| self.math(e))?;
+            Some(Arc::new(sampled))
         } else {
             None
         };

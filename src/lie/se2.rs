@@ -364,7 +364,11 @@ impl LieGroup<3> for Se2 {
     }
 
     fn to_se3(&self) -> super::Se3 {
-        crate::convert::se2_to_se3(self)
+        let t = self.translation();
+        super::Se3::from_parts(
+            nalgebra::Vector3::new(t.x, t.y, 0.0),
+            super::So3::from_rpy(0.0, 0.0, self.theta()),
+        )
     }
 }
 
