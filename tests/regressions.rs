@@ -41,7 +41,9 @@ output = "landmark"
 
 /// The point of [`POINT_OK`] used as a pose by a second operation (lines 15–18).
 fn point_used_as_pose() -> String {
-    format!("{POINT_OK}[[operation]]\nkind = \"inverse\"\ninput = \"landmark\"\noutput = \"oops\"\n")
+    format!(
+        "{POINT_OK}[[operation]]\nkind = \"inverse\"\ninput = \"landmark\"\noutput = \"oops\"\n"
+    )
 }
 
 /// A point used as a pose was silently the identity; now it is an error naming the operation

@@ -8,7 +8,7 @@ use crate::lie::{LieGroup, Tangent, TangentMatrix};
 use crate::scene::{
     self, Color, Ellipsoid, Ellipsoids, FillMode, ItemKind, LineStrips, Surface, Vec3,
 };
-use crate::uncertain::{Side, UncertainPose};
+use crate::uncertain::UncertainPose;
 
 /// Sphere-mesh resolution of banana surfaces (latitude bands, meridians).
 const BANANA_MESH: (u32, u32) = (16, 32);
@@ -129,10 +129,7 @@ impl<const N: usize> PrincipalFrame<N> {
     /// μ · Exp(τ) (right) or Exp(τ) · μ (left) for τ = Σ uᵢ cᵢ.
     fn apply<G: LieGroup<N>>(&self, pose: &UncertainPose<G, N>, u: [f64; 3]) -> G {
         let tau = self.columns[0] * u[0] + self.columns[1] * u[1] + self.columns[2] * u[2];
-        match pose.side() {
-            Side::Right => pose.mean().rplus(&tau),
-            Side::Left => pose.mean().lplus(&tau),
-        }
+        crate::sample::retract(pose.mean(), &tau, pose.side())
     }
 }
 

@@ -19,7 +19,7 @@ use crate::propagate::fourth_order::Order;
 use crate::propagate::fusion::{FusionOptions, fuse};
 use crate::propagate::odometry::{InputNoise, propagate_increments, propagate_tangent_inputs};
 use crate::propagate::sigma_point::{self, Unscented};
-use crate::sample::{Sampler, fill_par_from, standard_normal};
+use crate::sample::{Sampler, fill_par_from, retract, standard_normal};
 use crate::uncertain::{Method, Side, UncertainPose};
 
 /// Compose (`X · Y`) or between (`X⁻¹ · Y`).
@@ -242,10 +242,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                         &factor * DVector::from_iterator(2 * N, a.iter().chain(b.iter()).copied());
                     let ex = Tangent::<N>::from_iterator(e.rows(0, N).iter().copied());
                     let ey = Tangent::<N>::from_iterator(e.rows(N, N).iter().copied());
-                    let (x, y) = match side {
-                        Side::Right => (mx.rplus(&ex), my.rplus(&ey)),
-                        Side::Left => (mx.lplus(&ex), my.lplus(&ey)),
-                    };
+                    let (x, y) = (retract(&mx, &ex, side), retract(&my, &ey, side));
                     *z = pair.apply(&x, &y);
                 }
             },
