@@ -116,7 +116,7 @@ pub fn se2_to_glam(x: &Se2) -> (Vec3, Quat) {
 }
 
 /// Lifts a planar pose to SE(3): (x, y, 0) and a rotation θ about z
-/// ([`LieGroup::to_se3`](crate::lie::LieGroup::to_se3) of [`Se2`]).
+/// ([`LieGroup::to_se3`] of [`Se2`]).
 ///
 /// ```
 /// use posecov::{convert::se2_to_se3, lie::Se2};
