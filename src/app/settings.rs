@@ -10,7 +10,7 @@ use crate::input::Input;
 use crate::plan::{StepPolicy, limits};
 
 /// Monte Carlo samples when neither the command line nor the file says.
-pub const DEFAULT_SAMPLES: u64 = 2000;
+pub const DEFAULT_SAMPLES: u64 = crate::eval::DEFAULT_SAMPLES as u64;
 /// Probability inside drawn regions when neither the command line nor the file says.
 pub const DEFAULT_CONFIDENCE: f64 = 0.95;
 

@@ -63,6 +63,9 @@ pub const MAX_BLOCK_SAMPLES: usize = 64 * CHUNK_SIZE;
 /// At least this many particles per block, however many nodes hold particles.
 pub const MIN_BLOCK_SAMPLES: usize = 4 * CHUNK_SIZE;
 
+/// Monte Carlo samples of [`EvalSettings::default`] (and of a scenario that names none).
+pub const DEFAULT_SAMPLES: usize = 2000;
+
 /// What an evaluation needs besides the plan, resolved once by the caller.
 #[derive(Debug, Clone)]
 pub struct EvalSettings {
@@ -86,7 +89,7 @@ impl Default for EvalSettings {
     fn default() -> Self {
         Self {
             seed: 0,
-            samples: 2000,
+            samples: DEFAULT_SAMPLES,
             methods: Vec::new(),
             block_samples: None,
             steps: StepPolicy::default(),
