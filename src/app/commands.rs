@@ -102,10 +102,10 @@ pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> 
         evaluation.records().len(),
         scene.items.len(),
         scene.steps().len(),
-        if findings == 0 {
-            String::new()
-        } else {
-            format!(", {findings} findings (see `posecov report`)")
+        match findings {
+            0 => String::new(),
+            1 => ", 1 finding (see `posecov report`)".to_owned(),
+            n => format!(", {n} findings (see `posecov report`)"),
         }
     ))
 }
