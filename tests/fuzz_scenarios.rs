@@ -717,8 +717,11 @@ fn reported_indefinite(findings: &[EvalFinding], label: &str) -> bool {
         None => (name_step, None),
     };
     findings.iter().any(|f| {
-        matches!(f, EvalFinding::NotPositiveSemiDefinite { output, step: s, method, .. }
-            if output == name && *s == step && format!("{method:?}") == method_of(label))
+        // One finding per output and method: its first step, and a count of later ones.
+        matches!(f, EvalFinding::NotPositiveSemiDefinite { output, step: s, method, later_steps, .. }
+            if output == name
+                && (*s == step || (*later_steps > 0 && *s < step))
+                && format!("{method:?}") == method_of(label))
     })
 }
 

@@ -170,10 +170,12 @@ fn finding_text(f: &Finding) -> String {
             step,
             method,
             reason,
+            later_steps,
         } => format!(
-            "*{} gave no estimate for `{output}`{}: {reason}.*",
+            "*{} gave no estimate for `{output}`{}{}: {reason}.*",
             method.label(),
-            at(step)
+            at(step),
+            and_later(*later_steps)
         ),
         Finding::NotPositiveSemiDefinite {
             output,
@@ -181,10 +183,12 @@ fn finding_text(f: &Finding) -> String {
             method,
             smallest_eigenvalue,
             largest_eigenvalue,
+            later_steps,
         } => format!(
-            "**Warning:** the {} covariance of `{output}`{} is not positive semi-definite (smallest eigenvalue {smallest_eigenvalue:.3e}, largest {largest_eigenvalue:.3e}); its regions are drawn from its positive part.",
+            "**Warning:** the {} covariance of `{output}`{}{} is not positive semi-definite (smallest eigenvalue {smallest_eigenvalue:.3e}, largest {largest_eigenvalue:.3e}); its regions are drawn from its positive part.",
             method.label(),
-            at(step)
+            at(step),
+            and_later(*later_steps)
         ),
         Finding::StepsThinned {
             output,
@@ -196,6 +200,15 @@ fn finding_text(f: &Finding) -> String {
         Finding::Interrupted => {
             "*Evaluation interrupted: later operations or steps were not evaluated.*".to_owned()
         }
+    }
+}
+
+/// " (and at n later steps)", or nothing.
+fn and_later(n: u64) -> String {
+    match n {
+        0 => String::new(),
+        1 => " (and at 1 later step)".to_owned(),
+        n => format!(" (and at {n} later steps)"),
     }
 }
 

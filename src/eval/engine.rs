@@ -207,11 +207,28 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
 
     /// A finding that a method failed for the current output.
     pub(super) fn method_failed(&mut self, step: Option<u64>, method: Method, reason: String) {
+        let output = &self.current.1;
+        // One finding per output and method: later steps are counted, not repeated.
+        for f in &mut self.out.findings {
+            if let Finding::MethodFailed {
+                output: o,
+                method: m,
+                later_steps,
+                ..
+            } = f
+                && o == output
+                && *m == method
+            {
+                *later_steps += 1;
+                return;
+            }
+        }
         self.out.findings.push(Finding::MethodFailed {
-            output: self.current.1.clone(),
+            output: output.clone(),
             step,
             method,
             reason,
+            later_steps: 0,
         });
     }
 
@@ -483,12 +500,27 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
         let largest = eig.eigenvalues.max();
         let scale = eig.eigenvalues.amax().max(f64::MIN_POSITIVE);
         if smallest < -1e-9 * scale {
+            for f in &mut self.out.findings {
+                if let Finding::NotPositiveSemiDefinite {
+                    output,
+                    method: m,
+                    later_steps,
+                    ..
+                } = f
+                    && output == name
+                    && *m == method
+                {
+                    *later_steps += 1;
+                    return;
+                }
+            }
             self.out.findings.push(Finding::NotPositiveSemiDefinite {
                 output: name.to_owned(),
                 step,
                 method,
                 smallest_eigenvalue: smallest,
                 largest_eigenvalue: largest,
+                later_steps: 0,
             });
         }
     }

@@ -175,6 +175,8 @@ pub enum Finding {
         method: Method,
         /// Why.
         reason: String,
+        /// How many later recorded steps of the same output failed the same way.
+        later_steps: u64,
     },
     /// An estimate's covariance is not positive semi-definite (it is reported and drawn
     /// clamped to its PSD part, never hidden).
@@ -185,10 +187,12 @@ pub enum Finding {
         step: Option<u64>,
         /// The method.
         method: Method,
-        /// Smallest eigenvalue.
+        /// Smallest eigenvalue (at `step`, the first such step).
         smallest_eigenvalue: f64,
-        /// Largest eigenvalue.
+        /// Largest eigenvalue (at `step`).
         largest_eigenvalue: f64,
+        /// How many later recorded steps of the same output and method are indefinite too.
+        later_steps: u64,
     },
     /// Recorded steps of a long propagation were thinned ([`StepPolicy`](crate::plan::StepPolicy)).
     StepsThinned {
