@@ -371,6 +371,28 @@ impl<G: LieGroup<N>, const N: usize> Plan<G, N> {
         });
         Operand::Defined(self.definitions() - 1)
     }
+
+    /// Adds `output = lhs · rhs` for independent operands ([`Op::Compose`] without a
+    /// cross-covariance); returns it as an operand.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::plan::{Operand, Plan};
+    /// use posecov::uncertain::UncertainPose;
+    /// let mut plan = Plan::<So2, 1>::default();
+    /// let a = plan.uncertain("a", UncertainPose::certain(So2::identity()));
+    /// assert_eq!(plan.compose("aa", a, a), Operand::Defined(1));
+    /// ```
+    pub fn compose(&mut self, output: &str, lhs: Operand<G>, rhs: Operand<G>) -> Operand<G> {
+        self.operation(
+            output,
+            Op::Compose {
+                lhs,
+                rhs,
+                cross_cov: None,
+            },
+        )
+    }
 }
 
 /// A plan of any group (input files choose the group at run time).

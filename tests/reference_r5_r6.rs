@@ -203,14 +203,7 @@ fn se2_embedding_against_monte_carlo() {
     let b = UncertainPose::try_new(Se2::from_xy_theta(2.0, -1.0, -0.7), cov2, Side::Right).unwrap();
     let mut plan = Plan::<Se2, 3>::default();
     let (x, y) = (plan.uncertain("a", a), plan.uncertain("b", b));
-    plan.operation(
-        "ab",
-        Op::Compose {
-            lhs: x,
-            rhs: y,
-            cross_cov: None,
-        },
-    );
+    plan.compose("ab", x, y);
     let evaluation = evaluate_plan(plan, &mc_settings(100_000, 7));
     let ab = nodes(&evaluation, "ab")[0];
     let nominal = a.mean().compose(b.mean());

@@ -14,7 +14,7 @@ use common::{evaluate_plan, mc_settings, nodes};
 use nalgebra::{Matrix3, Matrix6, Vector6};
 use posecov::Error;
 use posecov::lie::{LieGroup, Se2, Se3, So2};
-use posecov::plan::{Op, Plan};
+use posecov::plan::Plan;
 use posecov::propagate::relative_frobenius_error;
 use posecov::sample::{
     MeanError, Sampler, centred_covariance, covariance_square_root, lie_mean, nees,
@@ -146,14 +146,7 @@ fn identical_results_for_one_and_two_threads() {
     assert_eq!(s1, s2);
     let mut plan = Plan::<Se3, 6>::default();
     let (x, y) = (plan.uncertain("x", pose), plan.uncertain("y", pose));
-    plan.operation(
-        "xy",
-        Op::Compose {
-            lhs: x,
-            rhs: y,
-            cross_cov: None,
-        },
-    );
+    plan.compose("xy", x, y);
     let settings = mc_settings(10_000, 3);
     let run = || {
         let e = evaluate_plan(plan.clone(), &settings);

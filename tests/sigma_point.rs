@@ -80,14 +80,7 @@ fn compose_equals_first_order_and_is_close_to_monte_carlo() {
     assert!(relative_frobenius_error(ut.pose.cov(), fo.pose.cov()) < 1e-12);
     let mut plan = Plan::<Se3, 6>::default();
     let (x, y) = (plan.uncertain("a", a), plan.uncertain("b", b));
-    plan.operation(
-        "ab",
-        Op::Compose {
-            lhs: x,
-            rhs: y,
-            cross_cov: None,
-        },
-    );
+    plan.compose("ab", x, y);
     let evaluation = evaluate_plan(plan, &mc_settings(100_000, 21));
     let truth = mc_stats(nodes(&evaluation, "ab")[0]);
     let e_ut = relative_frobenius_error(ut.pose.cov(), &truth.cov);
@@ -114,22 +107,8 @@ fn compose_equals_first_order_and_is_close_to_monte_carlo() {
     let y = plan.uncertain("y", inputs[1]);
     let z = plan.uncertain("z", inputs[2]);
     let y_inv = plan.operation("y_inv", Op::Inverse { input: y });
-    let x_y_inv = plan.operation(
-        "x_y_inv",
-        Op::Compose {
-            lhs: x,
-            rhs: y_inv,
-            cross_cov: None,
-        },
-    );
-    plan.operation(
-        "x_y_inv_z",
-        Op::Compose {
-            lhs: x_y_inv,
-            rhs: z,
-            cross_cov: None,
-        },
-    );
+    let x_y_inv = plan.compose("x_y_inv", x, y_inv);
+    plan.compose("x_y_inv_z", x_y_inv, z);
     let evaluation = evaluate_plan(plan, &mc_settings(100_000, 22));
     let truth = mc_stats(nodes(&evaluation, "x_y_inv_z")[0]);
     let ut = map(&inputs, f, &Unscented::default()).unwrap();
