@@ -26,6 +26,8 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+pub mod bag;
+
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 use crate::uncertain::{Side, UncertainPose};
 

@@ -3,6 +3,7 @@
 //! settings. Nothing after this stage reads a file format.
 //!
 //! - [`scenario`]: TOML scenario files (and the bundled lecture scenarios).
+//! - [`bag`]: robot logs, ROS 1 bags and MCAP files (ROS 2).
 
 use std::collections::BTreeMap;
 
@@ -11,6 +12,7 @@ use serde::Serialize;
 use crate::plan::AnyPlan;
 use crate::uncertain::Method;
 
+pub mod bag;
 pub mod scenario;
 
 /// What an input describes, for the text panel and `posecov list`.

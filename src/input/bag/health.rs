@@ -1,0 +1,213 @@
+//! Covariance health of one message, and the per-topic state that finds sudden drops and
+//! unbounded growth. Words and thresholds are the README's ("Covariance health").
+
+use nalgebra::{DMatrix, SymmetricEigen};
+
+use crate::plan::bag::{COV_LEN, Issue};
+
+/// A variance at or above this is a placeholder ("not estimated"), not a measurement.
+pub const PLACEHOLDER: f64 = 1e6;
+/// Relative tolerance of the symmetry check: |Σᵢⱼ − Σⱼᵢ| ≤ tol · max(1, max |Σᵢᵢ|).
+pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
+/// Relative tolerance of the PSD check: λ_min ≥ −tol · max(λ_max, tiny).
+pub const PSD_TOLERANCE: f64 = 1e-9;
+/// A drop: the position trace divided by at least this from one usable message to the next.
+pub const DROP_FACTOR: f64 = 5.0;
+/// Growth: the position trace at least this many times its value after the last drop.
+pub const GROWTH_FACTOR: f64 = 100.0;
+
+/// What one message's covariance is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MessageHealth {
+    /// The issues of this message alone (drops and growth come from [`Trend`]).
+    pub issues: Vec<Issue>,
+    /// Axes whose variance is ≥ [`PLACEHOLDER`] or exactly 0, per ROS axis.
+    pub unestimated: [bool; 6],
+    /// Smallest eigenvalue of the estimated block (when finite and symmetric).
+    pub min_eigenvalue: Option<f64>,
+    /// Trace of the estimated position block, m² (usable messages only).
+    pub position_trace: Option<f64>,
+}
+
+impl MessageHealth {
+    /// Whether the covariance can be drawn as a Gaussian.
+    pub fn usable(&self) -> bool {
+        !self.issues.iter().any(|i| i.unusable())
+    }
+}
+
+/// Classifies one covariance (ROS layout) and its orientation quaternion.
+///
+/// ```
+/// use posecov::input::bag::health::classify;
+/// use posecov::plan::bag::Issue;
+/// let mut cov = [0.0; 36];
+/// for (i, v) in [0.001, 0.001, 1e6, 1e6, 1e6, 0.03].iter().enumerate() { cov[i * 7] = *v; }
+/// let h = classify(&cov, [0.0, 0.0, 0.0, 1.0]);
+/// assert_eq!(h.issues, vec![Issue::Placeholder]);
+/// assert!(h.usable());
+/// assert_eq!(h.unestimated, [false, false, true, true, true, false]);
+/// ```
+pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHealth {
+    let mut issues = Vec::new();
+    let norm = orientation_xyzw.iter().map(|q| q * q).sum::<f64>().sqrt();
+    if !norm.is_finite() || (norm - 1.0).abs() > 1e-3 {
+        issues.push(Issue::BadOrientation);
+    }
+    let diag: [f64; 6] = std::array::from_fn(|i| cov[i * 7]);
+    let mut unestimated = diag.map(|v| v == 0.0 || v >= PLACEHOLDER);
+    if cov.iter().any(|v| !v.is_finite()) {
+        issues.push(Issue::NonFinite);
+        unestimated = [false; 6];
+        return MessageHealth {
+            issues,
+            unestimated,
+            min_eigenvalue: None,
+            position_trace: None,
+        };
+    }
+    if cov[0] == -1.0 {
+        issues.push(Issue::UnknownMarker);
+    } else if cov.iter().all(|v| *v == 0.0) {
+        issues.push(Issue::AllZero);
+    }
+    if diag.iter().any(|v| *v >= PLACEHOLDER) {
+        issues.push(Issue::Placeholder);
+    }
+    // The estimated axes: not a placeholder (a huge row would swamp the rounding of the rest).
+    let kept: Vec<usize> = (0..6).filter(|&i| diag[i] < PLACEHOLDER).collect();
+    let scale = kept.iter().map(|&i| diag[i].abs()).fold(0.0, f64::max);
+    let tol = SYMMETRY_TOLERANCE * scale.max(1.0);
+    let asymmetric = kept.iter().any(|&i| {
+        kept.iter()
+            .any(|&j| (cov[i * 6 + j] - cov[j * 6 + i]).abs() > tol)
+    });
+    let mut min_eigenvalue = None;
+    if asymmetric {
+        issues.push(Issue::Asymmetric);
+    } else if !kept.is_empty() && !issues.contains(&Issue::UnknownMarker) {
+        let block = DMatrix::from_fn(kept.len(), kept.len(), |r, c| {
+            0.5 * (cov[kept[r] * 6 + kept[c]] + cov[kept[c] * 6 + kept[r]])
+        });
+        let eig = SymmetricEigen::new(block);
+        let lo = eig
+            .eigenvalues
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let hi = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
+        min_eigenvalue = Some(lo);
+        if lo < -PSD_TOLERANCE * hi.max(f64::MIN_POSITIVE) {
+            issues.push(Issue::NotPsd);
+        }
+    }
+    let health = MessageHealth {
+        issues,
+        unestimated,
+        min_eigenvalue,
+        position_trace: None,
+    };
+    let position_trace = health.usable().then(|| {
+        (0..3)
+            .filter(|&i| !unestimated[i])
+            .map(|i| diag[i])
+            .sum::<f64>()
+    });
+    MessageHealth {
+        position_trace,
+        ..health
+    }
+}
+
+/// The running state of a topic's position trace: finds sudden drops and unbounded growth.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Trend {
+    previous: Option<f64>,
+    /// The smallest trace since the last drop (growth is measured from it).
+    floor: Option<f64>,
+}
+
+impl Trend {
+    /// The trend issues of the next usable message with position trace `trace` (> 0).
+    ///
+    /// ```
+    /// use posecov::input::bag::health::Trend;
+    /// use posecov::plan::bag::Issue;
+    /// let mut t = Trend::default();
+    /// assert!(t.next(1.0).is_empty());
+    /// assert_eq!(t.next(0.1), vec![Issue::SuddenDrop]);
+    /// assert!(t.next(5.0).is_empty());
+    /// assert_eq!(t.next(10.0), vec![Issue::Growth]);
+    /// ```
+    pub fn next(&mut self, trace: f64) -> Vec<Issue> {
+        let mut out = Vec::new();
+        if trace <= 0.0 {
+            return out;
+        }
+        if let Some(prev) = self.previous
+            && trace * DROP_FACTOR <= prev
+        {
+            out.push(Issue::SuddenDrop);
+            self.floor = None;
+        }
+        let floor = self.floor.map_or(trace, |f| f.min(trace));
+        if trace >= GROWTH_FACTOR * floor {
+            out.push(Issue::Growth);
+        }
+        self.floor = Some(floor);
+        self.previous = Some(trace);
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn diag(d: [f64; 6]) -> [f64; 36] {
+        let mut c = [0.0; 36];
+        for i in 0..6 {
+            c[i * 7] = d[i];
+        }
+        c
+    }
+    const Q: [f64; 4] = [0.0, 0.0, 0.0, 1.0];
+
+    #[test]
+    fn each_case_has_its_word() {
+        assert!(classify(&diag([0.1; 6]), Q).issues.is_empty());
+        assert_eq!(classify(&[0.0; 36], Q).issues, vec![Issue::AllZero]);
+        let mut m = diag([0.1; 6]);
+        m[0] = -1.0;
+        assert_eq!(classify(&m, Q).issues, vec![Issue::UnknownMarker]);
+        assert_eq!(
+            classify(&diag([0.1, 0.1, 1.79e308, 0.1, 0.1, 0.1]), Q).issues,
+            vec![Issue::Placeholder]
+        );
+        let mut n = diag([0.1; 6]);
+        n[3] = f64::NAN;
+        assert_eq!(classify(&n, Q).issues, vec![Issue::NonFinite]);
+        let mut a = diag([0.1; 6]);
+        a[1] = 0.05;
+        assert_eq!(classify(&a, Q).issues, vec![Issue::Asymmetric]);
+        let mut p = diag([0.1; 6]);
+        p[1] = 0.5;
+        p[6] = 0.5;
+        let h = classify(&p, Q);
+        assert_eq!(h.issues, vec![Issue::NotPsd]);
+        assert!((h.min_eigenvalue.unwrap() - (0.1 - 0.5)).abs() < 1e-12);
+        assert_eq!(
+            classify(&diag([0.1; 6]), [0.0, 0.0, 0.0, 2.0]).issues,
+            vec![Issue::BadOrientation]
+        );
+    }
+
+    #[test]
+    fn placeholders_do_not_spoil_the_psd_check() {
+        // 1.79e308 next to 1e-3: eigenvalues of the whole matrix would be rounding noise.
+        let h = classify(&diag([1e-3, 1e-3, 1.79e308, 1e6, 1e6, 0.03]), Q);
+        assert!(h.usable());
+        assert_eq!(h.min_eigenvalue, Some(1e-3));
+        assert_eq!(h.position_trace, Some(2e-3));
+    }
+}

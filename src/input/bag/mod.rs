@@ -1,0 +1,476 @@
+//! Robot logs: ROS 1 bags (format 2.0; uncompressed, bz2 and lz4 chunks, through the `rosbag`
+//! crate) and MCAP files (ROS 2, CDR messages, through the `mcap` crate's streaming reader
+//! and `re_cdr`). Both are streamed: messages are decoded one at a time into a bounded
+//! [`BagPlan`] — every message's health is counted, a decimated set of messages is kept for
+//! drawing, and time series are kept at a bounded length (halving their density when full).
+//!
+//! Messages read: `nav_msgs/Odometry`, `geometry_msgs/PoseWithCovarianceStamped` and
+//! `geometry_msgs/PoseWithCovariance`; other types are listed as skipped. Stamps are the
+//! header stamp, or the log time when the header's is zero or missing (counted and said).
+//!
+//! ```
+//! use posecov::input::bag::{BagOptions, read_bag};
+//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
+//! let plan = read_bag(path.as_ref(), &BagOptions::default(), &mut |_, _| {}, None).unwrap();
+//! assert_eq!(plan.topics[0].name, "/jackal_velocity_controller/odom");
+//! assert!(plan.topics[0].planar);
+//! ```
+
+use std::collections::BTreeMap;
+use std::io::Read;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::plan::bag::{
+    BagPlan, DrawnMessage, Health, Issue, LogFormat, PoseMessage, PoseMessageKind, SeriesPoint,
+    SkippedTopic, TopicPlan,
+};
+
+pub mod decode;
+pub mod health;
+mod mcap;
+mod ros1;
+
+use decode::{DecodeError, Decoded};
+
+/// Default number of messages drawn per topic (at most; evenly spaced).
+pub const DEFAULT_MAX_DRAWN: usize = 200;
+/// However `--every` is set, at most this many messages per topic are drawn (the stride is
+/// doubled beyond, and the text panel says so).
+pub const MAX_DRAWN_LIMIT: usize = 5000;
+/// Points kept per topic for the trajectory and the time series (density halves beyond).
+pub const MAX_SERIES: usize = 20_000;
+
+/// The first bytes of a ROS 1 bag.
+pub const ROS1_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
+/// The first bytes of an MCAP file.
+pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
+
+/// What to read and how much to keep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BagOptions {
+    /// Topics to read (`--topic`, repeatable); empty: every pose topic.
+    pub topics: Vec<String>,
+    /// Draw every N-th message (`--every N`); `None`: at most [`DEFAULT_MAX_DRAWN`].
+    pub every: Option<u64>,
+}
+
+impl Default for BagOptions {
+    fn default() -> Self {
+        Self {
+            topics: Vec::new(),
+            every: None,
+        }
+    }
+}
+
+/// Why a log could not be read. Each names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum BagError {
+    /// Opening or reading the file.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// The container is damaged or not what its magic bytes say.
+    #[error("{path}: {what}")]
+    Format {
+        /// The file.
+        path: String,
+        /// What is wrong, where.
+        what: String,
+    },
+    /// `--topic` named a topic the log does not have (or not of a pose type).
+    #[error("{path}: --topic {topic}: {why}")]
+    Topic {
+        /// The file.
+        path: String,
+        /// The name given.
+        topic: String,
+        /// What the log has instead.
+        why: String,
+    },
+}
+
+/// The format of a file by its magic bytes (then by its extension, `.bag` / `.mcap`).
+///
+/// ```
+/// use posecov::input::bag::detect;
+/// use posecov::plan::bag::LogFormat;
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
+/// assert_eq!(detect(path.as_ref()), Some(LogFormat::Ros1Bag));
+/// assert_eq!(detect("Cargo.toml".as_ref()), None);
+/// ```
+pub fn detect(path: &Path) -> Option<LogFormat> {
+    let mut head = [0u8; 13];
+    let n = std::fs::File::open(path)
+        .and_then(|mut f| f.read(&mut head))
+        .unwrap_or(0);
+    if head[..n].starts_with(ROS1_MAGIC) {
+        return Some(LogFormat::Ros1Bag);
+    }
+    if head[..n].starts_with(MCAP_MAGIC) {
+        return Some(LogFormat::Mcap);
+    }
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("bag") => Some(LogFormat::Ros1Bag),
+        Some("mcap") => Some(LogFormat::Mcap),
+        _ => None,
+    }
+}
+
+/// Reads a log into a [`BagPlan`]. `progress(done, total)` is called as the read advances
+/// (bytes or chunks); a raised `cancel` stops the read at the next message and marks the plan
+/// `cancelled` (everything before is kept).
+///
+/// See the [module docs](self) for an example.
+pub fn read_bag(
+    path: &Path,
+    options: &BagOptions,
+    progress: &mut dyn FnMut(u64, u64),
+    cancel: Option<&AtomicBool>,
+) -> Result<BagPlan, BagError> {
+    let format = detect(path).ok_or_else(|| BagError::Format {
+        path: path.display().to_string(),
+        what: "neither a ROS 1 bag (#ROSBAG V2.0) nor an MCAP file (\\x89MCAP0)".into(),
+    })?;
+    let mut collector = Collector::new(options, cancel);
+    match format {
+        LogFormat::Ros1Bag => ros1::read(path, &mut collector, progress)?,
+        LogFormat::Mcap => mcap::read(path, &mut collector, progress)?,
+    }
+    collector.finish(path, format)
+}
+
+/// How a message's bytes are encoded.
+#[derive(Debug, Clone, Copy)]
+enum Codec {
+    Ros1,
+    Cdr,
+}
+
+/// The per-topic streaming state.
+struct TopicState {
+    kind: PoseMessageKind,
+    frame_id: Option<String>,
+    child_frame_id: Option<String>,
+    count: u64,
+    from_log: u64,
+    out_of_order: u64,
+    last_stamp: Option<i64>,
+    range: Option<(i64, i64)>,
+    health: Health,
+    trend: health::Trend,
+    usable: u64,
+    planar: bool,
+    drawn: Decimator<DrawnMessage>,
+    trajectory: Decimator<(i64, [f64; 3])>,
+    series: Decimator<SeriesPoint>,
+}
+
+/// Keeps items at indices that are multiples of `stride`; when more than `cap` are kept, the
+/// stride doubles and every other one is dropped. Memory stays bounded by `cap`.
+struct Decimator<T> {
+    items: Vec<(u64, T)>,
+    stride: u64,
+    cap: usize,
+}
+
+impl<T> Decimator<T> {
+    fn new(stride: u64, cap: usize) -> Self {
+        Self {
+            items: Vec::new(),
+            stride: stride.max(1),
+            cap: cap.max(1),
+        }
+    }
+    fn wants(&self, index: u64) -> bool {
+        index.is_multiple_of(self.stride)
+    }
+    fn push(&mut self, index: u64, item: T) {
+        if !self.wants(index) {
+            return;
+        }
+        self.items.push((index, item));
+        while self.items.len() > self.cap {
+            self.stride *= 2;
+            let stride = self.stride;
+            self.items.retain(|(i, _)| i.is_multiple_of(stride));
+        }
+    }
+    fn into_items(self) -> Vec<T> {
+        self.items.into_iter().map(|(_, t)| t).collect()
+    }
+}
+
+/// Receives every message of a log in file order.
+struct Collector<'a> {
+    options: &'a BagOptions,
+    cancel: Option<&'a AtomicBool>,
+    cancelled: bool,
+    topics: BTreeMap<String, TopicState>,
+    skipped: BTreeMap<String, (String, u64)>,
+    not_selected: BTreeMap<String, ()>,
+    total: u64,
+}
+
+impl<'a> Collector<'a> {
+    fn new(options: &'a BagOptions, cancel: Option<&'a AtomicBool>) -> Self {
+        Self {
+            options,
+            cancel,
+            cancelled: false,
+            topics: BTreeMap::new(),
+            skipped: BTreeMap::new(),
+            not_selected: BTreeMap::new(),
+            total: 0,
+        }
+    }
+
+    /// Whether to stop (Ctrl-C).
+    fn stop(&mut self) -> bool {
+        if self.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            self.cancelled = true;
+        }
+        self.cancelled
+    }
+
+    /// One message: `kind` is `None` for another type, `Some(Err(why))` for a pose type whose
+    /// definition does not match.
+    fn message(
+        &mut self,
+        topic: &str,
+        type_name: &str,
+        kind: Option<Result<PoseMessageKind, String>>,
+        log_time_ns: i64,
+        bytes: &[u8],
+        codec: Codec,
+    ) {
+        self.total += 1;
+        let kind = match kind {
+            Some(Ok(kind)) => kind,
+            other => {
+                let label = match other {
+                    Some(Err(why)) => why,
+                    _ => type_name.to_owned(),
+                };
+                self.skipped.entry(topic.to_owned()).or_insert((label, 0)).1 += 1;
+                return;
+            }
+        };
+        if !self.options.topics.is_empty() && !self.options.topics.iter().any(|t| t == topic) {
+            self.not_selected.insert(topic.to_owned(), ());
+            return;
+        }
+        let every = self.options.every;
+        let state = self
+            .topics
+            .entry(topic.to_owned())
+            .or_insert_with(|| TopicState {
+                kind,
+                frame_id: None,
+                child_frame_id: None,
+                count: 0,
+                from_log: 0,
+                out_of_order: 0,
+                last_stamp: None,
+                range: None,
+                health: Health::default(),
+                trend: health::Trend::default(),
+                usable: 0,
+                planar: true,
+                drawn: match every {
+                    Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
+                    None => Decimator::new(1, DEFAULT_MAX_DRAWN),
+                },
+                trajectory: Decimator::new(1, MAX_SERIES),
+                series: Decimator::new(1, MAX_SERIES),
+            });
+        let decoded: Result<Decoded, DecodeError> = match codec {
+            Codec::Ros1 => decode::decode_ros1(state.kind, bytes),
+            Codec::Cdr => decode::decode_cdr(state.kind, bytes),
+        };
+        state.add(decoded, log_time_ns);
+    }
+
+    fn finish(self, path: &Path, format: LogFormat) -> Result<BagPlan, BagError> {
+        for wanted in &self.options.topics {
+            if !self.topics.contains_key(wanted) && !self.cancelled {
+                let why = match self.skipped.get(wanted) {
+                    Some((t, _)) => format!("its messages are {t}, not a pose with covariance"),
+                    None => {
+                        let have: Vec<&str> = self
+                            .topics
+                            .keys()
+                            .chain(self.not_selected.keys())
+                            .map(String::as_str)
+                            .collect();
+                        format!(
+                            "no such topic; pose topics in this log: {}",
+                            if have.is_empty() {
+                                "none".to_owned()
+                            } else {
+                                have.join(", ")
+                            }
+                        )
+                    }
+                };
+                return Err(BagError::Topic {
+                    path: path.display().to_string(),
+                    topic: wanted.clone(),
+                    why,
+                });
+            }
+        }
+        Ok(BagPlan {
+            format: Some(format),
+            topics: self
+                .topics
+                .into_iter()
+                .map(|(name, s)| s.into_plan(name))
+                .collect(),
+            skipped: self
+                .skipped
+                .into_iter()
+                .map(|(name, (message_type, count))| SkippedTopic {
+                    name,
+                    message_type,
+                    count,
+                })
+                .collect(),
+            not_selected: self.not_selected.into_keys().collect(),
+            messages_total: self.total,
+            cancelled: self.cancelled,
+        })
+    }
+}
+
+impl TopicState {
+    fn add(&mut self, decoded: Result<Decoded, DecodeError>, log_time_ns: i64) {
+        let index = self.count;
+        self.count += 1;
+        let d = match decoded {
+            Ok(d) => d,
+            Err(_) => {
+                self.health.note(Issue::Undecodable, log_time_ns);
+                return;
+            }
+        };
+        let (stamp_ns, from_log_time) = match d.stamp_ns {
+            Some(s) => (s, false),
+            None => (log_time_ns, true),
+        };
+        if from_log_time && self.kind != PoseMessageKind::PoseWithCovariance {
+            self.from_log += 1;
+        }
+        if self.last_stamp.is_some_and(|last| stamp_ns < last) {
+            self.out_of_order += 1;
+        }
+        self.last_stamp = Some(stamp_ns);
+        self.range = Some(match self.range {
+            Some((a, b)) => (a.min(stamp_ns), b.max(stamp_ns)),
+            None => (stamp_ns, stamp_ns),
+        });
+        if self.frame_id.is_none() && !d.frame_id.is_empty() {
+            self.frame_id = Some(d.frame_id.clone());
+        }
+        if self.child_frame_id.is_none() && !d.child_frame_id.is_empty() {
+            self.child_frame_id = Some(d.child_frame_id.clone());
+        }
+        let mut h = health::classify(&d.covariance, d.orientation_xyzw);
+        if let Some(trace) = h.position_trace {
+            h.issues.extend(self.trend.next(trace));
+        }
+        for issue in &h.issues {
+            self.health.note(*issue, stamp_ns);
+        }
+        if h.issues.contains(&Issue::NotPsd) {
+            let lo = h.min_eigenvalue.unwrap_or(0.0);
+            self.health.min_eigenvalue = Some(self.health.min_eigenvalue.map_or(lo, |m| m.min(lo)));
+        }
+        let usable = h.usable();
+        if usable {
+            self.usable += 1;
+            self.planar &= h.unestimated[2] && h.unestimated[3] && h.unestimated[4];
+            if d.position.iter().all(|v| v.is_finite()) {
+                self.trajectory.push(index, (stamp_ns, d.position));
+            }
+        }
+        let sigma = std::array::from_fn(|i| {
+            let v = d.covariance[i * 7];
+            (usable && !h.unestimated[i]).then(|| v.max(0.0).sqrt())
+        });
+        self.series.push(
+            index,
+            SeriesPoint {
+                stamp_ns,
+                sigma,
+                position_trace: h.position_trace,
+            },
+        );
+        if self.drawn.wants(index) {
+            let unusable = h.issues.iter().copied().filter(|i| i.unusable()).collect();
+            self.drawn.push(
+                index,
+                DrawnMessage {
+                    index,
+                    message: PoseMessage {
+                        stamp_ns,
+                        from_log_time,
+                        position: d.position,
+                        orientation_xyzw: d.orientation_xyzw,
+                        covariance: d.covariance,
+                        twist_covariance: d.twist_covariance,
+                    },
+                    unusable,
+                    unestimated: h.unestimated,
+                },
+            );
+        }
+    }
+
+    fn into_plan(self, name: String) -> TopicPlan {
+        let stride = self.drawn.stride;
+        let mut trajectory = self.trajectory.into_items();
+        trajectory.sort_by_key(|p| p.0);
+        let mut series = self.series.into_items();
+        series.sort_by_key(|p| p.stamp_ns);
+        TopicPlan {
+            name,
+            kind: self.kind,
+            frame_id: self.frame_id.unwrap_or_default(),
+            child_frame_id: self.child_frame_id.unwrap_or_default(),
+            count: self.count,
+            stamps_from_log_time: self.from_log,
+            stamps_out_of_order: self.out_of_order,
+            stamp_range: self.range,
+            health: self.health,
+            planar: self.planar && self.usable > 0,
+            drawn: self.drawn.into_items(),
+            stride,
+            trajectory,
+            series,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimation_is_bounded_and_even() {
+        let mut d = Decimator::new(1, 200);
+        for i in 0..100_000u64 {
+            d.push(i, i);
+        }
+        let kept = d.into_items();
+        assert!(kept.len() <= 200 && kept.len() > 100, "{}", kept.len());
+        let stride = kept[1] - kept[0];
+        assert!(kept.windows(2).all(|w| w[1] - w[0] == stride));
+        assert_eq!(kept[0], 0);
+    }
+}

@@ -1,0 +1,160 @@
+//! ROS 1 bags (format 2.0, wiki.ros.org/Bags/Format/2.0) through the `rosbag` crate: the
+//! file is memory-mapped and its chunks are decompressed one at a time (uncompressed, bz2,
+//! lz4), so memory stays bounded by one chunk whatever the bag's length.
+
+use std::collections::HashMap;
+use std::io::Read;
+use std::path::Path;
+
+use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
+
+use super::decode::ros1_kind;
+use super::{BagError, Codec, Collector, ROS1_MAGIC};
+use crate::plan::bag::PoseMessageKind;
+
+/// A connection: topic, type, what posecov makes of it.
+struct Conn {
+    topic: String,
+    type_name: String,
+    kind: Option<Result<PoseMessageKind, String>>,
+}
+
+fn conn_of(c: &rosbag::record_types::Connection<'_>) -> Conn {
+    let md5: String = c.md5sum.iter().map(|b| format!("{b:02x}")).collect();
+    Conn {
+        topic: c.topic.to_owned(),
+        type_name: c.tp.to_owned(),
+        kind: ros1_kind(c.tp, &md5),
+    }
+}
+
+/// Checks the bag header before the crate maps it: the index position must lie inside the
+/// file (a bag whose recording was interrupted has `index_pos = 0` and must be reindexed).
+fn check_header(path: &Path) -> Result<(), BagError> {
+    let err = |what: String| BagError::Format {
+        path: path.display().to_string(),
+        what,
+    };
+    let io = |source| BagError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    let mut head = vec![0u8; 4096];
+    let mut n = 0;
+    while n < head.len() {
+        let k = file.read(&mut head[n..]).map_err(io)?;
+        if k == 0 {
+            break;
+        }
+        n += k;
+    }
+    let head = &head[..n];
+    let rest = head
+        .strip_prefix(ROS1_MAGIC)
+        .ok_or_else(|| err("not a ROS 1 bag of format 2.0 (no '#ROSBAG V2.0' line)".into()))?;
+    let u32_at = |b: &[u8], at: usize| -> Option<u32> {
+        b.get(at..at + 4)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+    };
+    let header_len = u32_at(rest, 0).ok_or_else(|| err("truncated bag header".into()))? as usize;
+    let header = rest
+        .get(4..4 + header_len)
+        .ok_or_else(|| err("truncated bag header".into()))?;
+    let mut at = 0;
+    let mut index_pos = None;
+    while let Some(field_len) = u32_at(header, at) {
+        let Some(field) = header.get(at + 4..at + 4 + field_len as usize) else {
+            break;
+        };
+        if let Some(v) = field.strip_prefix(b"index_pos=")
+            && v.len() == 8
+        {
+            index_pos = Some(u64::from_le_bytes(v.try_into().unwrap_or([0; 8])));
+        }
+        at += 4 + field_len as usize;
+    }
+    match index_pos {
+        Some(0) => Err(err(
+            "the bag has no index (index_pos = 0: its recording was interrupted); \
+             run `rosbag reindex` on it first"
+                .into(),
+        )),
+        Some(p) if p > len || p < (ROS1_MAGIC.len() + 4 + header_len) as u64 => Err(err(format!(
+            "the bag header's index_pos {p} is outside the file ({len} bytes): truncated copy?"
+        ))),
+        Some(_) => Ok(()),
+        None => Err(err("the bag header has no index_pos field".into())),
+    }
+}
+
+/// Streams every message of the bag into `collector`.
+pub(super) fn read(
+    path: &Path,
+    collector: &mut Collector<'_>,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<(), BagError> {
+    check_header(path)?;
+    let fail = |what: String| BagError::Format {
+        path: path.display().to_string(),
+        what,
+    };
+    let bag = RosBag::new(path).map_err(|source| BagError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    // Connections from the index section (every topic and type up front), then any the
+    // chunks declare themselves.
+    let mut conns: HashMap<u32, Conn> = HashMap::new();
+    for record in bag.index_records() {
+        match record {
+            Ok(IndexRecord::Connection(c)) => {
+                conns.insert(c.id, conn_of(&c));
+            }
+            Ok(_) => {}
+            Err(e) => return Err(fail(format!("index section: {e}"))),
+        }
+    }
+    let chunks = u64::from(bag.get_chunk_count()).max(1);
+    let mut done = 0;
+    for record in bag.chunk_records() {
+        let chunk = match record {
+            Ok(ChunkRecord::Chunk(chunk)) => chunk,
+            Ok(ChunkRecord::IndexData(_)) => continue,
+            Err(e) => return Err(fail(format!("chunk {}: {e}", done + 1))),
+        };
+        for message in chunk.messages() {
+            match message {
+                Ok(MessageRecord::Connection(c)) => {
+                    conns.entry(c.id).or_insert_with(|| conn_of(&c));
+                }
+                Ok(MessageRecord::MessageData(m)) => {
+                    if collector.stop() {
+                        return Ok(());
+                    }
+                    let Some(conn) = conns.get(&m.conn_id) else {
+                        return Err(fail(format!(
+                            "chunk {}: a message on connection {} that the bag never declares",
+                            done + 1,
+                            m.conn_id
+                        )));
+                    };
+                    let log_ns = i64::try_from(m.time).unwrap_or(i64::MAX);
+                    collector.message(
+                        &conn.topic,
+                        &conn.type_name,
+                        conn.kind.clone(),
+                        log_ns,
+                        m.data,
+                        Codec::Ros1,
+                    );
+                }
+                Err(e) => return Err(fail(format!("chunk {}: {e}", done + 1))),
+            }
+        }
+        done += 1;
+        progress(done, chunks);
+    }
+    Ok(())
+}

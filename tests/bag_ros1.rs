@@ -1,0 +1,104 @@
+//! The ROS 1 reader on a real bag: robot_localization's test2.bag (a Jackal's odometry with
+//! 1e6 placeholders for z, roll and pitch; bz2 chunks).
+
+use posecov::input::bag::{BagOptions, read_bag};
+use posecov::plan::bag::{Issue, PoseMessageKind};
+
+const TEST2: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/robot_localization/test2.bag"
+);
+
+#[test]
+fn test2_bag_reads_with_its_placeholders() {
+    let plan = read_bag(TEST2.as_ref(), &BagOptions::default(), &mut |_, _| {}, None).unwrap();
+    let odom = &plan.topics[0];
+    assert_eq!(odom.kind, PoseMessageKind::Odometry);
+    assert_eq!(odom.health.count(Issue::Placeholder), odom.count);
+    assert!(odom.planar);
+    assert_eq!(odom.name, "/jackal_velocity_controller/odom");
+    assert_eq!(
+        (odom.frame_id.as_str(), odom.child_frame_id.as_str()),
+        ("odom", "base_link")
+    );
+    assert_eq!(odom.count, 3060);
+    assert_eq!(odom.health.first(Issue::Placeholder), Some(47_584_000_000));
+    assert_eq!(odom.health.issues.len(), 1, "{:?}", odom.health);
+    assert_eq!(odom.stamps_from_log_time, 0);
+    // At most 200 drawn, evenly spaced; the trajectory keeps every message of a small bag.
+    assert!(odom.drawn.len() <= 200 && odom.drawn.len() > 100);
+    assert_eq!(odom.trajectory.len(), 3060);
+    let first = &odom.drawn[0].message;
+    assert_eq!(first.covariance[0], 0.001);
+    assert_eq!(first.covariance[14], 1e6);
+    assert_eq!(first.covariance[35], 0.03);
+    assert!((first.position[0] - 0.1571574254425733).abs() < 1e-12);
+    // The IMU is another type: skipped and listed.
+    assert_eq!(plan.skipped.len(), 1);
+    assert_eq!(plan.skipped[0].name, "/imu/data");
+    assert_eq!(plan.skipped[0].message_type, "sensor_msgs/Imu");
+    assert_eq!(plan.skipped[0].count, 3061);
+    assert_eq!(plan.messages_total, 3060 + 3061);
+}
+
+#[test]
+fn topic_selection_and_every() {
+    let only = BagOptions {
+        topics: vec!["/jackal_velocity_controller/odom".into()],
+        every: Some(100),
+    };
+    let plan = read_bag(TEST2.as_ref(), &only, &mut |_, _| {}, None).unwrap();
+    assert_eq!(plan.topics[0].drawn.len(), 31); // messages 0, 100, …, 3000
+    assert_eq!(plan.topics[0].stride, 100);
+    let wrong = BagOptions {
+        topics: vec!["/imu/data".into()],
+        every: None,
+    };
+    let e = read_bag(TEST2.as_ref(), &wrong, &mut |_, _| {}, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.ends_with(
+            "--topic /imu/data: its messages are sensor_msgs/Imu, not a pose with covariance"
+        ),
+        "{e}"
+    );
+    let missing = BagOptions {
+        topics: vec!["/odom".into()],
+        every: None,
+    };
+    let e = read_bag(TEST2.as_ref(), &missing, &mut |_, _| {}, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("no such topic; pose topics in this log: /jackal_velocity_controller/odom"),
+        "{e}"
+    );
+}
+
+#[test]
+fn damaged_bags_are_errors_not_panics() {
+    let bytes = std::fs::read(TEST2).unwrap();
+    let dir = std::env::temp_dir().join(format!("posecov-bag-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, data) in [
+        ("truncated.bag", bytes[..bytes.len() / 2].to_vec()),
+        ("header_only.bag", bytes[..20].to_vec()),
+        ("garbage.bag", {
+            let mut b = bytes.clone();
+            for (i, v) in b.iter_mut().enumerate().skip(5000).step_by(97) {
+                *v = (i % 251) as u8;
+            }
+            b
+        }),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, &data).unwrap();
+        match read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None) {
+            Err(e) => assert!(e.to_string().contains(name), "{e}"),
+            // Flipped bytes inside messages are counted, not fatal.
+            Ok(plan) => assert_eq!(name, "garbage.bag", "{plan:?}"),
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
