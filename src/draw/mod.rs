@@ -41,6 +41,7 @@ use crate::scene::{
 };
 use crate::uncertain::Method;
 
+pub mod bag;
 mod plots;
 mod shapes;
 mod text;

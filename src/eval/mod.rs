@@ -36,6 +36,7 @@ use std::ops::Range;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+pub mod bag;
 mod blocked;
 mod engine;
 pub mod groups;

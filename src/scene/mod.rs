@@ -98,6 +98,19 @@ pub enum Timing {
     /// From this value of the `step` sequence timeline on (until the same entity is logged
     /// at a later step).
     Step(i64),
+    /// From this message stamp on (nanoseconds, the `stamp` time timeline): a robot log's
+    /// items, so the time slider scrubs the log.
+    Stamp(i64),
+}
+
+/// The timeline a scene's plot series and its time panel use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Timeline {
+    /// The `step` sequence (propagation steps; series points are steps).
+    #[default]
+    Step,
+    /// The `stamp` time timeline (robot logs; series points are nanoseconds).
+    Stamp,
 }
 
 /// How an ellipsoid is drawn.
@@ -243,7 +256,7 @@ pub enum ItemKind {
 pub struct SceneItem {
     /// Entity path, `/`-separated; segments use `[A-Za-z0-9_.-]`.
     pub path: String,
-    /// Static, or at a `step`.
+    /// Static, at a `step`, or at a stamp.
     pub timing: Timing,
     /// What to draw.
     pub kind: ItemKind,
@@ -305,7 +318,8 @@ pub struct ScalarSeries {
     pub color: Color,
     /// Line width in UI points.
     pub width: f64,
-    /// `(step, value)` samples.
+    /// `(step, value)` samples (`(stamp ns, value)` when the scene's timeline is
+    /// [`Timeline::Stamp`]).
     pub points: Vec<(i64, f64)>,
 }
 
@@ -325,6 +339,8 @@ pub struct Scene {
     /// A planar scene (SE(2), SO(2)) lives in the x–y plane: the sink declares +y as the
     /// viewer's up axis so the default camera faces that plane instead of grazing it.
     pub planar: bool,
+    /// The timeline of the plot series and the time panel.
+    pub timeline: Timeline,
 }
 
 impl Scene {
@@ -342,6 +358,7 @@ impl Scene {
             plots: Vec::new(),
             series: Vec::new(),
             planar: false,
+            timeline: Timeline::Step,
         }
     }
 
@@ -365,12 +382,13 @@ impl Scene {
             .items
             .iter()
             .filter_map(|item| match item.timing {
-                Timing::Static => None,
+                Timing::Static | Timing::Stamp(_) => None,
                 Timing::Step(k) => Some(k),
             })
             .chain(
                 self.series
                     .iter()
+                    .filter(|_| self.timeline == Timeline::Step)
                     .flat_map(|s| s.points.iter().map(|p| p.0)),
             )
             .collect();
@@ -386,6 +404,7 @@ impl Scene {
         items.sort_by_key(|item| match item.timing {
             Timing::Static => (0, 0),
             Timing::Step(k) => (1, k),
+            Timing::Stamp(ns) => (2, ns),
         });
         items
     }

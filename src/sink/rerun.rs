@@ -24,6 +24,8 @@ use crate::scene::{
 
 /// Name of the sequence timeline that [`Timing::Step`] items are logged on.
 pub const STEP_TIMELINE: &str = "step";
+/// Name of the time timeline that [`Timing::Stamp`] items (robot logs) are logged on.
+pub const STAMP_TIMELINE: &str = "stamp";
 
 /// Whether [`log_scene_cancellable`] logged everything.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -88,7 +90,7 @@ pub fn log_scene_cancellable(
         return Ok(cancelled);
     }
     for series in &scene.series {
-        log_series(rec, series)?;
+        log_series(rec, series, scene.timeline)?;
     }
     Ok(LogOutcome::Complete)
 }
@@ -128,7 +130,7 @@ fn log_items(
     for item in scene.items_in_log_order() {
         if cancel.load(Ordering::Relaxed) {
             let next_step = match item.timing {
-                Timing::Static => None,
+                Timing::Static | Timing::Stamp(_) => None,
                 Timing::Step(k) => Some(k),
             };
             return Ok(LogOutcome::Cancelled { next_step });
@@ -167,7 +169,10 @@ pub fn blueprint_for(scene: &Scene) -> Blueprint {
         .with_time_panel(
             TimePanel::new()
                 .with_state(PanelState::Collapsed)
-                .with_timeline(STEP_TIMELINE)
+                .with_timeline(match scene.timeline {
+                    scene::Timeline::Step => STEP_TIMELINE,
+                    scene::Timeline::Stamp => STAMP_TIMELINE,
+                })
                 .with_play_state(rr::blueprint::components::PlayState::Following),
         )
 }
@@ -183,6 +188,9 @@ fn send(
         Timing::Static => rr::TimePoint::default(),
         Timing::Step(k) => {
             rr::TimePoint::default().with(rr::Timeline::new_sequence(STEP_TIMELINE), k)
+        }
+        Timing::Stamp(ns) => {
+            rr::TimePoint::default().with(rr::Timeline::new_timestamp(STAMP_TIMELINE), ns)
         }
     };
     let path = path.into();
@@ -326,7 +334,11 @@ fn arrows3d(arrows: &Arrows) -> rr::Arrows3D {
 }
 
 /// Series style (static, once) and all samples in one column chunk.
-fn log_series(rec: &rr::RecordingStream, series: &ScalarSeries) -> Result<(), SinkError> {
+fn log_series(
+    rec: &rr::RecordingStream,
+    series: &ScalarSeries,
+    timeline: scene::Timeline,
+) -> Result<(), SinkError> {
     let style = rr::SeriesLines::new()
         .with_names([series.name.as_str()])
         .with_colors([color(series.color)])
@@ -335,7 +347,13 @@ fn log_series(rec: &rr::RecordingStream, series: &ScalarSeries) -> Result<(), Si
     if series.points.is_empty() {
         return Ok(());
     }
-    let steps = rr::TimeColumn::new_sequence(STEP_TIMELINE, series.points.iter().map(|p| p.0));
+    let times = series.points.iter().map(|p| p.0);
+    let steps = match timeline {
+        scene::Timeline::Step => rr::TimeColumn::new_sequence(STEP_TIMELINE, times),
+        scene::Timeline::Stamp => {
+            rr::TimeColumn::new_timestamp_nanos_since_epoch(STAMP_TIMELINE, times)
+        }
+    };
     let values = rr::Scalars::new(series.points.iter().map(|p| p.1))
         .columns_of_unit_batches()
         .map_err(rr::RecordingStreamError::from)?;

@@ -1,0 +1,335 @@
+//! The numbers of a robot log ([`BagPlan`]): per drawn message, what its covariance means in
+//! posecov's body-frame right form (through the one ROS conversion,
+//! [`ros_cov_to_right`]), a seeded sample cloud, and the numbers RViz draws from
+//! the same message. Planar topics become SE(2) (x, y, yaw), others SE(3).
+//!
+//! Confidence regions: a planar topic's position region has d = 2 degrees of freedom and its
+//! pose region d = 3; a 3-D topic's d = 3 and d = 6 ([CONVENTIONS §7](crate::conventions)).
+//!
+//! ```
+//! use posecov::eval::bag::{BagEvalSettings, evaluate_bag};
+//! use posecov::input::bag::{BagOptions, read_bag};
+//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
+//! let plan = read_bag(path.as_ref(), &BagOptions::default(), &mut |_, _| {}, None).unwrap();
+//! let e = evaluate_bag(&plan, &BagEvalSettings::default());
+//! let odom = &e.topics[0];
+//! assert_eq!((odom.position_dof, odom.pose_dof), (2, 3));
+//! assert!(odom.poses.iter().all(|p| p.state.is_drawable()));
+//! ```
+
+use nalgebra::{Matrix3, Matrix6, Vector2};
+
+use crate::interop::ros_cov_to_right;
+use crate::lie::{Se2, Se3, So2, So3};
+use crate::plan::bag::{BagPlan, Issue, SeriesPoint, TopicPlan};
+use crate::sample::{Sampler, chunk_rng};
+use crate::uncertain::{Side, UncertainPose};
+
+/// Samples drawn per message by default (a cloud per drawn message).
+pub const DEFAULT_CLOUD_SAMPLES: usize = 100;
+
+/// What evaluating a log needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BagEvalSettings {
+    /// Seed of every cloud (topic k, message i draw from stream (seed, k, i)).
+    pub seed: u64,
+    /// Samples per drawn message.
+    pub cloud_samples: usize,
+}
+
+impl Default for BagEvalSettings {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            cloud_samples: DEFAULT_CLOUD_SAMPLES,
+        }
+    }
+}
+
+/// What RViz draws from one message (its `CovarianceVisual`): the position block in the parent
+/// frame's axes, the rotation block, and whether it decides the pose is 2-D (Σzz, Σroll,
+/// Σpitch all ≤ 0 — placeholders make it draw in 3-D).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RvizNumbers {
+    /// Σ of (x, y, z), parent axes.
+    pub position_cov: Matrix3<f64>,
+    /// Σ of (roll, pitch, yaw), body axes.
+    pub rotation_cov: Matrix3<f64>,
+    /// RViz's 2-D rule.
+    pub pose_2d: bool,
+}
+
+/// One drawn message's meaning.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PoseState {
+    /// Planar: x, y, yaw as SE(2), body-frame right form, with its cloud.
+    Planar {
+        /// The Gaussian.
+        pose: UncertainPose<Se2, 3>,
+        /// Samples μ · Exp(ε).
+        cloud: Vec<Se2>,
+    },
+    /// 3-D: SE(3), body-frame right form, with its cloud.
+    Spatial {
+        /// The Gaussian.
+        pose: UncertainPose<Se3, 6>,
+        /// Samples μ · Exp(ε).
+        cloud: Vec<Se3>,
+    },
+    /// Not a Gaussian posecov can draw: why.
+    Invalid {
+        /// The issues (or a placeholder in a 3-D topic).
+        issues: Vec<Issue>,
+    },
+}
+
+impl PoseState {
+    /// Whether it is drawn as a Gaussian.
+    pub fn is_drawable(&self) -> bool {
+        !matches!(self, PoseState::Invalid { .. })
+    }
+}
+
+/// One drawn message.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseEvaluation {
+    /// Index on the topic.
+    pub index: u64,
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// The message's pose as published (`None`: not finite / not a rotation).
+    pub mean: Option<Se3>,
+    /// What the covariance means.
+    pub state: PoseState,
+    /// RViz's numbers (`None` when the covariance is not finite).
+    pub rviz: Option<RvizNumbers>,
+}
+
+/// One topic's numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicEvaluation {
+    /// Topic name.
+    pub name: String,
+    /// Drawn as SE(2) in the x–y plane.
+    pub planar: bool,
+    /// Degrees of freedom of the position region (2 planar, 3 otherwise).
+    pub position_dof: usize,
+    /// Degrees of freedom of the pose region (3 planar, 6 otherwise).
+    pub pose_dof: usize,
+    /// Drawn messages.
+    pub poses: Vec<PoseEvaluation>,
+    /// Trajectory (stamp ns, position).
+    pub trajectory: Vec<(i64, [f64; 3])>,
+    /// Time series.
+    pub series: Vec<SeriesPoint>,
+}
+
+/// A log's numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BagEvaluation {
+    /// Per topic, in the plan's order.
+    pub topics: Vec<TopicEvaluation>,
+}
+
+/// Evaluates every topic of a log.
+///
+/// See the [module docs](self) for an example.
+pub fn evaluate_bag(plan: &BagPlan, settings: &BagEvalSettings) -> BagEvaluation {
+    BagEvaluation {
+        topics: plan
+            .topics
+            .iter()
+            .enumerate()
+            .map(|(k, t)| evaluate_topic(k as u64, t, settings))
+            .collect(),
+    }
+}
+
+fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) -> TopicEvaluation {
+    let poses = topic
+        .drawn
+        .iter()
+        .map(|d| {
+            let m = &d.message;
+            let finite = m.covariance.iter().all(|v| v.is_finite());
+            let cov_ros = Matrix6::from_row_slice(&m.covariance);
+            let rotation = So3::try_from_quaternion_xyzw(m.orientation_xyzw).ok();
+            let mean = rotation
+                .filter(|_| m.position.iter().all(|v| v.is_finite()))
+                .map(|r| Se3::from_parts(m.position.into(), r));
+            let rviz = finite.then(|| RvizNumbers {
+                position_cov: cov_ros.fixed_view::<3, 3>(0, 0).into_owned(),
+                rotation_cov: cov_ros.fixed_view::<3, 3>(3, 3).into_owned(),
+                pose_2d: m.covariance[14] <= 0.0
+                    && m.covariance[21] <= 0.0
+                    && m.covariance[28] <= 0.0,
+            });
+            let state = match (mean, d.unusable.is_empty()) {
+                (Some(mean), true) => meaning(&mean, &cov_ros, &d.unestimated, topic.planar)
+                    .map_or_else(
+                        |issues| PoseState::Invalid { issues },
+                        |state| with_cloud(state, settings, family, d.index),
+                    ),
+                _ => PoseState::Invalid {
+                    issues: if d.unusable.is_empty() {
+                        vec![Issue::BadOrientation]
+                    } else {
+                        d.unusable.clone()
+                    },
+                },
+            };
+            PoseEvaluation {
+                index: d.index,
+                stamp_ns: m.stamp_ns,
+                mean,
+                state,
+                rviz,
+            }
+        })
+        .collect();
+    TopicEvaluation {
+        name: topic.name.clone(),
+        planar: topic.planar,
+        position_dof: if topic.planar { 2 } else { 3 },
+        pose_dof: if topic.planar { 3 } else { 6 },
+        poses,
+        trajectory: topic.trajectory.clone(),
+        series: topic.series.clone(),
+    }
+}
+
+/// The right-form Gaussian of a usable message. Planar: the unestimated z / roll / pitch rows
+/// and columns are dropped (they are placeholders or zero, not variances), the pose is
+/// projected to (x, y, yaw), and the one ROS conversion is applied at R = Rz(yaw); the
+/// (ρx, ρy, θz) block is SE(2)'s tangent. 3-D: the conversion at the message's rotation; a
+/// placeholder there cannot be drawn.
+fn meaning(
+    mean: &Se3,
+    cov_ros: &Matrix6<f64>,
+    unestimated: &[bool; 6],
+    planar: bool,
+) -> Result<PoseState, Vec<Issue>> {
+    let invalid = |_| vec![Issue::NotPsd];
+    if planar {
+        let yaw = mean.rotation().to_rpy()[2];
+        let mut cov = *cov_ros;
+        for i in [2, 3, 4] {
+            cov.row_mut(i).fill(0.0);
+            cov.column_mut(i).fill(0.0);
+        }
+        let right = ros_cov_to_right(&cov, &So3::from_rpy(0.0, 0.0, yaw));
+        let keep = [0, 1, 5];
+        let cov2 = Matrix3::from_fn(|r, c| right[(keep[r], keep[c])]);
+        let t = mean.translation();
+        let mean2 = Se2::from_parts(Vector2::new(t.x, t.y), So2::from_angle(yaw));
+        UncertainPose::try_new(mean2, cov2, Side::Right)
+            .map(|pose| PoseState::Planar {
+                pose,
+                cloud: Vec::new(),
+            })
+            .map_err(invalid)
+    } else {
+        if unestimated
+            .iter()
+            .zip(cov_ros.diagonal().iter())
+            .any(|(u, v)| *u && *v != 0.0)
+        {
+            return Err(vec![Issue::Placeholder]);
+        }
+        let right = ros_cov_to_right(cov_ros, mean.rotation());
+        UncertainPose::try_new(*mean, right, Side::Right)
+            .map(|pose| PoseState::Spatial {
+                pose,
+                cloud: Vec::new(),
+            })
+            .map_err(invalid)
+    }
+}
+
+fn with_cloud(state: PoseState, settings: &BagEvalSettings, family: u64, index: u64) -> PoseState {
+    let mut rng = chunk_rng(settings.seed, family, index);
+    let n = settings.cloud_samples;
+    match state {
+        PoseState::Planar { pose, .. } => match Sampler::new(&pose) {
+            Ok(s) => PoseState::Planar {
+                cloud: s.draw_many(&mut rng, n),
+                pose,
+            },
+            Err(_) => PoseState::Invalid {
+                issues: vec![Issue::NonFinite],
+            },
+        },
+        PoseState::Spatial { pose, .. } => match Sampler::new(&pose) {
+            Ok(s) => PoseState::Spatial {
+                cloud: s.draw_many(&mut rng, n),
+                pose,
+            },
+            Err(_) => PoseState::Invalid {
+                issues: vec![Issue::NonFinite],
+            },
+        },
+        invalid => invalid,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::interop::RosPoseWithCovariance;
+
+    #[test]
+    fn planar_meaning_is_the_ros_conversion_restricted_to_the_plane() {
+        let yaw: f64 = 0.7;
+        let mean = Se3::from_xyz_rpy([1.0, 2.0, 0.0], [0.0, 0.0, yaw]);
+        let mut cov = Matrix6::zeros();
+        cov[(0, 0)] = 0.04;
+        cov[(1, 1)] = 0.01;
+        cov[(0, 1)] = 0.005;
+        cov[(1, 0)] = 0.005;
+        cov[(5, 5)] = 0.02;
+        let mut with_placeholders = cov;
+        for i in [2, 3, 4] {
+            with_placeholders[(i, i)] = 1e6;
+        }
+        let un = [false, false, true, true, true, false];
+        let PoseState::Planar { pose, .. } = meaning(&mean, &with_placeholders, &un, true).unwrap()
+        else {
+            panic!()
+        };
+        // The same numbers through the one public conversion of a full message.
+        let mut full = cov;
+        for i in [2, 3, 4] {
+            full[(i, i)] = 1.0;
+        }
+        let msg = RosPoseWithCovariance {
+            position: [1.0, 2.0, 0.0],
+            orientation_xyzw: mean.rotation().to_quaternion_xyzw(),
+            covariance: full.transpose().iter().copied().collect(),
+        };
+        let right = msg.try_to_uncertain().unwrap().cov_right();
+        let keep = [0, 1, 5];
+        for r in 0..3 {
+            for c in 0..3 {
+                assert!((pose.cov()[(r, c)] - right[(keep[r], keep[c])]).abs() < 1e-15);
+            }
+        }
+        // Body x is the parent's direction at yaw: its variance mixes parent x and y.
+        let (s, c) = yaw.sin_cos();
+        let expect = c * c * 0.04 + s * s * 0.01 + 2.0 * s * c * 0.005;
+        assert!((pose.cov()[(0, 0)] - expect).abs() < 1e-15);
+        assert!((pose.mean().rotation().angle() - yaw).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_placeholder_in_3d_is_not_drawn() {
+        let mean = Se3::identity();
+        let mut cov = Matrix6::identity() * 0.01;
+        cov[(3, 3)] = 1.79e308;
+        let mut un = [false; 6];
+        un[3] = true;
+        assert_eq!(
+            meaning(&mean, &cov, &un, false).unwrap_err(),
+            vec![Issue::Placeholder]
+        );
+    }
+}
