@@ -15,7 +15,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::{Matrix3, Vector3};
 use posecov::eval::{AnyEvaluation, EvalSettings, evaluate};
 use posecov::lie::{LieGroup, Se2};
-use posecov::plan::{AnyPlan, Control, OdometryModel, Op, Plan};
+use posecov::plan::{AnyPlan, Control, OdometryModel, Op, Plan, StepNoise};
 use posecov::uncertain::Method;
 use rayon::ThreadPoolBuilder;
 
@@ -54,7 +54,7 @@ fn na568(c: &mut Criterion) {
                     tangent: u.log(),
                 })
                 .collect(),
-            noise,
+            noise: StepNoise::Same(noise),
         },
     );
     let plan = AnyPlan::Se2(plan);

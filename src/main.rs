@@ -76,6 +76,12 @@ struct ScenarioArgs {
     /// stays bounded, statistics use every sample, and each block's cloud is logged in turn.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     block_samples: Option<u64>,
+    /// Robot logs: read only this topic (repeatable; default every pose-with-covariance topic).
+    #[arg(long = "topic", value_name = "NAME")]
+    topics: Vec<String>,
+    /// Robot logs: draw every N-th message (default: at most ~200 per topic, evenly spaced).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    every: Option<u64>,
 }
 
 #[derive(Debug, Args)]
@@ -170,6 +176,8 @@ impl ScenarioArgs {
             samples: self.samples,
             confidence: self.confidence,
             block_samples: self.block_samples,
+            topics: self.topics.clone(),
+            every: self.every,
         }
     }
 }

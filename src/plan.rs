@@ -29,6 +29,7 @@ use nalgebra::{Matrix3, Vector3};
 pub mod bag;
 
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
+pub use crate::propagate::odometry::StepNoise;
 use crate::uncertain::{Side, UncertainPose};
 
 /// What an operation reads: a known transform, or an earlier definition (an uncertain input
@@ -141,7 +142,8 @@ pub enum Op<G: LieGroup<N>, const N: usize> {
         /// Cross-covariance Σ_XY (on X's side).
         cross_cov: Option<TangentMatrix<N>>,
     },
-    /// Odometry from `input`, one step per control, noise w_k ~ N(0, `noise`) on the right.
+    /// Odometry from `input`, one step per control, noise w_k ~ N(0, `noise.at(k)`) on the
+    /// right (one Σ_w for all steps, or one per step as a pose graph's edges give).
     Odometry {
         /// X₀.
         input: Operand<G>,
@@ -149,8 +151,8 @@ pub enum Op<G: LieGroup<N>, const N: usize> {
         model: OdometryModel,
         /// One per step.
         controls: Vec<Control<G, N>>,
-        /// Σ_w (right side, body frame).
-        noise: TangentMatrix<N>,
+        /// Σ_w (right side, body frame), for all steps or per step.
+        noise: StepNoise<N>,
     },
     /// Barfoot & Furgale's repeated compounding T_k = Exp(w_k) · T̄ · T_{k−1}.
     Compound {

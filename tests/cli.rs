@@ -111,7 +111,7 @@ fn missing_file_and_unknown_name() {
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("/no/such/scenario.toml: cannot read scenario"),
+        stderr.contains("/no/such/scenario.toml: cannot read input"),
         "{stderr}"
     );
 }

@@ -57,7 +57,7 @@ fn missing_file() {
     assert!(matches!(e, ScenarioError::Read { .. }));
     assert!(
         e.to_string()
-            .starts_with("/definitely/not/here.toml: cannot read scenario:"),
+            .starts_with("/definitely/not/here.toml: cannot read input:"),
         "{e}"
     );
 }

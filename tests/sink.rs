@@ -269,7 +269,7 @@ fn bad_arguments_fail_with_a_message() {
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("nosuch: cannot read scenario") && stderr.contains("camera_on_robot"),
+        stderr.contains("nosuch: cannot read input") && stderr.contains("camera_on_robot"),
         "{stderr}"
     );
 }

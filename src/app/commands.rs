@@ -2,23 +2,43 @@
 
 use std::fmt::Write as _;
 
-use super::{AppError, Overrides, evaluate, load, report_json, resolve};
-use crate::input::scenario::{Scenario, bundled::BUNDLED};
+use super::{AppError, Overrides, bag, evaluate, load, report_json, resolve};
+use crate::input::{Format, examples, open_text};
 
 /// Samples `check` evaluates with (enough to exercise every path, quick on any input).
 pub const CHECK_SAMPLES: u64 = 32;
 
-/// `posecov list`: every bundled scenario with its title.
+/// `posecov list`: every bundled example with its title, by format.
 ///
 /// ```
-/// assert!(posecov::app::commands::list().unwrap().contains("camera_on_robot"));
+/// let list = posecov::app::commands::list().unwrap();
+/// assert!(list.contains("camera_on_robot") && list.contains("gtsam_pose3example"), "{list}");
 /// ```
 pub fn list() -> Result<String, AppError> {
-    let width = BUNDLED.iter().map(|b| b.name.len()).max().unwrap_or(0);
+    let examples = examples();
+    let width = examples.iter().map(|e| e.name.len()).max().unwrap_or(0);
     let mut out = String::new();
-    for b in BUNDLED {
-        let scenario = Scenario::parse(b.text, b.name)?;
-        let _ = writeln!(out, "{:width$}  {}", b.name, scenario.file.scenario.title);
+    for format in Format::ALL {
+        let of_format: Vec<_> = examples.iter().filter(|e| e.format == format).collect();
+        if of_format.is_empty() {
+            continue;
+        }
+        let extensions: Vec<String> = format
+            .extensions()
+            .iter()
+            .map(|e| format!(".{e}"))
+            .collect();
+        if !out.is_empty() {
+            out.push('\n');
+        }
+        let _ = writeln!(out, "{}s ({}):", format.name(), extensions.join(", "));
+        for e in of_format {
+            let title = match crate::input::bag::bundled::find(e.name) {
+                Some(log) => log.title.to_owned(),
+                None => open_text(e.text, e.file, e.format)?.1.about.title,
+            };
+            let _ = writeln!(out, "{:width$}  {title}", e.name);
+        }
     }
     Ok(out)
 }
@@ -32,6 +52,14 @@ pub fn list() -> Result<String, AppError> {
 /// assert_eq!(json["meta"]["samples"], 50);
 /// ```
 pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<String, AppError> {
+    if let Some(place) = bag::locate(scenario)? {
+        let run = bag::run(&place, scenario, overrides, None)?;
+        return Ok(if json {
+            serde_json::to_string_pretty(&bag::report_json(&run)).unwrap_or_default() + "\n"
+        } else {
+            bag::report_text(&run)
+        });
+    }
     let loaded = load(scenario)?;
     let settings = resolve(&loaded.input, overrides, None)?;
     let evaluation = evaluate(&loaded, &settings.eval)?;
@@ -94,6 +122,11 @@ pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> 
         ),
         ..overrides.clone()
     };
+    if let Some(place) = bag::locate(scenario)? {
+        return Ok(bag::check_line(&bag::run(
+            &place, scenario, overrides, None,
+        )?));
+    }
     let loaded = load(scenario)?;
     let (evaluation, scene) = super::pipeline(&loaded, &quick, None)?;
     let findings = evaluation.findings().len();

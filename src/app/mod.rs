@@ -17,10 +17,10 @@ use std::sync::atomic::AtomicBool;
 
 use crate::draw;
 use crate::eval::{self, AnyEvaluation, EvalError, EvalSettings};
-use crate::input::Input;
-use crate::input::scenario::{Scenario, ScenarioError, lower};
+use crate::input::{self, Format, Input, InputError, Source};
 use crate::scene::{Scene, SceneError};
 
+pub mod bag;
 pub mod commands;
 #[cfg(feature = "viewer")]
 pub mod session;
@@ -34,9 +34,10 @@ pub use settings::{
 /// file, line, column and key, or the command-line flag.
 #[derive(Debug, thiserror::Error)]
 pub enum AppError {
-    /// The input file (reading, syntax, values), or an evaluation error located in it.
+    /// The input file (reading, format, syntax, values), or an evaluation error located in
+    /// it.
     #[error(transparent)]
-    Input(#[from] ScenarioError),
+    Input(#[from] InputError),
     /// A command-line value.
     #[error(transparent)]
     Settings(#[from] SettingsError),
@@ -52,18 +53,18 @@ pub enum AppError {
     Watch(String),
 }
 
-/// An input and the file it came from (to locate evaluation errors in it).
+/// An input and the file it came from (to locate evaluation errors in it), of any format.
 #[derive(Debug, Clone)]
 pub struct Loaded {
-    /// The parsed file.
-    pub scenario: Scenario,
+    /// The parsed file (a scenario, a graph, …).
+    pub source: Source,
     /// The checked input.
     pub input: Input,
 }
 
 impl Loaded {
     /// An evaluation error, located at the operation it is about (`file:line:column:
-    /// operation[k]: …`), or at the file.
+    /// operation[k]: …` in a scenario, the edge's line in a graph), or at the file.
     ///
     /// ```
     /// use posecov::eval::EvalError;
@@ -71,7 +72,7 @@ impl Loaded {
     /// let e = loaded.locate(&EvalError::Undefined { operation: 0, output: "x".into(), definition: 9 });
     /// assert!(e.to_string().starts_with("camera_on_robot.toml (bundled):"), "{e}");
     /// ```
-    pub fn locate(&self, error: &EvalError) -> ScenarioError {
+    pub fn locate(&self, error: &EvalError) -> InputError {
         let message = error.to_string();
         // The location names the operation; keep its output's name, drop the repeated index.
         let message = match error.operation() {
@@ -81,20 +82,20 @@ impl Loaded {
                 .to_owned(),
             None => message,
         };
-        self.scenario.operation_error(error.operation(), message)
+        self.source.operation_error(error.operation(), message)
     }
 }
 
-/// Loads a bundled scenario by name, or a scenario file, and lowers it.
+/// Loads a file of any format posecov reads (by content and extension, see
+/// [`input::format`]) or a bundled example by name, and checks it ([`input::open`]).
 ///
 /// ```
 /// let e = posecov::app::load("no_such_thing").unwrap_err().to_string();
 /// assert!(e.contains("camera_on_robot"), "{e}");
 /// ```
 pub fn load(name_or_path: &str) -> Result<Loaded, AppError> {
-    let scenario = Scenario::load_any(name_or_path)?;
-    let input = lower(&scenario)?;
-    Ok(Loaded { scenario, input })
+    let (source, input) = input::open(name_or_path)?;
+    Ok(Loaded { source, input })
 }
 
 /// Parses and lowers scenario text (`origin` names it in messages).
@@ -104,9 +105,8 @@ pub fn load(name_or_path: &str) -> Result<Loaded, AppError> {
 /// assert!(e.to_string().starts_with("t.toml:4:9: scenario.samples: 1 is out of range"), "{e}");
 /// ```
 pub fn load_text(text: &str, origin: &str) -> Result<Loaded, AppError> {
-    let scenario = Scenario::parse(text, origin)?;
-    let input = lower(&scenario)?;
-    Ok(Loaded { scenario, input })
+    let (source, input) = input::open_text(text, origin, Format::Scenario)?;
+    Ok(Loaded { source, input })
 }
 
 /// Evaluates a loaded input with resolved settings, locating any error in the file.
@@ -155,6 +155,7 @@ pub fn report_json(
     let (seed, samples, block_samples, methods) = evaluation.run();
     serde_json::json!({
         "scenario": name,
+        "format": loaded.source.format(),
         "meta": {
             "title": loaded.input.about.title,
             "description": loaded.input.about.description,

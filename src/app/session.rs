@@ -210,6 +210,9 @@ fn scenario_name(scenario: &str) -> String {
 /// Shows a scenario: in the viewer, a file, stdout or a PNG; with `watch`, again on every
 /// change. Returns the process exit code.
 pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppError> {
+    if let Some(place) = super::bag::locate(&options.scenario)? {
+        return super::bag::view(options, &place, cancel);
+    }
     if options.watch {
         return watch(options, cancel);
     }
@@ -234,7 +237,11 @@ pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
     finish(guard, rec, &sink, outcome)
 }
 
-fn serve(options: &ServeOptions, guard: &SinkGuard, cancel: &AtomicBool) -> Result<(), AppError> {
+pub(crate) fn serve(
+    options: &ServeOptions,
+    guard: &SinkGuard,
+    cancel: &AtomicBool,
+) -> Result<(), AppError> {
     let limit = serve_limit(options)?;
     match limit {
         Some(l) => eprintln!("Serving for {} s (Ctrl-C stops).", l.as_secs()),
@@ -322,7 +329,7 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, AppError> {
     Ok(0)
 }
 
-fn finish(
+pub(crate) fn finish(
     guard: SinkGuard,
     rec: rerun::RecordingStream,
     sink: &Sink,
@@ -339,7 +346,7 @@ fn finish(
 }
 
 /// The sink asked for; without one: a native 0.36 viewer if available, else serve.
-fn choose_sink(options: &ViewOptions) -> Result<Sink, AppError> {
+pub(crate) fn choose_sink(options: &ViewOptions) -> Result<Sink, AppError> {
     if let Some(sink) = &options.sink {
         return Ok(sink.clone());
     }
@@ -383,6 +390,26 @@ fn render(
     size: (u32, u32),
     cancel: &AtomicBool,
 ) -> Result<u8, AppError> {
+    render_with(
+        options,
+        &session.scene,
+        &|rec| session.log(rec, cancel),
+        ids,
+        png,
+        size,
+    )
+}
+
+/// Saves a scene to an .rrd (`--save`, else a temporary file) with `log`, then renders it to
+/// `png` in the native viewer.
+pub(crate) fn render_with(
+    options: &ViewOptions,
+    scene: &Scene,
+    log: &dyn Fn(&rerun::RecordingStream) -> Result<LogOutcome, AppError>,
+    ids: &RecordingIds,
+    png: &Path,
+    size: (u32, u32),
+) -> Result<u8, AppError> {
     let viewer = find_native_viewer()?;
     let (rrd, temporary) = match &options.sink {
         Some(Sink::Save(path)) => (path.clone(), false),
@@ -392,8 +419,8 @@ fn render(
         ),
     };
     let sink = Sink::Save(rrd.clone());
-    let (rec, guard) = open_stream(&sink, ids, &session.scene)?;
-    let outcome = session.log(&rec, cancel)?;
+    let (rec, guard) = open_stream(&sink, ids, scene)?;
+    let outcome = log(&rec)?;
     guard.finish(rec)?;
     if outcome != LogOutcome::Complete {
         return Ok(EXIT_INTERRUPTED);

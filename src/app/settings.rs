@@ -25,6 +25,10 @@ pub struct Overrides {
     pub confidence: Option<f64>,
     /// `--block-samples`.
     pub block_samples: Option<u64>,
+    /// `--topic` (repeatable; robot logs only): the topics to read.
+    pub topics: Vec<String>,
+    /// `--every N` (robot logs only): draw every N-th message.
+    pub every: Option<u64>,
 }
 
 /// A command-line value out of range: names the flag, the value and what is accepted.
@@ -65,6 +69,20 @@ pub fn resolve(
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<Settings, SettingsError> {
     let file = &input.defaults;
+    if let Some(flag) = (!overrides.topics.is_empty())
+        .then_some("--topic")
+        .or(overrides.every.map(|_| "--every"))
+    {
+        return Err(SettingsError {
+            flag,
+            value: overrides
+                .topics
+                .first()
+                .cloned()
+                .unwrap_or_else(|| overrides.every.map_or_else(String::new, |n| n.to_string())),
+            expected: "a robot log (ROS 1 bag or MCAP file); this input is not one".to_owned(),
+        });
+    }
     if let Some(n) = overrides.samples
         && !(limits::MIN_SAMPLES..=limits::MAX_SAMPLES).contains(&n)
     {

@@ -174,8 +174,8 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
         Timing::Static,
         ItemKind::LineStrips(LineStrips {
             strips: vec![strip],
-            color: color.with_alpha(200),
-            radius: 0.15 * p.axis_length * 0.05,
+            color: color.with_alpha(220),
+            radius: 0.003 * p.extent,
         }),
     );
     history(p, &base, t);
@@ -266,7 +266,11 @@ fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
             let rviz = q.rviz.as_ref()?;
             let mean = q.mean?;
             let c = Vector3::from(flat(t.planar, mean.translation()));
-            Some(rviz_position(rviz, &c, r, p.extent, t.planar).0)
+            // A planar topic's overview shows RViz's ellipse in the plane (its 3-D shape of a
+            // placeholder is drawn, clipped, at the current stamp only).
+            let mut flat_rviz = *rviz;
+            flat_rviz.pose_2d |= t.planar;
+            Some(rviz_position(&flat_rviz, &c, r, p.extent, t.planar).0)
         })
         .collect();
     put(
@@ -325,7 +329,7 @@ fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
 }
 
 /// RViz's position shape: the 3-D ellipsoid of the parent-frame position block, or the
-/// ellipse of its x–y block when RViz takes the pose as 2-D; half sizes clipped at 3 × the
+/// ellipse of its x–y block when RViz takes the pose as 2-D; half sizes clipped at half the
 /// scene's size (a 1e6 placeholder would be kilometres). Returns the shape and whether it
 /// was clipped.
 fn rviz_position(
@@ -342,7 +346,7 @@ fn rviz_position(
         cov.column_mut(2).fill(0.0);
     }
     let mut shape = ellipsoid_of(center, &cov, r);
-    let limit = 3.0 * extent;
+    let limit = 0.5 * extent;
     let clipped = shape.half_sizes.iter().any(|h| *h > limit);
     for h in &mut shape.half_sizes {
         *h = h.min(limit);

@@ -276,6 +276,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
             );
         }
     }
+    links(&mut p, e);
     for point in &e.points {
         for (method, mean, cov) in &point.estimates {
             let shape = shapes::ellipsoid_of(mean, cov, chi2_radius(p.confidence(), 3));
@@ -331,6 +332,35 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     p.scene.plots = plots;
     p.scene.series = series;
     p.scene
+}
+
+/// The lines the input asks for between two poses (a graph's loop closures), at
+/// `world/links`, between the poses' nominal positions.
+fn links<G: LieGroup<N>, const N: usize>(p: &mut Painter, e: &Evaluation<G, N>) {
+    let position = |name: &str| {
+        e.nodes
+            .iter()
+            .find(|n| n.name == name)
+            .map(|n| v3(n.nominal.to_se3().translation()))
+    };
+    let strips: Vec<Vec<Vec3>> = p
+        .settings
+        .choices
+        .links
+        .iter()
+        .filter_map(|(a, b)| Some(vec![position(a)?, position(b)?]))
+        .collect();
+    if !strips.is_empty() {
+        p.push(
+            "world/links".to_owned(),
+            None,
+            ItemKind::LineStrips(LineStrips {
+                strips,
+                color: scene::LINK,
+                radius: 0.003 * p.extent.max(0.25),
+            }),
+        );
+    }
 }
 
 /// The Monte Carlo points of a `point_through_pose` output.

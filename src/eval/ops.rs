@@ -17,7 +17,9 @@ use crate::propagate::Propagated;
 use crate::propagate::first_order::{self, CorrelatedPair};
 use crate::propagate::fourth_order::Order;
 use crate::propagate::fusion::{FusionOptions, fuse};
-use crate::propagate::odometry::{InputNoise, propagate_increments, propagate_tangent_inputs};
+use crate::propagate::odometry::{
+    InputNoise, StepNoise, propagate_increments_each, propagate_tangent_inputs_each,
+};
 use crate::propagate::sigma_point::{self, Unscented};
 use crate::sample::{Sampler, fill_par_from, retract, standard_normal};
 use crate::uncertain::{Method, Side, UncertainPose};
@@ -257,7 +259,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         input: Operand<G>,
         model: OdometryModel,
         controls: &[Control<G, N>],
-        noise: &TangentMatrix<N>,
+        noise: &StepNoise<N>,
     ) -> Result<(), EvalError> {
         let (start, start_particles) = self.gaussian(input)?;
         let start_right = start.to_side(Side::Right);
@@ -265,12 +267,13 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let mut tracks: Vec<Vec<Propagated<G, N>>> = Vec::new();
         match model {
             OdometryModel::Increment => tracks.push(
-                propagate_increments(&start_right, &increments, noise).map_err(|e| self.math(e))?,
+                propagate_increments_each(&start_right, &increments, noise)
+                    .map_err(|e| self.math(e))?,
             ),
             OdometryModel::Exp => {
                 let inputs: Vec<Tangent<N>> = controls.iter().map(|c| c.tangent).collect();
                 tracks.push(
-                    propagate_tangent_inputs(
+                    propagate_tangent_inputs_each(
                         &start_right,
                         &inputs,
                         noise,
@@ -280,7 +283,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                 );
                 if self.wants(Method::LectureNoJr) {
                     tracks.push(
-                        propagate_tangent_inputs(
+                        propagate_tangent_inputs_each(
                             &start_right,
                             &inputs,
                             noise,
@@ -291,12 +294,21 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                 }
             }
         }
-        if self.wants(Method::VectorSpace) {
-            match G::ssc_odometry(&start_right, &increments, noise) {
-                Some(Ok(track)) => tracks.push(track),
-                Some(Err(e)) => self.method_failed(None, Method::VectorSpace, e.to_string()),
-                None => {}
+        match noise {
+            StepNoise::Same(noise) if self.wants(Method::VectorSpace) => {
+                match G::ssc_odometry(&start_right, &increments, noise) {
+                    Some(Ok(track)) => tracks.push(track),
+                    Some(Err(e)) => self.method_failed(None, Method::VectorSpace, e.to_string()),
+                    None => {}
+                }
             }
+            StepNoise::PerStep(_) if self.wants(Method::VectorSpace) => self.method_failed(
+                None,
+                Method::VectorSpace,
+                "the vector-space odometry baseline takes one noise covariance for every step"
+                    .to_owned(),
+            ),
+            _ => {}
         }
         let last = controls.len() as u64;
         let name = self.output();
@@ -306,11 +318,21 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let mut current: Option<Vec<G>> = self
             .monte_carlo
             .then(|| self.particles_of(&start, start_particles).as_ref().clone());
-        let sampler = Sampler::new(&UncertainPose::new_unchecked(
-            G::identity(),
-            *noise,
-            Side::Right,
-        ))
+        let sampler_of = |cov: TangentMatrix<N>| {
+            Sampler::new(&UncertainPose::new_unchecked(
+                G::identity(),
+                cov,
+                Side::Right,
+            ))
+        };
+        let samplers = match noise {
+            StepNoise::Same(cov) => sampler_of(*cov).map(|s| vec![s]),
+            StepNoise::PerStep(covs) if current.is_some() => covs
+                .iter()
+                .map(|c| sampler_of(*c))
+                .collect::<Result<_, _>>(),
+            StepNoise::PerStep(_) => Ok(Vec::new()),
+        }
         .map_err(|e| self.math(e))?;
         self.push_step(&name, 0, last, step_estimates(0), current.as_deref())?;
         for (k, control) in controls.iter().enumerate() {
@@ -318,7 +340,9 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                 self.out.findings.push(Finding::Interrupted);
                 break;
             }
-            if let Some(particles) = current.as_mut() {
+            if let (Some(particles), Some(sampler)) =
+                (current.as_mut(), samplers.get(k).or(samplers.first()))
+            {
                 let family = self.next_family();
                 let (seed, first_chunk) = (self.settings.seed, self.first_chunk());
                 fill_par_map(particles, seed, family, first_chunk, |rng, x| {

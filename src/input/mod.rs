@@ -2,10 +2,23 @@
 //! and produces an [`Input`]: a typed [`Plan`](crate::plan::Plan) plus the file's text and
 //! settings. Nothing after this stage reads a file format.
 //!
-//! - [`scenario`]: TOML scenario files (and the bundled lecture scenarios).
-//! - [`bag`]: robot logs, ROS 1 bags and MCAP files (ROS 2).
+//! - [`scenario`]: TOML scenario files (and the bundled lecture scenarios);
+//! - [`graph`]: g2o / GTSAM text pose graphs (and two bundled GTSAM examples);
+//! - [`bag`]: robot logs, ROS 1 bags and MCAP files (ROS 2), streamed.
+//!
+//! [`open`] is the one entry: it finds the file (or a bundled example by name), decides its
+//! [`Format`] by content and extension, and calls that format's reader. A new format is a
+//! [`Format`] variant, a [`Source`] variant and one arm in [`open_file`] and [`open_text`].
+//!
+//! ```
+//! use posecov::input::{Format, open};
+//! let (source, input) = open("camera_on_robot").unwrap();
+//! assert_eq!(source.format(), Format::Scenario);
+//! assert!(!input.about.title.is_empty());
+//! ```
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
 use serde::Serialize;
 
@@ -13,7 +26,181 @@ use crate::plan::AnyPlan;
 use crate::uncertain::Method;
 
 pub mod bag;
+pub mod format;
+pub mod graph;
+mod located;
 pub mod scenario;
+
+pub use format::Format;
+pub use located::{InputError, Locator};
+
+/// The file an [`Input`] came from, kept to locate later (evaluation) errors in it.
+#[derive(Debug, Clone)]
+pub enum Source {
+    /// A TOML scenario.
+    Scenario(scenario::Scenario),
+    /// A g2o / GTSAM pose graph.
+    Graph(graph::Graph),
+}
+
+impl Source {
+    /// The file's format.
+    ///
+    /// ```
+    /// use posecov::input::{Format, open};
+    /// assert_eq!(open("gtsam_pose2example").unwrap().0.format(), Format::Graph);
+    /// ```
+    pub fn format(&self) -> Format {
+        match self {
+            Source::Scenario(_) => Format::Scenario,
+            Source::Graph(_) => Format::Graph,
+        }
+    }
+
+    /// An error about plan operation `index` at the place in the file that defined it (a
+    /// scenario's `[[operation]]`, a graph's edge line), or about the file as a whole.
+    ///
+    /// ```
+    /// let (source, _) = posecov::input::open("gtsam_pose2example").unwrap();
+    /// let e = source.operation_error(None, "odd").to_string();
+    /// assert!(e.starts_with("gtsam_pose2example.txt (bundled):1:1: file: odd"), "{e}");
+    /// ```
+    pub fn operation_error(&self, index: Option<usize>, message: impl Into<String>) -> InputError {
+        match self {
+            Source::Scenario(s) => s.operation_error(index, message),
+            Source::Graph(g) => g.operation_error(index, message),
+        }
+    }
+}
+
+/// A bundled example: its name (what `posecov NAME` takes), format and text.
+#[derive(Debug, Clone, Copy)]
+pub struct Example {
+    /// Name, e.g. `camera_on_robot`.
+    pub name: &'static str,
+    /// Its format.
+    pub format: Format,
+    /// The file name it is shown under in messages, e.g. `camera_on_robot.toml`.
+    pub file: &'static str,
+    /// The file's text.
+    pub text: &'static str,
+}
+
+/// Every bundled example, scenarios first, then graphs, then robot logs (binary: their
+/// `text` is empty, see [`bag::bundled`]).
+///
+/// ```
+/// use posecov::input::{Format, examples};
+/// assert!(examples().iter().any(|e| e.format == Format::Graph));
+/// ```
+pub fn examples() -> Vec<Example> {
+    let scenarios = scenario::bundled::BUNDLED.iter().map(|b| Example {
+        name: b.name,
+        format: Format::Scenario,
+        file: b.file,
+        text: b.text,
+    });
+    scenarios
+        .chain(graph::bundled::examples())
+        .chain(bag::bundled::examples())
+        .collect()
+}
+
+/// Reads a file (its format by content and extension) or else a bundled example by name, and
+/// checks it. Errors name the file and the place in it.
+///
+/// ```
+/// let e = posecov::input::open("no_such_thing").unwrap_err().to_string();
+/// assert!(e.contains("camera_on_robot") && e.contains("gtsam_pose2example"), "{e}");
+/// ```
+pub fn open(name_or_path: &str) -> Result<(Source, Input), InputError> {
+    let path = Path::new(name_or_path);
+    if path.exists() {
+        return open_file(path);
+    }
+    let examples = examples();
+    let stem = |e: &Example| name_or_path == e.name || name_or_path == e.file;
+    match examples.iter().find(|e| stem(e)) {
+        Some(e) => open_text(e.text, &format!("{} (bundled)", e.file), e.format),
+        None => {
+            let by_format: Vec<String> = Format::ALL
+                .iter()
+                .filter_map(|f| {
+                    let names: Vec<&str> = examples
+                        .iter()
+                        .filter(|e| e.format == *f)
+                        .map(|e| e.name)
+                        .collect();
+                    (!names.is_empty()).then(|| format!("{}s: {}", f.name(), names.join(", ")))
+                })
+                .collect();
+            Err(InputError::Read {
+                path: name_or_path.to_owned(),
+                reason: format!(
+                    "no such file, and no bundled example of that name (see `posecov list`; {})",
+                    by_format.join("; ")
+                ),
+            })
+        }
+    }
+}
+
+/// Reads and checks a file whose format is decided by [`format::detect`].
+///
+/// ```
+/// let e = posecov::input::open_file(std::path::Path::new("/no/such.toml")).unwrap_err();
+/// assert!(e.to_string().starts_with("/no/such.toml: cannot read input"), "{e}");
+/// ```
+pub fn open_file(path: &Path) -> Result<(Source, Input), InputError> {
+    let file = path.display().to_string();
+    let format = format::detect(&file, &format::read_head(path)?)?;
+    match format {
+        Format::Scenario => {
+            let s = scenario::Scenario::load(path)?;
+            let input = scenario::lower(&s)?;
+            Ok((Source::Scenario(s), input))
+        }
+        Format::Graph => {
+            let (g, input) = graph::read_file(path)?;
+            Ok((Source::Graph(g), input))
+        }
+        Format::Ros1Bag | Format::Mcap => Err(not_a_plan(&file, format)),
+    }
+}
+
+/// Parses and checks text of a known format (`origin` names it in messages).
+///
+/// ```
+/// use posecov::input::{Format, open_text};
+/// let (_, input) = open_text("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 1 0 0 100 0 0 100 0 400\n", "g.g2o", Format::Graph).unwrap();
+/// assert!(input.about.title.contains("g.g2o"));
+/// ```
+pub fn open_text(text: &str, origin: &str, format: Format) -> Result<(Source, Input), InputError> {
+    match format {
+        Format::Scenario => {
+            let s = scenario::Scenario::parse(text, origin)?;
+            let input = scenario::lower(&s)?;
+            Ok((Source::Scenario(s), input))
+        }
+        Format::Graph => {
+            let (g, input) = graph::read_text(text, origin)?;
+            Ok((Source::Graph(g), input))
+        }
+        Format::Ros1Bag | Format::Mcap => Err(not_a_plan(origin, format)),
+    }
+}
+
+/// A robot log is streamed into a [`bag`] plan ([`bag::read_bag`]), not opened as an
+/// [`Input`]: the application routes it (`app::bag`).
+fn not_a_plan(file: &str, format: Format) -> InputError {
+    InputError::Format {
+        file: file.to_owned(),
+        message: format!(
+            "a {} is a robot log: it is streamed by input::bag::read_bag (posecov FILE, report, check)",
+            format.name()
+        ),
+    }
+}
 
 /// What an input describes, for the text panel and `posecov list`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -62,6 +249,8 @@ pub struct DrawChoices {
     pub top_view: Option<bool>,
     /// Per pose name, whether to draw it (overrides the default rule).
     pub shown: BTreeMap<String, bool>,
+    /// Pairs of pose names joined by a line (a pose graph's loop closures).
+    pub links: Vec<(String, String)>,
 }
 
 impl Default for DrawChoices {
@@ -77,6 +266,7 @@ impl Default for DrawChoices {
             axis_length: None,
             top_view: None,
             shown: BTreeMap::new(),
+            links: Vec::new(),
         }
     }
 }

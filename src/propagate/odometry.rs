@@ -39,6 +39,65 @@ pub enum InputNoise {
     LectureNoJr,
 }
 
+/// The noise covariance of each odometry step: one Σ_w for every step, or one per step (a
+/// pose graph's odometry edges each carry their own).
+///
+/// ```
+/// use posecov::propagate::odometry::StepNoise;
+/// use nalgebra::Matrix3;
+/// let each = StepNoise::PerStep(vec![Matrix3::identity(), Matrix3::identity() * 2.0]);
+/// assert_eq!(each.at(1)[(0, 0)], 2.0);
+/// assert_eq!(StepNoise::Same(Matrix3::<f64>::identity()).at(7)[(0, 0)], 1.0);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepNoise<const N: usize> {
+    /// The same Σ_w at every step.
+    Same(TangentMatrix<N>),
+    /// Σ_w of step k at index k (one per step).
+    PerStep(Vec<TangentMatrix<N>>),
+}
+
+impl<const N: usize> StepNoise<N> {
+    /// Σ_w of step `k` (the last one given beyond the end; zero if none is).
+    pub fn at(&self, k: usize) -> TangentMatrix<N> {
+        match self {
+            StepNoise::Same(m) => *m,
+            StepNoise::PerStep(v) => v
+                .get(k)
+                .or(v.last())
+                .copied()
+                .unwrap_or_else(TangentMatrix::<N>::zeros),
+        }
+    }
+
+    /// Each covariance checked (finite, symmetric, PSD) and symmetrised; a per-step list
+    /// must have one per step. Errors: the first bad covariance's, or the count.
+    ///
+    /// ```
+    /// use posecov::propagate::odometry::StepNoise;
+    /// use nalgebra::Matrix3;
+    /// let bad = StepNoise::PerStep(vec![Matrix3::identity(), -Matrix3::identity()]);
+    /// assert!(bad.validated(2).unwrap_err().to_string().contains("not positive semi-definite"));
+    /// assert!(StepNoise::PerStep(vec![Matrix3::<f64>::identity()]).validated(2).is_err());
+    /// ```
+    pub fn validated(&self, steps: usize) -> Result<Self> {
+        const WHAT: &str = "odometry noise covariance Σ_w";
+        match self {
+            StepNoise::Same(m) => Ok(StepNoise::Same(validate_covariance(WHAT, m)?)),
+            StepNoise::PerStep(v) if v.len() != steps => Err(crate::Error::WrongLength {
+                what: "odometry noise covariances Σ_w (one per step)",
+                expected: steps,
+                got: v.len(),
+            }),
+            StepNoise::PerStep(v) => v
+                .iter()
+                .map(|m| validate_covariance(WHAT, m))
+                .collect::<Result<Vec<_>>>()
+                .map(StepNoise::PerStep),
+        }
+    }
+}
+
 /// X_{k+1} = X_k · U_k · Exp(w_k), w_k ~ N(0, Σ_w) with Σ_w in the body frame at X_{k+1}
 /// (NA 568): right form Σ_{k+1} = Ad_{U_k⁻¹} Σ_k Ad_{U_k⁻¹}ᵀ + Σ_w, left form
 /// Σ_{k+1} = Σ_k + Ad_{X_{k+1}} Σ_w Ad_{X_{k+1}}ᵀ. First order (Exp(Ad ε) Exp(w) ≈ Exp(Ad ε + w)).
@@ -61,10 +120,39 @@ pub fn propagate_increments<G: LieGroup<N>, const N: usize>(
     increments: &[G],
     cov_noise: &TangentMatrix<N>,
 ) -> Result<Vec<Propagated<G, N>>> {
-    let cov_noise = validate_covariance("odometry noise covariance Σ_w", cov_noise)?;
+    propagate_increments_each(start, increments, &StepNoise::Same(*cov_noise))
+}
+
+/// [`propagate_increments`] with Σ_w given per step ([`StepNoise`]): X_{k+1} = X_k · U_k ·
+/// Exp(w_k), w_k ~ N(0, Σ_{w,k}) — a pose graph's odometry chain, Σ_{w,k} the covariance of
+/// edge k (k, k+1) in the body frame of vertex k+1 ([CONVENTIONS §9]).
+///
+/// [CONVENTIONS §9]: crate::conventions#9-pose-graphs-g2o-and-gtsam
+///
+/// ```
+/// use posecov::lie::{LieGroup, Se2};
+/// use posecov::propagate::odometry::{StepNoise, propagate_increments_each};
+/// use posecov::uncertain::UncertainPose;
+/// use nalgebra::Matrix3;
+/// let (a, b) = (Matrix3::identity() * 0.01, Matrix3::identity() * 0.04);
+/// let step = Se2::from_xy_theta(1.0, 0.0, 0.0);
+/// let path = propagate_increments_each(&UncertainPose::certain(Se2::identity()), &[step, step], &StepNoise::PerStep(vec![a, b])).unwrap();
+/// assert!((path[1].pose.cov() - a).norm() < 1e-15);
+/// let ad = step.inverse().adj();
+/// assert!((path[2].pose.cov() - (ad * a * ad.transpose() + b)).norm() < 1e-15);
+/// ```
+pub fn propagate_increments_each<G: LieGroup<N>, const N: usize>(
+    start: &UncertainPose<G, N>,
+    increments: &[G],
+    noise: &StepNoise<N>,
+) -> Result<Vec<Propagated<G, N>>> {
+    let noise = noise.validated(increments.len())?;
     Ok(recursion(
         start,
-        increments.iter().map(|u| (*u, cov_noise)),
+        increments
+            .iter()
+            .enumerate()
+            .map(|(k, u)| (*u, noise.at(k))),
         Method::FirstOrder,
     ))
 }
@@ -96,16 +184,38 @@ pub fn propagate_tangent_inputs<G: LieGroup<N>, const N: usize>(
     cov_noise: &TangentMatrix<N>,
     noise: InputNoise,
 ) -> Result<Vec<Propagated<G, N>>> {
+    propagate_tangent_inputs_each(start, inputs, &StepNoise::Same(*cov_noise), noise)
+}
+
+/// [`propagate_tangent_inputs`] with Σ_w given per step ([`StepNoise`]).
+///
+/// ```
+/// use posecov::lie::{LieGroup, Se2};
+/// use posecov::propagate::odometry::{InputNoise, StepNoise, propagate_tangent_inputs_each};
+/// use posecov::uncertain::UncertainPose;
+/// use nalgebra::{Matrix3, Vector3};
+/// let u = Vector3::new(1.0, 0.0, 0.0);
+/// let noise = StepNoise::PerStep(vec![Matrix3::identity() * 1e-4]);
+/// let path = propagate_tangent_inputs_each(&UncertainPose::certain(Se2::identity()), &[u], &noise, InputNoise::LectureNoJr).unwrap();
+/// assert!((path[1].pose.cov() - Matrix3::identity() * 1e-4).norm() < 1e-18);
+/// ```
+pub fn propagate_tangent_inputs_each<G: LieGroup<N>, const N: usize>(
+    start: &UncertainPose<G, N>,
+    inputs: &[Tangent<N>],
+    step_noise: &StepNoise<N>,
+    noise: InputNoise,
+) -> Result<Vec<Propagated<G, N>>> {
     check_finite(
         "odometry inputs u_k",
         inputs.iter().flat_map(|u| u.iter().copied()),
     )?;
-    let cov_noise = validate_covariance("odometry noise covariance Σ_w", cov_noise)?;
+    let step_noise = step_noise.validated(inputs.len())?;
     let method = match noise {
         InputNoise::RightJacobian => Method::FirstOrder,
         InputNoise::LectureNoJr => Method::LectureNoJr,
     };
-    let steps = inputs.iter().map(|u| {
+    let steps = inputs.iter().enumerate().map(|(k, u)| {
+        let cov_noise = step_noise.at(k);
         let q = match noise {
             InputNoise::RightJacobian => {
                 let jr = G::jr(u);

@@ -41,7 +41,7 @@ mod palette;
 mod validate;
 
 pub use mesh::unit_sphere_mesh;
-pub use palette::NOMINAL;
+pub use palette::{LINK, NOMINAL};
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
 pub type Vec3 = [f64; 3];

@@ -10,6 +10,8 @@ use crate::uncertain::Method;
 /// Colour of nominal (noise-free) poses and paths: Okabe–Ito blue, readable on the viewer's
 /// dark and light themes.
 pub const NOMINAL: Color = Color::rgb(0, 114, 178);
+/// Lines between poses (a pose graph's loop closures): neutral grey.
+pub const LINK: Color = Color::rgb(110, 110, 110);
 
 impl Method {
     /// Every method, in legend order.

@@ -6,7 +6,7 @@
 use nalgebra::{SMatrix, SVector};
 use posecov::eval::{AnyEvaluation, EvalSettings, Evaluation, Node, evaluate};
 use posecov::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
-use posecov::plan::{AnyPlan, Control, OdometryModel, Op, Plan, StepPolicy};
+use posecov::plan::{AnyPlan, Control, OdometryModel, Op, Plan, StepNoise, StepPolicy};
 use posecov::sample::SampleStatistics;
 use posecov::uncertain::Method;
 use rand::{Rng, SeedableRng};
@@ -301,7 +301,7 @@ pub fn odometry_plan<G: LieGroup<N>, const N: usize>(
             input,
             model,
             controls,
-            noise,
+            noise: StepNoise::Same(noise),
         },
     );
     plan

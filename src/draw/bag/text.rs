@@ -36,7 +36,7 @@ pub fn description(plan: &BagPlan, e: &BagEvaluation, confidence: f64) -> String
         topic(&mut s, t, te, confidence);
     }
     if !plan.skipped.is_empty() {
-        let _ = writeln!(s, "\n### Skipped (other message types)\n");
+        let _ = writeln!(s, "\n---\n\n**Skipped** (other message types):\n");
         for k in &plan.skipped {
             let _ = writeln!(s, "- `{}`: {} × {}", k.name, k.count, k.message_type);
         }
@@ -54,12 +54,12 @@ pub fn description(plan: &BagPlan, e: &BagEvaluation, confidence: f64) -> String
     }
     let _ = writeln!(
         s,
-        "\n### The two pictures\n\n\
+        "\n---\n\n**The two pictures**\n\n\
          - **RViz's picture** (magenta, `rviz/`): the ellipsoid of the covariance's position \
          block read in the parent frame's axes, and orientation discs at the axis tips \
          (tan of the angular spread, bounded at 89°) — a yaw fan when RViz takes the pose as \
          2-D (Σzz, Σroll, Σpitch ≤ 0; a 1e6 placeholder makes it draw a 3-D shape kilometres \
-         tall, clipped here).\n\
+         tall, clipped here at half the scene's size).\n\
          - **What the numbers mean** (`meaning/`): ROS's covariance (position error in the \
          parent's axes, rotation error local) converted to posecov's body-frame right form, \
          X = μ · Exp(ε); its Exp-mapped banana, Cartesian ellipsoid and a seeded sample cloud \
@@ -71,7 +71,7 @@ pub fn description(plan: &BagPlan, e: &BagEvaluation, confidence: f64) -> String
 }
 
 fn topic(s: &mut String, t: &TopicPlan, e: &crate::eval::bag::TopicEvaluation, p: f64) {
-    let _ = writeln!(s, "\n### `{}` ({})\n", t.name, t.kind.ros1_name());
+    let _ = writeln!(s, "\n---\n\n**{}** ({})\n", t.name, t.kind.ros1_name());
     if !t.frame_id.is_empty() || !t.child_frame_id.is_empty() {
         let child = if t.child_frame_id.is_empty() {
             String::new()

@@ -11,7 +11,8 @@ use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use super::decode::ros2_kind;
-use super::{BagError, Codec, Collector};
+use super::{Codec, Collector};
+use crate::input::InputError;
 use crate::plan::bag::PoseMessageKind;
 
 /// The largest record (or decompressed chunk) read: larger ones are refused, not allocated.
@@ -30,14 +31,14 @@ pub(super) fn read(
     path: &Path,
     collector: &mut Collector<'_>,
     progress: &mut dyn FnMut(u64, u64),
-) -> Result<(), BagError> {
-    let io = |source| BagError::Io {
+) -> Result<(), InputError> {
+    let io = |source: std::io::Error| InputError::Read {
         path: path.display().to_string(),
-        source,
+        reason: source.to_string(),
     };
-    let fail = |what: String| BagError::Format {
-        path: path.display().to_string(),
-        what,
+    let fail = |what: String| InputError::Format {
+        file: path.display().to_string(),
+        message: what,
     };
     let mut file = std::fs::File::open(path).map_err(io)?;
     let total = file.metadata().map_err(io)?.len();

@@ -17,7 +17,6 @@
 //! ```
 
 use std::collections::BTreeMap;
-use std::io::Read;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -26,6 +25,10 @@ use crate::plan::bag::{
     SkippedTopic, TopicPlan,
 };
 
+use super::InputError;
+use super::format::{self, Format};
+
+pub mod bundled;
 pub mod decode;
 pub mod health;
 mod mcap;
@@ -40,11 +43,6 @@ pub const DEFAULT_MAX_DRAWN: usize = 200;
 pub const MAX_DRAWN_LIMIT: usize = 5000;
 /// Points kept per topic for the trajectory and the time series (density halves beyond).
 pub const MAX_SERIES: usize = 20_000;
-
-/// The first bytes of a ROS 1 bag.
-pub const ROS1_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
-/// The first bytes of an MCAP file.
-pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
 
 /// What to read and how much to keep.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,67 +62,10 @@ impl Default for BagOptions {
     }
 }
 
-/// Why a log could not be read. Each names the file.
-#[derive(Debug, thiserror::Error)]
-pub enum BagError {
-    /// Opening or reading the file.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The error.
-        source: std::io::Error,
-    },
-    /// The container is damaged or not what its magic bytes say.
-    #[error("{path}: {what}")]
-    Format {
-        /// The file.
-        path: String,
-        /// What is wrong, where.
-        what: String,
-    },
-    /// `--topic` named a topic the log does not have (or not of a pose type).
-    #[error("{path}: --topic {topic}: {why}")]
-    Topic {
-        /// The file.
-        path: String,
-        /// The name given.
-        topic: String,
-        /// What the log has instead.
-        why: String,
-    },
-}
-
-/// The format of a file by its magic bytes (then by its extension, `.bag` / `.mcap`).
-///
-/// ```
-/// use posecov::input::bag::detect;
-/// use posecov::plan::bag::LogFormat;
-/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
-/// assert_eq!(detect(path.as_ref()), Some(LogFormat::Ros1Bag));
-/// assert_eq!(detect("Cargo.toml".as_ref()), None);
-/// ```
-pub fn detect(path: &Path) -> Option<LogFormat> {
-    let mut head = [0u8; 13];
-    let n = std::fs::File::open(path)
-        .and_then(|mut f| f.read(&mut head))
-        .unwrap_or(0);
-    if head[..n].starts_with(ROS1_MAGIC) {
-        return Some(LogFormat::Ros1Bag);
-    }
-    if head[..n].starts_with(MCAP_MAGIC) {
-        return Some(LogFormat::Mcap);
-    }
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("bag") => Some(LogFormat::Ros1Bag),
-        Some("mcap") => Some(LogFormat::Mcap),
-        _ => None,
-    }
-}
-
-/// Reads a log into a [`BagPlan`]. `progress(done, total)` is called as the read advances
-/// (bytes or chunks); a raised `cancel` stops the read at the next message and marks the plan
-/// `cancelled` (everything before is kept).
+/// Reads a log into a [`BagPlan`]; its format by content and extension ([`format::detect`]).
+/// `progress(done, total)` is called as the read advances (chunks or bytes); a raised `cancel`
+/// stops the read at the next message and marks the plan `cancelled` (everything before is
+/// kept). Errors name the file: unreadable, damaged, not a log, or a `--topic` it lacks.
 ///
 /// See the [module docs](self) for an example.
 pub fn read_bag(
@@ -132,11 +73,18 @@ pub fn read_bag(
     options: &BagOptions,
     progress: &mut dyn FnMut(u64, u64),
     cancel: Option<&AtomicBool>,
-) -> Result<BagPlan, BagError> {
-    let format = detect(path).ok_or_else(|| BagError::Format {
-        path: path.display().to_string(),
-        what: "neither a ROS 1 bag (#ROSBAG V2.0) nor an MCAP file (\\x89MCAP0)".into(),
-    })?;
+) -> Result<BagPlan, InputError> {
+    let file = path.display().to_string();
+    let format = match format::detect(&file, &format::read_head(path)?)? {
+        Format::Ros1Bag => LogFormat::Ros1Bag,
+        Format::Mcap => LogFormat::Mcap,
+        other => {
+            return Err(InputError::Format {
+                file,
+                message: format!("a {}, not a robot log (ROS 1 bag or MCAP)", other.name()),
+            });
+        }
+    };
     let mut collector = Collector::new(options, cancel);
     match format {
         LogFormat::Ros1Bag => ros1::read(path, &mut collector, progress)?,
@@ -296,7 +244,7 @@ impl<'a> Collector<'a> {
         state.add(decoded, log_time_ns);
     }
 
-    fn finish(self, path: &Path, format: LogFormat) -> Result<BagPlan, BagError> {
+    fn finish(self, path: &Path, format: LogFormat) -> Result<BagPlan, InputError> {
         for wanted in &self.options.topics {
             if !self.topics.contains_key(wanted) && !self.cancelled {
                 let why = match self.skipped.get(wanted) {
@@ -318,10 +266,9 @@ impl<'a> Collector<'a> {
                         )
                     }
                 };
-                return Err(BagError::Topic {
-                    path: path.display().to_string(),
-                    topic: wanted.clone(),
-                    why,
+                return Err(InputError::Format {
+                    file: path.display().to_string(),
+                    message: format!("--topic {wanted}: {why}"),
                 });
             }
         }

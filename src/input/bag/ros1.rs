@@ -9,7 +9,9 @@ use std::path::Path;
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
 use super::decode::ros1_kind;
-use super::{BagError, Codec, Collector, ROS1_MAGIC};
+use super::{Codec, Collector};
+use crate::input::InputError;
+use crate::input::format::ROSBAG_MAGIC as ROS1_MAGIC;
 use crate::plan::bag::PoseMessageKind;
 
 /// A connection: topic, type, what posecov makes of it.
@@ -30,14 +32,14 @@ fn conn_of(c: &rosbag::record_types::Connection<'_>) -> Conn {
 
 /// Checks the bag header before the crate maps it: the index position must lie inside the
 /// file (a bag whose recording was interrupted has `index_pos = 0` and must be reindexed).
-fn check_header(path: &Path) -> Result<(), BagError> {
-    let err = |what: String| BagError::Format {
-        path: path.display().to_string(),
-        what,
+fn check_header(path: &Path) -> Result<(), InputError> {
+    let err = |what: String| InputError::Format {
+        file: path.display().to_string(),
+        message: what,
     };
-    let io = |source| BagError::Io {
+    let io = |source: std::io::Error| InputError::Read {
         path: path.display().to_string(),
-        source,
+        reason: source.to_string(),
     };
     let mut file = std::fs::File::open(path).map_err(io)?;
     let len = file.metadata().map_err(io)?.len();
@@ -94,15 +96,15 @@ pub(super) fn read(
     path: &Path,
     collector: &mut Collector<'_>,
     progress: &mut dyn FnMut(u64, u64),
-) -> Result<(), BagError> {
+) -> Result<(), InputError> {
     check_header(path)?;
-    let fail = |what: String| BagError::Format {
-        path: path.display().to_string(),
-        what,
+    let fail = |what: String| InputError::Format {
+        file: path.display().to_string(),
+        message: what,
     };
-    let bag = RosBag::new(path).map_err(|source| BagError::Io {
+    let bag = RosBag::new(path).map_err(|source| InputError::Read {
         path: path.display().to_string(),
-        source,
+        reason: source.to_string(),
     })?;
     // Connections from the index section (every topic and type up front), then any the
     // chunks declare themselves.

@@ -6,6 +6,8 @@
 pub struct Bundled {
     /// Name (the file stem), e.g. `camera_on_robot`.
     pub name: &'static str,
+    /// The file name, e.g. `camera_on_robot.toml`.
+    pub file: &'static str,
     /// The TOML text.
     pub text: &'static str,
 }
@@ -14,7 +16,7 @@ macro_rules! bundled {
     ($($name:literal),* $(,)?) => {
         /// Every bundled scenario, in teaching order.
         pub const BUNDLED: &[Bundled] = &[
-            $(Bundled { name: $name, text: include_str!(concat!("../../../assets/scenarios/", $name, ".toml")) }),*
+            $(Bundled { name: $name, file: concat!($name, ".toml"), text: include_str!(concat!("../../../assets/scenarios/", $name, ".toml")) }),*
         ];
     };
 }

@@ -26,9 +26,9 @@
 //! assert!(err.to_string().starts_with("demo.toml:8:"), "{err}");
 //! ```
 
-use std::fmt;
-use std::ops::Range;
 use std::path::Path;
+
+pub use crate::input::{InputError, Locator};
 
 pub mod bundled;
 mod lower;
@@ -40,122 +40,8 @@ pub use lower::{OPERATION_KINDS, lower};
 pub use schema::{GroupName, ScenarioFile};
 pub use values::{SpecGroup, ValueError};
 
-/// A scenario file could not be read, parsed or validated.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ScenarioError {
-    /// The file could not be read.
-    Read {
-        /// The path given.
-        path: String,
-        /// The operating system's reason.
-        reason: String,
-    },
-    /// Something in the file is wrong, at a known place.
-    At {
-        /// File name as given.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column (in characters).
-        column: usize,
-        /// The TOML key or section concerned (e.g. `pose[2].cov`).
-        field: String,
-        /// What is wrong and what is expected.
-        message: String,
-        /// The source line, for context.
-        source_line: String,
-    },
-}
-
-impl std::error::Error for ScenarioError {}
-
-impl fmt::Display for ScenarioError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ScenarioError::Read { path, reason } => {
-                write!(f, "{path}: cannot read scenario: {reason}")
-            }
-            ScenarioError::At {
-                file,
-                line,
-                column,
-                field,
-                message,
-                source_line,
-            } => {
-                write!(f, "{file}:{line}:{column}: {field}: {message}")?;
-                if !source_line.is_empty() {
-                    let pad = " ".repeat(column.saturating_sub(1));
-                    write!(f, "\n  | {source_line}\n  | {pad}^")?;
-                }
-                Ok(())
-            }
-        }
-    }
-}
-
-/// Maps byte spans of one source text to `line:column` errors.
-#[derive(Debug, Clone)]
-pub struct Locator {
-    file: String,
-    text: String,
-}
-
-impl Locator {
-    /// A locator for `text` read from `file`.
-    ///
-    /// ```
-    /// use posecov::input::scenario::Locator;
-    /// let l = Locator::new("a.toml", "x = 1\ny = 2\n");
-    /// assert_eq!(l.error(6..7, "y", "bad").to_string().lines().next().unwrap(), "a.toml:2:1: y: bad");
-    /// ```
-    pub fn new(file: &str, text: &str) -> Self {
-        Self {
-            file: file.to_owned(),
-            text: text.to_owned(),
-        }
-    }
-
-    /// An error at the start of `span`.
-    ///
-    /// ```
-    /// use posecov::input::scenario::Locator;
-    /// let e = Locator::new("f.toml", "abc").error(1..2, "k", "m");
-    /// assert!(e.to_string().starts_with("f.toml:1:2: k: m"));
-    /// ```
-    pub fn error(
-        &self,
-        span: Range<usize>,
-        field: &str,
-        message: impl Into<String>,
-    ) -> ScenarioError {
-        let start = span.start.min(self.text.len());
-        let before = &self.text[..floor_char_boundary(&self.text, start)];
-        let line = before.matches('\n').count() + 1;
-        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-        let column = before[line_start..].chars().count() + 1;
-        let source_line = self.text[line_start..]
-            .lines()
-            .next()
-            .unwrap_or("")
-            .to_owned();
-        ScenarioError::At {
-            file: self.file.clone(),
-            line,
-            column,
-            field: field.to_owned(),
-            message: message.into(),
-            source_line,
-        }
-    }
-}
-
-fn floor_char_boundary(s: &str, mut i: usize) -> usize {
-    while i > 0 && !s.is_char_boundary(i) {
-        i -= 1;
-    }
-    i
-}
+/// Scenario errors are [`InputError`]s: located at `file:line:column: key`.
+pub type ScenarioError = InputError;
 
 /// A parsed, syntactically valid scenario with its source (for error locations).
 #[derive(Debug, Clone)]
@@ -246,7 +132,7 @@ impl Scenario {
     /// ```
     /// use posecov::input::scenario::Scenario;
     /// let e = Scenario::load(std::path::Path::new("/no/such/file.toml")).unwrap_err();
-    /// assert!(e.to_string().starts_with("/no/such/file.toml: cannot read scenario"));
+    /// assert!(e.to_string().starts_with("/no/such/file.toml: cannot read input"));
     /// ```
     pub fn load(path: &Path) -> Result<Self, ScenarioError> {
         let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read {

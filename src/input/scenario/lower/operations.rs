@@ -8,7 +8,9 @@ use super::super::values::{SpecGroup, control_for, fixed_matrix};
 use super::{Bounds, Lowering, Table};
 use crate::input::scenario::ScenarioError;
 use crate::lie::{GroupKind, TangentMatrix};
-use crate::plan::{DiffDriveMotion, FrameSide, OdometryModel, Op, Operand, PoseValue, limits};
+use crate::plan::{
+    DiffDriveMotion, FrameSide, OdometryModel, Op, Operand, PoseValue, StepNoise, limits,
+};
 use crate::propagate::first_order::CorrelatedPair;
 use crate::uncertain::{Side, UncertainPose};
 
@@ -261,7 +263,7 @@ impl Lowering<'_> {
             input,
             model,
             controls,
-            noise,
+            noise: StepNoise::Same(noise),
         })
     }
 

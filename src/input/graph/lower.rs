@@ -1,0 +1,423 @@
+//! Records → a checked plan: vertex poses, edge covariances, the odometry chain and the loop
+//! closures (see the [module docs](super)). Every check names the line and the value.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use nalgebra::SMatrix;
+
+use super::convention::{from_upper_triangle, se3_cov_from_g2o_error_cov};
+use super::parse::{Dimension, Kind, Record, Records, information_axes};
+use super::{InputError, Locator, Summary};
+use crate::input::{About, DrawChoices, FileSettings, Input};
+use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
+use crate::plan::{
+    AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, limits,
+};
+use crate::uncertain::{Method, Side, UncertainPose};
+
+/// Most loop closures evaluated and drawn with their uncertainty (evenly chosen); the rest
+/// are counted in the text panel.
+pub const MAX_LOOP_CLOSURES: usize = 30;
+
+/// Most vertex estimates drawn as axes (evenly chosen, plus the loop closures' ends).
+pub const MAX_DRAWN_VERTICES: usize = 2000;
+
+/// What the two pose-graph groups need besides being Lie groups.
+trait GraphGroup<const N: usize>: LieGroup<N> {
+    /// A pose from the file's values (x y θ, or x y z qx qy qz qw).
+    fn from_values(values: &[f64]) -> crate::Result<Self>;
+    /// posecov's [ρ; θ] covariance from g2o's error covariance Ω⁻¹ ([`super::convention`]).
+    fn cov_from_error_cov(cov_error: &TangentMatrix<N>) -> TangentMatrix<N>;
+    /// The plan of this group.
+    fn any(plan: Plan<Self, N>) -> AnyPlan;
+}
+
+impl GraphGroup<3> for Se2 {
+    fn from_values(v: &[f64]) -> crate::Result<Self> {
+        Ok(Se2::from_xy_theta(v[0], v[1], v[2]))
+    }
+    fn cov_from_error_cov(cov_error: &TangentMatrix<3>) -> TangentMatrix<3> {
+        *cov_error
+    }
+    fn any(plan: Plan<Self, 3>) -> AnyPlan {
+        AnyPlan::Se2(plan)
+    }
+}
+
+impl GraphGroup<6> for Se3 {
+    fn from_values(v: &[f64]) -> crate::Result<Self> {
+        Se3::try_from_xyz_quaternion_xyzw([v[0], v[1], v[2]], [v[3], v[4], v[5], v[6]])
+    }
+    fn cov_from_error_cov(cov_error: &TangentMatrix<6>) -> TangentMatrix<6> {
+        se3_cov_from_g2o_error_cov(cov_error)
+    }
+    fn any(plan: Plan<Self, 6>) -> AnyPlan {
+        AnyPlan::Se3(plan)
+    }
+}
+
+/// A checked edge.
+struct Edge<G: LieGroup<N>, const N: usize> {
+    from: u64,
+    to: u64,
+    line: usize,
+    measurement: G,
+    /// Right-perturbation covariance over [ρ; θ] in the frame of X_from · Z.
+    cov: TangentMatrix<N>,
+}
+
+/// The plan, the line of each operation's edge, and the counts.
+pub(super) type Lowered = (Input, Vec<usize>, Summary);
+
+pub(super) fn lower(locator: &Locator, records: &Records) -> Result<Lowered, InputError> {
+    match records.records.first().map(|r| r.tag.dimension) {
+        Some(Dimension::Spatial) => build::<Se3, 6>(locator, records),
+        _ => build::<Se2, 3>(locator, records),
+    }
+}
+
+fn label(r: &Record) -> String {
+    let ids: Vec<String> = r.ids.iter().map(|(id, _)| id.to_string()).collect();
+    format!("{} {}", r.tag.name, ids.join(" "))
+}
+
+/// Σ = conversion(Ω⁻¹) of an edge, with every failure at the information's first number.
+fn edge_cov<G: GraphGroup<N>, const N: usize>(
+    locator: &Locator,
+    r: &Record,
+) -> Result<TangentMatrix<N>, InputError> {
+    let values: Vec<f64> = r.information.iter().map(|v| v.value).collect();
+    let information: SMatrix<f64, N, N> = from_upper_triangle::<N>(&values);
+    let at = r.information.first().map_or(r.at, |v| v.at);
+    let axes = information_axes(r.tag.dimension).join(", ");
+    let error =
+        |message: String| locator.error(at..at, &format!("{} information", label(r)), message);
+    let Some(cholesky) = information.cholesky() else {
+        let smallest = nalgebra::DMatrix::from_iterator(N, N, information.iter().copied())
+            .symmetric_eigenvalues()
+            .min();
+        return Err(error(format!(
+            "the information matrix over ({axes}) is not positive definite (smallest eigenvalue {smallest:.6e}); an edge's information must be, or the measurement says nothing in some direction"
+        )));
+    };
+    let cov_error = cholesky.inverse();
+    let cov = G::cov_from_error_cov(&((cov_error + cov_error.transpose()) * 0.5));
+    let largest = cov.amax();
+    if !largest.is_finite() || largest > limits::MAX_VARIANCE {
+        return Err(error(format!(
+            "the information matrix is so small that a variance reaches {largest:.3e} (σ beyond {:.0e}); posecov draws variances up to {:.0e}",
+            limits::MAX_VARIANCE.sqrt(),
+            limits::MAX_VARIANCE
+        )));
+    }
+    Ok(cov)
+}
+
+fn build<G: GraphGroup<N>, const N: usize>(
+    locator: &Locator,
+    records: &Records,
+) -> Result<Lowered, InputError> {
+    let mut vertices: BTreeMap<u64, (G, usize)> = BTreeMap::new();
+    let mut edges: Vec<Edge<G, N>> = Vec::new();
+    for r in &records.records {
+        let values: Vec<f64> = r.pose.iter().map(|v| v.value).collect();
+        let pose_at = r.pose.first().map_or(r.at, |v| v.at);
+        let pose = G::from_values(&values)
+            .map_err(|e| locator.error(pose_at..pose_at, &label(r), e.to_string()))?;
+        check_coordinates(locator, r)?;
+        match r.tag.kind {
+            Kind::Vertex => {
+                let (id, id_at) = r.ids[0];
+                if let Some((_, first)) = vertices.get(&id) {
+                    return Err(locator.error(
+                        id_at..id_at,
+                        &label(r),
+                        format!("vertex {id} is defined twice (first on line {first})"),
+                    ));
+                }
+                vertices.insert(id, (pose, r.line));
+            }
+            Kind::Edge => {
+                let ((from, _), (to, to_at)) = (r.ids[0], r.ids[1]);
+                if from == to {
+                    return Err(locator.error(
+                        to_at..to_at,
+                        &label(r),
+                        format!("an edge from vertex {from} to itself says nothing"),
+                    ));
+                }
+                edges.push(Edge {
+                    from,
+                    to,
+                    line: r.line,
+                    measurement: pose,
+                    cov: edge_cov::<G, N>(locator, r)?,
+                });
+            }
+        }
+    }
+    if vertices.is_empty() {
+        let r = &records.records[0];
+        return Err(locator.error(
+            r.at..r.at,
+            r.tag.name,
+            "the file has edges but no vertices: posecov draws the vertex estimates and starts the chain at the first one",
+        ));
+    }
+    if vertices.len() as u64 > limits::MAX_STEPS + 1 {
+        return Err(locator.error(
+            0..0,
+            "file",
+            format!(
+                "{} vertices; posecov draws graphs of up to {} vertices",
+                vertices.len(),
+                limits::MAX_STEPS + 1
+            ),
+        ));
+    }
+    for (r, e) in records
+        .records
+        .iter()
+        .filter(|r| r.tag.kind == Kind::Edge)
+        .zip(&edges)
+    {
+        for (id, at) in &r.ids {
+            if !vertices.contains_key(id) {
+                return Err(locator.error(
+                    *at..*at,
+                    &label(r),
+                    format!(
+                        "vertex {id} is not defined (no VERTEX line has id {id}); edge {} → {} cannot be drawn",
+                        e.from, e.to
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(assemble(locator, records, &vertices, &edges))
+}
+
+/// Positions beyond [`limits::MAX_COORDINATE`] cannot be drawn.
+fn check_coordinates(locator: &Locator, r: &Record) -> Result<(), InputError> {
+    let translation = match r.tag.dimension {
+        Dimension::Planar => &r.pose[..2],
+        Dimension::Spatial => &r.pose[..3],
+    };
+    match translation
+        .iter()
+        .find(|v| v.value.abs() > limits::MAX_COORDINATE)
+    {
+        Some(v) => Err(locator.error(
+            v.at..v.at,
+            &label(r),
+            format!(
+                "coordinate {} is beyond ±{:.0e} m, too far to draw",
+                v.value,
+                limits::MAX_COORDINATE
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The odometry chain: from the first vertex, the first edge (k, k+1) or (k+1, k) of each
+/// consecutive pair, as (edge index, increment, covariance) — a reversed edge inverted:
+/// (Z Exp(ξ))⁻¹ = Z⁻¹ Exp(−Ad_Z ξ), so Σ' = Ad_Z Σ Ad_Zᵀ.
+fn chain<G: LieGroup<N>, const N: usize>(
+    vertices: &BTreeMap<u64, (G, usize)>,
+    edges: &[Edge<G, N>],
+) -> Vec<(usize, G, TangentMatrix<N>)> {
+    let mut first_edge: BTreeMap<(u64, u64), usize> = BTreeMap::new();
+    for (i, e) in edges.iter().enumerate() {
+        if e.from.abs_diff(e.to) == 1 {
+            first_edge
+                .entry((e.from.min(e.to), e.from.max(e.to)))
+                .or_insert(i);
+        }
+    }
+    let mut out = Vec::new();
+    let Some(mut k) = vertices.keys().next().copied() else {
+        return out;
+    };
+    while let Some(&i) = k.checked_add(1).and_then(|next| first_edge.get(&(k, next))) {
+        let e = &edges[i];
+        if e.from == k {
+            out.push((i, e.measurement, e.cov));
+        } else {
+            let ad = e.measurement.adj();
+            out.push((i, e.measurement.inverse(), ad * e.cov * ad.transpose()));
+        }
+        k += 1;
+    }
+    out
+}
+
+/// At most `max` of `0..n`, evenly spaced (all when n ≤ max).
+fn evenly(n: usize, max: usize) -> Vec<usize> {
+    if n <= max {
+        return (0..n).collect();
+    }
+    (0..max).map(|k| k * (n - 1) / (max - 1).max(1)).collect()
+}
+
+fn vertex_name(id: u64) -> String {
+    format!("v{id}")
+}
+
+fn assemble<G: GraphGroup<N>, const N: usize>(
+    locator: &Locator,
+    records: &Records,
+    vertices: &BTreeMap<u64, (G, usize)>,
+    edges: &[Edge<G, N>],
+) -> Lowered {
+    let chain = chain(vertices, edges);
+    let in_chain: BTreeSet<usize> = chain.iter().map(|c| c.0).collect();
+    let loops: Vec<usize> = (0..edges.len()).filter(|i| !in_chain.contains(i)).collect();
+    let drawn_loops: Vec<usize> = evenly(loops.len(), MAX_LOOP_CLOSURES)
+        .into_iter()
+        .map(|k| loops[k])
+        .collect();
+    let ids: Vec<u64> = vertices.keys().copied().collect();
+    let mut drawn_ids: BTreeSet<u64> = evenly(ids.len(), MAX_DRAWN_VERTICES)
+        .into_iter()
+        .map(|k| ids[k])
+        .collect();
+    drawn_ids.extend(
+        drawn_loops
+            .iter()
+            .flat_map(|&i| [edges[i].from, edges[i].to]),
+    );
+
+    let mut plan = Plan::<G, N>::default();
+    let mut choices = DrawChoices {
+        sample_axes: false,
+        ..DrawChoices::default()
+    };
+    let mut operation_lines = Vec::new();
+    for id in &drawn_ids {
+        let name = vertex_name(*id);
+        plan.known(&name, vertices[id].0);
+        choices.shown.insert(name, true);
+    }
+    let first = ids[0];
+    if let Some(&(first_edge, ..)) = chain.first() {
+        plan.operation(
+            "odometry_chain",
+            Op::Odometry {
+                input: Operand::Known(vertices[&first].0),
+                model: OdometryModel::Increment,
+                controls: chain
+                    .iter()
+                    .map(|(_, z, _)| Control {
+                        increment: *z,
+                        tangent: z.log(),
+                    })
+                    .collect(),
+                noise: StepNoise::PerStep(chain.iter().map(|c| c.2).collect()),
+            },
+        );
+        operation_lines.push(edges[first_edge].line);
+        choices.shown.insert("odometry_chain".to_owned(), true);
+    }
+    for &i in &drawn_loops {
+        let e = &edges[i];
+        let measured = format!("v{}_to_v{}_measured", e.from, e.to);
+        let mut via = format!("v{}_via_v{}", e.to, e.from);
+        if choices.shown.contains_key(&via) {
+            via = format!("{via}_line{}", e.line);
+        }
+        let input = plan.uncertain(
+            &measured,
+            UncertainPose::new_unchecked(e.measurement, e.cov, Side::Right),
+        );
+        choices.shown.insert(measured, false);
+        plan.operation(
+            &via,
+            Op::ChangeFrame {
+                input,
+                by: vertices[&e.from].0,
+                side: FrameSide::Left,
+            },
+        );
+        operation_lines.push(e.line);
+        choices.shown.insert(via, true);
+        choices.links.push((vertex_name(e.from), vertex_name(e.to)));
+    }
+    let mut steps: Vec<f64> = chain
+        .iter()
+        .map(|(_, z, _)| z.to_se3().translation().norm())
+        .filter(|d| *d > 0.0)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    if let Some(median) = steps.get(steps.len() / 2) {
+        choices.axis_length =
+            Some((0.3 * median).clamp(limits::MIN_AXIS_LENGTH, limits::MAX_AXIS_LENGTH));
+    }
+    let summary = Summary {
+        vertices: vertices.len(),
+        edges: edges.len(),
+        chain_edges: chain.len(),
+        loop_closures: loops.len(),
+        loop_closures_drawn: drawn_loops.len(),
+    };
+    let chain_end = first + chain.len() as u64;
+    let about = About {
+        title: format!("Pose graph {}", locator.file()),
+        description: describe(G::KIND.is_planar(), &summary, first, chain_end, records),
+        source: String::new(),
+    };
+    let input = Input {
+        about,
+        plan: G::any(plan),
+        defaults: FileSettings {
+            methods: vec![Method::FirstOrder, Method::MonteCarlo],
+            ..FileSettings::default()
+        },
+        draw: choices,
+    };
+    (input, operation_lines, summary)
+}
+
+fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Records) -> String {
+    let mut d = format!(
+        "**{} vertices, {} edges** ({}).\n\n\
+         - **Odometry chain** `odometry_chain`: the {} edges between consecutive vertex ids, \
+         v{first} → v{chain_end}, composed from v{first}'s estimate with each edge's covariance \
+         (first order in colour, Monte Carlo as the cloud). Scrub the `step` timeline: step k is \
+         vertex v{first}+k, and the banana grows as the errors of every edge add up.\n\
+         - **Vertex estimates** `v<id>`: the file's poses, as axes. Where they part from the \
+         chain's mean, the file's estimate is not dead reckoning (e.g. it was optimised).\n\
+         - **Loop closures** (the other {} edges): a grey line between the two vertices, and \
+         `v<j>_via_v<i>` = X_i · Z, where edge i → j puts vertex j, with the edge's own uncertainty.\n",
+        s.vertices,
+        s.edges,
+        if planar { "SE(2)" } else { "SE(3)" },
+        s.chain_edges,
+        s.loop_closures,
+    );
+    if s.loop_closures_drawn < s.loop_closures {
+        d.push_str(&format!(
+            "\n{} of the {} loop closures are drawn (evenly chosen).\n",
+            s.loop_closures_drawn, s.loop_closures
+        ));
+    }
+    if s.vertices as u64 > chain_end - first + 1 {
+        d.push_str(&format!(
+            "\nThe chain stops at v{chain_end}: no edge joins it to v{}.\n",
+            chain_end + 1
+        ));
+    }
+    for (tag, n) in &records.skipped {
+        d.push_str(&format!("\nSkipped {n} `{tag}` record(s) (not drawn).\n"));
+    }
+    d.push_str(if planar {
+        "\nEdge covariance: g2o's EDGE_SE2 information over (x, y, θ) of Z⁻¹ X_i⁻¹ X_j, \
+         inverted: posecov's right-perturbation Σ over [ρx, ρy, θ] (GTSAM reads it the same way).\n"
+    } else {
+        "\nEdge covariance: g2o's EDGE_SE3:QUAT information is over (t, q.xyz) of \
+         Z⁻¹ X_i⁻¹ X_j; q.xyz ≈ θ/2, so posecov's Σ over [ρ; θ] has the rotation block ×4 and \
+         the cross block ×2 of Ω⁻¹. GTSAM's readG2o applies no such factor: its rotation σ is \
+         half of this.\n"
+    });
+    d
+}

@@ -1,0 +1,159 @@
+//! Errors of every input format, located in the user's file: `file:line:column: field:
+//! message` for text formats (with the offending source line), `file: place: message` for
+//! binary ones (a bag's topic and message), `file: message` for the file as a whole.
+
+use std::fmt;
+use std::ops::Range;
+
+/// An input file could not be read, recognised, parsed or validated.
+#[derive(Debug, Clone, PartialEq)]
+pub enum InputError {
+    /// The file could not be read (or no file or bundled example has that name).
+    Read {
+        /// The path given.
+        path: String,
+        /// The operating system's reason, or what was looked for.
+        reason: String,
+    },
+    /// The file as a whole: not a known format, extension and content disagree, too large, a
+    /// format this build cannot read yet.
+    Format {
+        /// File name as given.
+        file: String,
+        /// What is wrong and what is expected.
+        message: String,
+    },
+    /// Something in a text file is wrong, at a known place.
+    At {
+        /// File name as given.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column (in characters).
+        column: usize,
+        /// The key, section or field concerned (e.g. `pose[2].cov`, `EDGE_SE2.information`).
+        field: String,
+        /// What is wrong and what is expected.
+        message: String,
+        /// The source line, for context.
+        source_line: String,
+    },
+    /// Something in a binary file is wrong, at a place named in the format's words.
+    In {
+        /// File name as given.
+        file: String,
+        /// Where, e.g. `topic /odom, message 12 (log time 3.25 s)`.
+        place: String,
+        /// What is wrong and what is expected.
+        message: String,
+    },
+}
+
+impl std::error::Error for InputError {}
+
+impl fmt::Display for InputError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InputError::Read { path, reason } => {
+                write!(f, "{path}: cannot read input: {reason}")
+            }
+            InputError::Format { file, message } => write!(f, "{file}: {message}"),
+            InputError::In {
+                file,
+                place,
+                message,
+            } => write!(f, "{file}: {place}: {message}"),
+            InputError::At {
+                file,
+                line,
+                column,
+                field,
+                message,
+                source_line,
+            } => {
+                write!(f, "{file}:{line}:{column}: {field}: {message}")?;
+                if !source_line.is_empty() {
+                    let pad = " ".repeat(column.saturating_sub(1));
+                    write!(f, "\n  | {source_line}\n  | {pad}^")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Maps byte spans of one source text to `line:column` errors.
+#[derive(Debug, Clone)]
+pub struct Locator {
+    file: String,
+    text: String,
+}
+
+impl Locator {
+    /// A locator for `text` read from `file`.
+    ///
+    /// ```
+    /// use posecov::input::Locator;
+    /// let l = Locator::new("a.toml", "x = 1\ny = 2\n");
+    /// assert_eq!(l.error(6..7, "y", "bad").to_string().lines().next().unwrap(), "a.toml:2:1: y: bad");
+    /// ```
+    pub fn new(file: &str, text: &str) -> Self {
+        Self {
+            file: file.to_owned(),
+            text: text.to_owned(),
+        }
+    }
+
+    /// The file name as given.
+    ///
+    /// ```
+    /// assert_eq!(posecov::input::Locator::new("a.g2o", "").file(), "a.g2o");
+    /// ```
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// The whole text.
+    ///
+    /// ```
+    /// assert_eq!(posecov::input::Locator::new("a.g2o", "x").text(), "x");
+    /// ```
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// An error at the start of `span`.
+    ///
+    /// ```
+    /// use posecov::input::Locator;
+    /// let e = Locator::new("f.toml", "abc").error(1..2, "k", "m");
+    /// assert!(e.to_string().starts_with("f.toml:1:2: k: m"));
+    /// ```
+    pub fn error(&self, span: Range<usize>, field: &str, message: impl Into<String>) -> InputError {
+        let start = span.start.min(self.text.len());
+        let before = &self.text[..floor_char_boundary(&self.text, start)];
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let column = before[line_start..].chars().count() + 1;
+        let source_line = self.text[line_start..]
+            .lines()
+            .next()
+            .unwrap_or("")
+            .to_owned();
+        InputError::At {
+            file: self.file.clone(),
+            line,
+            column,
+            field: field.to_owned(),
+            message: message.into(),
+            source_line,
+        }
+    }
+}
+
+fn floor_char_boundary(s: &str, mut i: usize) -> usize {
+    while i > 0 && !s.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
