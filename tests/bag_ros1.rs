@@ -102,3 +102,38 @@ fn damaged_bags_are_errors_not_panics() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn ctrl_c_keeps_what_was_read_and_draws_it() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let cancel = AtomicBool::new(false);
+    // Raise the flag after the first chunk, as Ctrl-C would mid-read.
+    let plan = read_bag(
+        TEST2.as_ref(),
+        &BagOptions::default(),
+        &mut |_, _| cancel.store(true, Ordering::Relaxed),
+        Some(&cancel),
+    )
+    .unwrap();
+    assert!(plan.cancelled);
+    let odom = &plan.topics[0];
+    assert!(odom.count > 0 && odom.count < 3060, "{}", odom.count);
+    let e = posecov::eval::bag::evaluate_bag(&plan, &Default::default());
+    let about = posecov::input::About {
+        title: "t".into(),
+        description: String::new(),
+        source: String::new(),
+    };
+    let settings = posecov::draw::bag::BagDrawSettings {
+        about,
+        confidence: 0.95,
+        axis_length: None,
+    };
+    let text = posecov::draw::bag::description(&plan, &e, 0.95);
+    assert!(text.contains("Interrupted (Ctrl-C)"), "{text}");
+    assert!(
+        posecov::draw::bag::bag_scene(&e, &settings, &text)
+            .validate()
+            .is_ok()
+    );
+}

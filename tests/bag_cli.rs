@@ -1,0 +1,145 @@
+//! Robot logs on the command line: `check`, `report --json`, `--topic`, `--every`, `--save`,
+//! bundled logs, and errors that name the file.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_posecov");
+const TEST2: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/robot_localization/test2.bag"
+);
+
+fn run(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = Command::new(BIN).args(args).output().expect("run posecov");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("posecov-bagcli-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+#[test]
+fn check_and_list_know_both_log_formats() {
+    let (code, out, err) = run(&["check", TEST2]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        out.contains(": ok (1 pose topic(s), 6121 messages"),
+        "{out}"
+    );
+    let (code, out, _) = run(&["list"]);
+    assert_eq!(code, Some(0));
+    assert!(
+        out.contains("jackal_odometry") && out.contains("covariance_health"),
+        "{out}"
+    );
+    let (code, out, err) = run(&["check", "covariance_health"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        out.starts_with("covariance_health: ok (3 pose topic(s), 70 messages"),
+        "{out}"
+    );
+}
+
+#[test]
+fn report_json_gives_the_health_to_scripts() {
+    let (code, out, err) = run(&["report", "--json", TEST2]);
+    assert_eq!(code, Some(0), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    assert_eq!(v["format"], "ros1_bag");
+    let odom = &v["topics"][0];
+    assert_eq!(odom["name"], "/jackal_velocity_controller/odom");
+    assert_eq!(odom["type"], "nav_msgs/Odometry");
+    assert_eq!(odom["messages"], 3060);
+    assert_eq!(odom["planar"], true);
+    assert_eq!(
+        (odom["position_dof"].as_u64(), odom["pose_dof"].as_u64()),
+        (Some(2), Some(3))
+    );
+    assert_eq!(odom["health"]["placeholder"]["count"], 3060);
+    assert_eq!(odom["health"]["placeholder"]["first_stamp_s"], 47.584);
+    assert_eq!(v["skipped"][0]["message_type"], "sensor_msgs/Imu");
+    let (_, out, _) = run(&[
+        "report",
+        "--json",
+        "covariance_health",
+        "--topic",
+        "/amcl_pose",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&out).expect("json");
+    let amcl = &v["topics"][0];
+    for issue in [
+        "all_zero",
+        "unknown_marker",
+        "placeholder",
+        "non_finite",
+        "asymmetric",
+        "not_psd",
+        "bad_orientation",
+        "undecodable",
+    ] {
+        assert_eq!(amcl["health"][issue]["count"], 1, "{issue}");
+    }
+    assert_eq!(amcl["stamps"]["from_log_time"], 1);
+    assert_eq!(amcl["stamps"]["out_of_order"], 1);
+    assert_eq!(amcl["drawn_invalid"], 7);
+    assert_eq!(v["not_selected"][0], "/bare");
+}
+
+#[test]
+fn save_writes_a_recording_and_every_thins_it() {
+    let dir = scratch("save");
+    let all = dir.join("all.rrd");
+    let thin = dir.join("thin.rrd");
+    let (code, _, err) = run(&[TEST2, "--save", all.to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{err}");
+    let (code, _, err) = run(&[TEST2, "--every", "500", "--save", thin.to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{err}");
+    let size = |p: &PathBuf| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+    assert!(
+        size(&thin) > 10_000 && size(&thin) * 4 < size(&all),
+        "{} {}",
+        size(&thin),
+        size(&all)
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn errors_name_the_file_and_the_flag() {
+    let (code, _, err) = run(&["check", TEST2, "--topic", "/odom"]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("test2.bag: --topic /odom: no such topic; pose topics in this log: /jackal_velocity_controller/odom"), "{err}");
+    let (code, _, err) = run(&["check", "camera_on_robot", "--topic", "/odom"]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("--topic /odom: out of range: a robot log"),
+        "{err}"
+    );
+    let dir = scratch("bad");
+    let fake = dir.join("fake.bag");
+    std::fs::write(&fake, "not a bag\n").unwrap();
+    let (code, _, err) = run(&["check", fake.to_str().unwrap()]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("fake.bag: the extension .bag says ROS 1 bag"),
+        "{err}"
+    );
+    let cut = dir.join("cut.bag");
+    let bytes = std::fs::read(TEST2).unwrap();
+    std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
+    let (code, _, err) = run(&["report", cut.to_str().unwrap()]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("cut.bag:") && err.contains("outside the file"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
