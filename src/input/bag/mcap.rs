@@ -110,7 +110,7 @@ pub(super) fn read(
                         collector.message(
                             &chan.topic,
                             &chan.type_name,
-                            chan.kind.clone(),
+                            chan.kind.as_ref(),
                             log_ns,
                             &data,
                             Codec::Cdr,

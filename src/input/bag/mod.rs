@@ -192,51 +192,62 @@ impl<'a> Collector<'a> {
         &mut self,
         topic: &str,
         type_name: &str,
-        kind: Option<Result<PoseMessageKind, String>>,
+        kind: Option<&Result<PoseMessageKind, String>>,
         log_time_ns: i64,
         bytes: &[u8],
         codec: Codec,
     ) {
         self.total += 1;
         let kind = match kind {
-            Some(Ok(kind)) => kind,
+            Some(Ok(kind)) => *kind,
             other => {
-                let label = match other {
-                    Some(Err(why)) => why,
-                    _ => type_name.to_owned(),
-                };
-                self.skipped.entry(topic.to_owned()).or_insert((label, 0)).1 += 1;
+                if let Some(entry) = self.skipped.get_mut(topic) {
+                    entry.1 += 1;
+                } else {
+                    let label = match other {
+                        Some(Err(why)) => why.clone(),
+                        _ => type_name.to_owned(),
+                    };
+                    self.skipped.insert(topic.to_owned(), (label, 1));
+                }
                 return;
             }
         };
         if !self.options.topics.is_empty() && !self.options.topics.iter().any(|t| t == topic) {
-            self.not_selected.insert(topic.to_owned(), ());
+            if !self.not_selected.contains_key(topic) {
+                self.not_selected.insert(topic.to_owned(), ());
+            }
             return;
         }
         let every = self.options.every;
-        let state = self
-            .topics
-            .entry(topic.to_owned())
-            .or_insert_with(|| TopicState {
-                kind,
-                frame_id: None,
-                child_frame_id: None,
-                count: 0,
-                from_log: 0,
-                out_of_order: 0,
-                last_stamp: None,
-                range: None,
-                health: Health::default(),
-                trend: health::Trend::default(),
-                usable: 0,
-                planar: true,
-                drawn: match every {
-                    Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
-                    None => Decimator::new(1, DEFAULT_MAX_DRAWN),
+        if !self.topics.contains_key(topic) {
+            self.topics.insert(
+                topic.to_owned(),
+                TopicState {
+                    kind,
+                    frame_id: None,
+                    child_frame_id: None,
+                    count: 0,
+                    from_log: 0,
+                    out_of_order: 0,
+                    last_stamp: None,
+                    range: None,
+                    health: Health::default(),
+                    trend: health::Trend::default(),
+                    usable: 0,
+                    planar: true,
+                    drawn: match every {
+                        Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
+                        None => Decimator::new(1, DEFAULT_MAX_DRAWN),
+                    },
+                    trajectory: Decimator::new(1, MAX_SERIES),
+                    series: Decimator::new(1, MAX_SERIES),
                 },
-                trajectory: Decimator::new(1, MAX_SERIES),
-                series: Decimator::new(1, MAX_SERIES),
-            });
+            );
+        }
+        let Some(state) = self.topics.get_mut(topic) else {
+            return;
+        };
         let decoded: Result<Decoded, DecodeError> = match codec {
             Codec::Ros1 => decode::decode_ros1(state.kind, bytes),
             Codec::Cdr => decode::decode_cdr(state.kind, bytes),

@@ -1,11 +1,14 @@
 //! ROS 1 bags (format 2.0, wiki.ros.org/Bags/Format/2.0) through the `rosbag` crate: the
-//! file is memory-mapped and its chunks are decompressed one at a time (uncompressed, bz2,
-//! lz4), so memory stays bounded by one chunk whatever the bag's length.
+//! file is memory-mapped, the index gives every chunk's position, and chunks are decompressed
+//! (uncompressed, bz2, lz4) a few per thread at a time, in parallel, their messages handed on
+//! in file order: memory stays bounded by those few chunks whatever the bag's length.
 
 use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
+use rayon::prelude::*;
+use rosbag::record_types::Chunk;
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
 use super::decode::ros1_kind;
@@ -109,54 +112,81 @@ pub(super) fn read(
     // Connections from the index section (every topic and type up front), then any the
     // chunks declare themselves.
     let mut conns: HashMap<u32, Conn> = HashMap::new();
+    let mut chunk_positions = Vec::new();
     for record in bag.index_records() {
         match record {
             Ok(IndexRecord::Connection(c)) => {
                 conns.insert(c.id, conn_of(&c));
             }
+            Ok(IndexRecord::ChunkInfo(info)) => chunk_positions.push(info.chunk_pos),
             Ok(_) => {}
             Err(e) => return Err(fail(format!("index section: {e}"))),
         }
     }
-    let chunks = u64::from(bag.get_chunk_count()).max(1);
-    let mut done = 0;
-    for record in bag.chunk_records() {
-        let chunk = match record {
-            Ok(ChunkRecord::Chunk(chunk)) => chunk,
-            Ok(ChunkRecord::IndexData(_)) => continue,
-            Err(e) => return Err(fail(format!("chunk {}: {e}", done + 1))),
-        };
-        for message in chunk.messages() {
-            match message {
-                Ok(MessageRecord::Connection(c)) => {
-                    conns.entry(c.id).or_insert_with(|| conn_of(&c));
-                }
-                Ok(MessageRecord::MessageData(m)) => {
-                    if collector.stop() {
-                        return Ok(());
-                    }
-                    let Some(conn) = conns.get(&m.conn_id) else {
-                        return Err(fail(format!(
-                            "chunk {}: a message on connection {} that the bag never declares",
-                            done + 1,
-                            m.conn_id
-                        )));
-                    };
-                    let log_ns = i64::try_from(m.time).unwrap_or(i64::MAX);
-                    collector.message(
-                        &conn.topic,
-                        &conn.type_name,
-                        conn.kind.clone(),
-                        log_ns,
-                        m.data,
-                        Codec::Ros1,
-                    );
-                }
-                Err(e) => return Err(fail(format!("chunk {}: {e}", done + 1))),
-            }
+    if chunk_positions.is_empty() {
+        return Err(fail(
+            "the index lists no chunks (an unindexed or empty bag; run `rosbag reindex`)".into(),
+        ));
+    }
+    chunk_positions.sort_unstable();
+    chunk_positions.dedup();
+    let total = chunk_positions.len() as u64;
+    // Chunks are decompressed in parallel, a few per thread at a time (memory stays bounded
+    // by that many chunks), and their messages handed on in file order.
+    let batch = 2 * rayon::current_num_threads().max(1);
+    let mut done = 0u64;
+    for group in chunk_positions.chunks(batch) {
+        if collector.stop() {
+            return Ok(());
         }
-        done += 1;
-        progress(done, chunks);
+        let chunks: Vec<Result<Chunk<'_>, String>> = group
+            .par_iter()
+            .map(|&pos| {
+                let mut records = bag.chunk_records();
+                records
+                    .seek(pos)
+                    .map_err(|e| format!("at byte {pos}: {e}"))?;
+                match records.next() {
+                    Some(Ok(ChunkRecord::Chunk(chunk))) => Ok(chunk),
+                    Some(Ok(_)) => Err(format!("at byte {pos}: the index points at no chunk")),
+                    Some(Err(e)) => Err(format!("at byte {pos}: {e}")),
+                    None => Err(format!("at byte {pos}: past the end of the chunks")),
+                }
+            })
+            .collect();
+        for chunk in chunks {
+            done += 1;
+            let chunk = chunk.map_err(|e| fail(format!("chunk {done} of {total}: {e}")))?;
+            for message in chunk.messages() {
+                match message {
+                    Ok(MessageRecord::Connection(c)) => {
+                        conns.entry(c.id).or_insert_with(|| conn_of(&c));
+                    }
+                    Ok(MessageRecord::MessageData(m)) => {
+                        if collector.stop() {
+                            return Ok(());
+                        }
+                        let Some(conn) = conns.get(&m.conn_id) else {
+                            return Err(fail(format!(
+                                "chunk {done} of {total}: a message on connection {} that the bag never declares",
+                                m.conn_id
+                            )));
+                        };
+                        let log_ns = i64::try_from(m.time).unwrap_or(i64::MAX);
+                        collector.message(
+                            &conn.topic,
+                            &conn.type_name,
+                            conn.kind.as_ref(),
+                            log_ns,
+                            m.data,
+                            Codec::Ros1,
+                        );
+                    }
+                    Err(e) => return Err(fail(format!("chunk {done} of {total}: {e}"))),
+                }
+            }
+            progress(done, total);
+        }
     }
     Ok(())
 }
