@@ -20,10 +20,10 @@ const EXAMPLE: &str = concat!(
     "/tests/data/mcap/health_cases.mcap"
 );
 
-/// The planar topic's covariance at message k: x, y growing, z / roll / pitch placeholders;
-/// at k = 40 a relocalisation divides it by 20.
+/// The planar topic's covariance at message k: x, y and yaw growing, z / roll / pitch
+/// placeholders; at k = 25 a relocalisation resets it, and it grows again.
 fn planar_cov(k: usize) -> [f64; 36] {
-    let scale = if k < 40 { 0.01 + 0.05 * k as f64 } else { 0.01 };
+    let scale = 0.01 + 0.05 * (k % 25) as f64;
     let mut c = [0.0; 36];
     c[0] = scale;
     c[1] = 0.3 * scale;
@@ -32,7 +32,7 @@ fn planar_cov(k: usize) -> [f64; 36] {
     c[14] = 1e6;
     c[21] = 1e6;
     c[28] = 1e6;
-    c[35] = 0.002;
+    c[35] = 0.1 * scale;
     c[5] = 0.001;
     c[30] = 0.001;
     c
@@ -196,7 +196,10 @@ fn write_example() -> Vec<u8> {
 fn read(bytes: &[u8], options: &BagOptions) -> posecov::plan::bag::BagPlan {
     let dir = std::env::temp_dir().join(format!("posecov-mcap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("log-{}.mcap", bytes.len()));
+    // Tests run in parallel: one file each.
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path = dir.join(format!("log-{n}.mcap"));
     std::fs::write(&path, bytes).unwrap();
     let plan = read_bag(&path, options, &mut |_, _| {}, None).unwrap();
     std::fs::remove_file(&path).ok();
@@ -287,11 +290,12 @@ fn planar_odometry_numbers_are_exact() {
     }
     let h = &odom.health;
     assert_eq!(h.count(Issue::Placeholder), 50);
-    // One drop (k = 40: trace 2.06 → 0.015).
+    // One drop (k = 25: trace 1.815 → 0.015).
     assert_eq!(h.count(Issue::SuddenDrop), 1);
-    assert_eq!(h.first(Issue::SuddenDrop), Some(50_500_000_000));
-    // Growth: trace_k = 1.5 (0.01 + 0.05 k) reaches 100 × 0.015 at k = 20 … 39.
-    assert_eq!(h.count(Issue::Growth), 20);
+    assert_eq!(h.first(Issue::SuddenDrop), Some(35_500_000_000));
+    // Growth: trace_k = 1.5 (0.01 + 0.05 (k mod 25)) reaches 100 × 0.015 at k mod 25 ≥ 20:
+    // k = 20 … 24 and, measured from the drop, 45 … 49.
+    assert_eq!(h.count(Issue::Growth), 10);
     assert_eq!(h.first(Issue::Growth), Some(30_500_000_000));
     assert_eq!(h.issues.len(), 3, "{h:?}");
     // σx series: √Σxx where estimated; z / roll / pitch are not.

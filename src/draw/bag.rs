@@ -72,7 +72,7 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
     let extent = extent(e);
     let axis_length = settings
         .axis_length
-        .unwrap_or((0.05 * extent).clamp(0.05, 2.0));
+        .unwrap_or((0.08 * extent).clamp(0.05, 2.0));
     let draw = DrawSettings {
         about: settings.about.clone(),
         confidence: settings.confidence,
@@ -454,7 +454,7 @@ fn cloud_item(p: &mut Painter, base: &str, at: Timing, positions: Vec<Vec3>) {
         ItemKind::Points(PointCloud {
             positions,
             color: super::cloud_color(),
-            radius: 0.08 * p.axis_length * 0.15,
+            radius: 0.05 * p.axis_length,
         }),
     );
 }
@@ -477,7 +477,7 @@ fn sprays(p: &mut Painter, base: &str, at: Timing, cloud: &[Se3]) {
             ItemKind::Points(PointCloud {
                 positions,
                 color: AXIS_COLORS[axis].with_alpha(150),
-                radius: 0.06 * l * 0.15,
+                radius: 0.03 * l,
             }),
         );
     }
