@@ -4,7 +4,7 @@
 //!
 //! - [`scenario`]: TOML scenario files (and the bundled lecture scenarios);
 //! - [`graph`]: g2o / GTSAM text pose graphs (and two bundled GTSAM examples);
-//! - ROS 1 bags and MCAP files are recognised ([`format`]) but not read yet.
+//! - ROS 1 bags and MCAP files are recognised ([`format`](mod@format)) but not read yet.
 //!
 //! [`open`] is the one entry: it finds the file (or a bundled example by name), decides its
 //! [`Format`] by content and extension, and calls that format's reader. A new format is a
@@ -258,6 +258,8 @@ pub struct DrawChoices {
     pub shown: BTreeMap<String, bool>,
     /// Pairs of pose names joined by a line (a pose graph's loop closures).
     pub links: Vec<(String, String)>,
+    /// Whether frames carry their names (off for a graph's many vertices).
+    pub labels: bool,
 }
 
 impl Default for DrawChoices {
@@ -274,6 +276,7 @@ impl Default for DrawChoices {
             top_view: None,
             shown: BTreeMap::new(),
             links: Vec::new(),
+            labels: true,
         }
     }
 }

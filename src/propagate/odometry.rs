@@ -125,9 +125,9 @@ pub fn propagate_increments<G: LieGroup<N>, const N: usize>(
 
 /// [`propagate_increments`] with Σ_w given per step ([`StepNoise`]): X_{k+1} = X_k · U_k ·
 /// Exp(w_k), w_k ~ N(0, Σ_{w,k}) — a pose graph's odometry chain, Σ_{w,k} the covariance of
-/// edge k (k, k+1) in the body frame of vertex k+1 ([CONVENTIONS §9]).
+/// edge k (k, k+1) in the body frame of vertex k+1 ([CONVENTIONS §10]).
 ///
-/// [CONVENTIONS §9]: crate::conventions#9-pose-graphs-g2o-and-gtsam
+/// [CONVENTIONS §10]: crate::conventions#10-pose-graphs-g2o-and-gtsam
 ///
 /// ```
 /// use posecov::lie::{LieGroup, Se2};

@@ -1,5 +1,5 @@
 //! What a g2o edge's information matrix means in posecov's terms, and what GTSAM makes of
-//! it ([CONVENTIONS §9]).
+//! it ([CONVENTIONS §10]).
 //!
 //! An edge (i, j) with measurement Z and information Ω says X_j ≈ X_i · Z. g2o's error is
 //! computed from Δ = Z⁻¹ · X_i⁻¹ · X_j:
@@ -25,7 +25,7 @@
 //! of g2o's (its Σ is Ω⁻¹ reordered, [`se3_cov_as_gtsam_reads`]). For `EDGE_SE2` both agree
 //! (`NoiseFormatG2O`, order x, y, θ = GTSAM's Pose2 tangent order).
 //!
-//! [CONVENTIONS §9]: crate::conventions#9-pose-graphs-g2o-and-gtsam
+//! [CONVENTIONS §10]: crate::conventions#10-pose-graphs-g2o-and-gtsam
 //! [CONVENTIONS §1–2]: crate::conventions
 
 use nalgebra::{Matrix6, SMatrix};

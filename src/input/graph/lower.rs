@@ -20,7 +20,10 @@ use crate::uncertain::{Method, Side, UncertainPose};
 pub const MAX_LOOP_CLOSURES: usize = 30;
 
 /// Most vertex estimates drawn as axes (evenly chosen, plus the loop closures' ends).
-pub const MAX_DRAWN_VERTICES: usize = 2000;
+pub const MAX_DRAWN_VERTICES: usize = 300;
+
+/// Frames carry their names only up to this many vertices and loop closures.
+const MAX_LABELLED: usize = 40;
 
 /// What the two pose-graph groups need besides being Lie groups.
 trait GraphGroup<const N: usize>: LieGroup<N> {
@@ -293,6 +296,7 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         sample_axes: false,
         ..DrawChoices::default()
     };
+    choices.labels = drawn_ids.len() + drawn_loops.len() <= MAX_LABELLED;
     let mut operation_lines = Vec::new();
     for id in &drawn_ids {
         let name = vertex_name(*id);
@@ -359,10 +363,18 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         chain_edges: chain.len(),
         loop_closures: loops.len(),
         loop_closures_drawn: drawn_loops.len(),
+        vertices_drawn: drawn_ids.len(),
     };
     let chain_end = first + chain.len() as u64;
     let about = About {
-        title: format!("Pose graph {}", locator.file()),
+        title: format!(
+            "Pose graph {}: {} {} poses, {} odometry edges, {} loop closures",
+            locator.file(),
+            summary.vertices,
+            if G::KIND.is_planar() { "SE(2)" } else { "SE(3)" },
+            summary.chain_edges,
+            summary.loop_closures
+        ),
         description: describe(G::KIND.is_planar(), &summary, first, chain_end, records),
         source: String::new(),
     };
@@ -395,6 +407,12 @@ fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Rec
         s.chain_edges,
         s.loop_closures,
     );
+    if s.vertices_drawn < s.vertices {
+        d.push_str(&format!(
+            "\n{} of the {} vertex estimates are drawn (evenly chosen, and the drawn loop closures' ends).\n",
+            s.vertices_drawn, s.vertices
+        ));
+    }
     if s.loop_closures_drawn < s.loop_closures {
         d.push_str(&format!(
             "\n{} of the {} loop closures are drawn (evenly chosen).\n",

@@ -12,7 +12,7 @@
 //!
 //! The edge covariance is posecov's right-perturbation Σ over [ρ; θ] — for `EDGE_SE3:QUAT`
 //! with the rotation block scaled from the quaternion's vector part, see [`convention`] and
-//! [CONVENTIONS §9](crate::conventions#9-pose-graphs-g2o-and-gtsam).
+//! [CONVENTIONS §10](crate::conventions#10-pose-graphs-g2o-and-gtsam).
 //!
 //! ```
 //! use posecov::input::graph::read_text;
@@ -52,6 +52,8 @@ pub struct Summary {
     /// Loop closures evaluated and drawn with their uncertainty (at most
     /// [`MAX_LOOP_CLOSURES`]).
     pub loop_closures_drawn: usize,
+    /// Vertex estimates drawn as axes (at most 300, plus the drawn loop closures' ends).
+    pub vertices_drawn: usize,
 }
 
 /// A read graph file: where its records are (to locate later errors) and what it holds.
