@@ -447,3 +447,32 @@ fn formats_are_decided_by_content_and_extension() {
         input.plan
     );
 }
+
+#[test]
+fn loop_closure_residuals_measure_the_estimates_with_the_edge_covariance() {
+    // Edge 0 → 2 says v2 = v0 · (2, 0, 0); v2's estimate is 0.1 m off in y, σ_y = 0.1 m: d = 1.
+    let text = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0.1 0\n\
+                EDGE_SE2 0 1 1 0 0 100 0 0 100 0 100\nEDGE_SE2 1 2 1 0.1 0 100 0 0 100 0 100\n\
+                EDGE_SE2 0 2 2 0 0 1 0 0 100 0 1\n";
+    let (graph, _) = read_text(text, "g.g2o").expect("valid");
+    let s = graph.summary();
+    assert_eq!(
+        (s.chain_edges, s.loop_closures, s.loop_closures_inconsistent),
+        (2, 1, 0)
+    );
+    let r = &s.worst_loop_closures[0];
+    assert_eq!((r.from, r.to, r.line), (0, 2, 6));
+    // r = Log(Z⁻¹ X_0⁻¹ X_2) = Log((0, 0.1, 0)) = (0, 0.1, 0) exactly (no rotation).
+    assert!((r.mahalanobis - 1.0).abs() < 1e-12, "{}", r.mahalanobis);
+    assert!((r.radius_95 - 2.795_483).abs() < 1e-6);
+
+    // GTSAM's pose3example: edge 3 → 0 (line 11) puts v0 about 1 m from v3, the estimates are
+    // 2.24 m apart: hundreds of σ. Edge 1 → 4 agrees.
+    let (graph, _) = read_text(POSE3, "pose3example.txt").expect("valid");
+    let s = graph.summary();
+    assert_eq!(s.loop_closures_inconsistent, 1);
+    let worst = &s.worst_loop_closures[0];
+    assert_eq!((worst.from, worst.to, worst.line), (3, 0, 11));
+    assert!(worst.mahalanobis > 100.0, "{}", worst.mahalanobis);
+    assert!(s.worst_loop_closures[1].mahalanobis < s.worst_loop_closures[1].radius_95);
+}
