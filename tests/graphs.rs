@@ -476,3 +476,56 @@ fn loop_closure_residuals_measure_the_estimates_with_the_edge_covariance() {
     assert!(worst.mahalanobis > 100.0, "{}", worst.mahalanobis);
     assert!(s.worst_loop_closures[1].mahalanobis < s.worst_loop_closures[1].radius_95);
 }
+
+#[test]
+fn mutated_graphs_are_refused_or_drawn_never_a_panic_or_a_bad_scene() {
+    // Replace each number of the GTSAM files, one at a time, by awkward values; every result
+    // is a located error or a valid scene.
+    use posecov::app::{AppError, Overrides};
+    let awkward = [
+        "0",
+        "-0",
+        "1e308",
+        "-1e308",
+        "1e-308",
+        "nan",
+        "-inf",
+        "18446744073709551616",
+        "",
+        "1e6",
+        "-1",
+    ];
+    let overrides = Overrides {
+        samples: Some(16),
+        ..Default::default()
+    };
+    let (mut drawn, mut refused) = (0, 0);
+    for text in [POSE2, OFFDIAGONAL, TOY] {
+        let tokens: Vec<&str> = text.split_whitespace().collect();
+        for (k, _) in tokens.iter().enumerate().skip(1).step_by(3) {
+            for value in awkward {
+                let mut mutated = tokens.clone();
+                mutated[k] = value;
+                let mutated = mutated
+                    .join(" ")
+                    .replace(" VERTEX", "\nVERTEX")
+                    .replace(" EDGE", "\nEDGE");
+                let Ok((source, input)) = open_text(&mutated, "m.g2o", Format::Graph) else {
+                    refused += 1;
+                    continue;
+                };
+                let loaded = posecov::app::Loaded { source, input };
+                match posecov::app::pipeline(&loaded, &overrides, None) {
+                    Ok(_) => drawn += 1,
+                    Err(AppError::Input(_)) => refused += 1,
+                    Err(e) => panic!("token {k} = {value:?}: {e}\n{mutated}"),
+                }
+            }
+        }
+    }
+    println!("{drawn} drawn, {refused} refused");
+    assert!(
+        drawn > 100 && refused > 100,
+        "{drawn} drawn, {refused} refused"
+    );
+}

@@ -70,6 +70,19 @@ impl<const N: usize> StepNoise<N> {
         }
     }
 
+    /// The covariances given: one for every step, or one per step.
+    ///
+    /// ```
+    /// use posecov::propagate::odometry::StepNoise;
+    /// assert_eq!(StepNoise::Same(nalgebra::Matrix3::<f64>::identity()).as_slice().len(), 1);
+    /// ```
+    pub fn as_slice(&self) -> &[TangentMatrix<N>] {
+        match self {
+            StepNoise::Same(m) => std::slice::from_ref(m),
+            StepNoise::PerStep(v) => v,
+        }
+    }
+
     /// Each covariance checked (finite, symmetric, PSD) and symmetrised; a per-step list
     /// must have one per step. Errors: the first bad covariance's, or the count.
     ///
