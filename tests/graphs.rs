@@ -529,3 +529,57 @@ fn mutated_graphs_are_refused_or_drawn_never_a_panic_or_a_bad_scene() {
         "{drawn} drawn, {refused} refused"
     );
 }
+
+#[test]
+fn large_graphs_are_drawn_bounded_and_said_so() {
+    let mut text = String::new();
+    for k in 0..1000 {
+        text += &format!("VERTEX_SE2 {k} {} 0 0\n", k as f64 * 0.5);
+    }
+    for k in 0..999 {
+        text += &format!("EDGE_SE2 {k} {} 0.5 0 0 400 0 0 400 0 2500\n", k + 1);
+    }
+    for k in 0..50 {
+        text += &format!(
+            "EDGE_SE2 {} {} 5 0 0 100 0 0 100 0 100\n",
+            10 * k,
+            10 * k + 10
+        );
+    }
+    let (graph, input) = read_text(&text, "big.g2o").expect("valid");
+    let s = graph.summary();
+    assert_eq!((s.chain_edges, s.loop_closures), (999, 50));
+    assert_eq!(
+        s.loop_closures_drawn,
+        posecov::input::graph::MAX_LOOP_CLOSURES
+    );
+    assert!(
+        s.vertices_drawn <= 300 + 2 * s.loop_closures_drawn,
+        "{}",
+        s.vertices_drawn
+    );
+    assert_eq!(s.loop_closures_inconsistent, 0);
+    assert!(!input.draw.labels);
+    assert_eq!(input.draw.links.len(), s.loop_closures_drawn);
+    let d = &input.about.description;
+    assert!(d.contains("30 of the 50 loop closures are drawn"), "{d}");
+    assert!(
+        d.contains(&format!(
+            "{} of the 1000 vertex estimates are drawn",
+            s.vertices_drawn
+        )),
+        "{d}"
+    );
+
+    // Without consecutive edges there is no chain, and the text says so.
+    let (_, input) = read_text(
+        "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 5 1 0 0\nEDGE_SE2 0 5 1 0 0 100 0 0 100 0 100\n",
+        "l.g2o",
+    )
+    .expect("valid");
+    assert!(
+        input.about.description.contains("No odometry chain"),
+        "{}",
+        input.about.description
+    );
+}

@@ -437,12 +437,23 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
 }
 
 fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Records) -> String {
+    let chain = if s.chain_edges == 0 {
+        format!(
+            "- **No odometry chain**: no edge joins v{first} to v{}, so nothing is propagated.\n",
+            first.saturating_add(1)
+        )
+    } else {
+        format!(
+            "- **Odometry chain** `odometry_chain`: the {} edges between consecutive vertex ids, \
+             v{first} → v{chain_end}, composed from v{first}'s estimate with each edge's \
+             covariance (first order in colour, Monte Carlo as the cloud). Scrub the `step` \
+             timeline: step k is vertex v{first}+k, and the banana grows as the errors of every \
+             edge add up.\n",
+            s.chain_edges
+        )
+    };
     let mut d = format!(
-        "**{} vertices, {} edges** ({}).\n\n\
-         - **Odometry chain** `odometry_chain`: the {} edges between consecutive vertex ids, \
-         v{first} → v{chain_end}, composed from v{first}'s estimate with each edge's covariance \
-         (first order in colour, Monte Carlo as the cloud). Scrub the `step` timeline: step k is \
-         vertex v{first}+k, and the banana grows as the errors of every edge add up.\n\
+        "**{} vertices, {} edges** ({}).\n\n{chain}\
          - **Vertex estimates** `v<id>`: the file's poses, as axes. Where they part from the \
          chain's mean, the file's estimate is not dead reckoning (e.g. it was optimised).\n\
          - **Loop closures** (the other {} edges): a grey line between the two vertices, and \
@@ -450,7 +461,6 @@ fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Rec
         s.vertices,
         s.edges,
         if planar { "SE(2)" } else { "SE(3)" },
-        s.chain_edges,
         s.loop_closures,
     );
     if s.vertices_drawn < s.vertices {
@@ -465,10 +475,11 @@ fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Rec
             s.loop_closures_drawn, s.loop_closures
         ));
     }
-    if s.vertices as u64 > chain_end - first + 1 {
+    if s.chain_edges > 0 && s.vertices as u64 > chain_end - first + 1 {
         d.push_str(&format!(
-            "\nThe chain stops at v{chain_end}: no edge joins it to v{}.\n",
-            chain_end + 1
+            "\nThe chain stops at v{chain_end}: no edge joins it to v{} (the later vertices are \
+             drawn, not propagated).\n",
+            chain_end.saturating_add(1)
         ));
     }
     if s.loop_closures > 0 {
