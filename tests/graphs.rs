@@ -583,3 +583,26 @@ fn large_graphs_are_drawn_bounded_and_said_so() {
         input.about.description
     );
 }
+
+#[test]
+fn crlf_tabs_and_a_byte_order_mark_read_like_plain_text() {
+    let plain = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 1 0 0 100 0 0 100 0 400\n";
+    let windows = format!("\u{feff}{}", plain.replace('\n', "\r\n").replace(' ', "\t"));
+    assert_eq!(input(&windows).plan, input(plain).plan);
+    let path = scratch("windows.g2o", windows.as_bytes());
+    assert_eq!(
+        open(path.to_str().expect("utf-8"))
+            .expect("by content")
+            .0
+            .format(),
+        Format::Graph
+    );
+    // Errors still point at the right line and column.
+    let e = read_text(&windows.replace("\t400", "\tnan"), "w.g2o")
+        .expect_err("nan")
+        .to_string();
+    assert!(
+        e.starts_with("w.g2o:3:34: EDGE_SE2 0 1: I(θ,θ) = nan"),
+        "{e}"
+    );
+}

@@ -163,6 +163,8 @@ pub fn read_file(path: &Path) -> Result<(Graph, Input), InputError> {
 ///
 /// See the [module docs](self) for an example.
 pub fn read_text(text: &str, origin: &str) -> Result<(Graph, Input), InputError> {
+    // A byte-order mark some editors write is not part of the first tag.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let locator = Locator::new(origin, text);
     let records = parse::read_records(&locator)?;
     let (input, operation_lines, summary) = lower::lower(&locator, &records)?;
