@@ -58,7 +58,8 @@ enum Command {
 /// Which scenario, evaluated how.
 #[derive(Clone, Debug, Args)]
 struct ScenarioArgs {
-    /// A bundled scenario name (see `posecov list`) or a scenario TOML file.
+    /// A bundled example (see `posecov list`) or a file: a TOML scenario or a g2o / GTSAM pose
+    /// graph (.g2o, .txt), recognised by content and extension.
     // `Option` only so that `posecov <COMMAND>` parses; clap requires it otherwise.
     #[arg(required = true)]
     scenario: Option<String>,

@@ -156,6 +156,7 @@ pub fn report_json(
     serde_json::json!({
         "scenario": name,
         "format": loaded.source.format(),
+        "input": loaded.source.facts(),
         "meta": {
             "title": loaded.input.about.title,
             "description": loaded.input.about.description,

@@ -430,7 +430,7 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
                 translation: v3(pose3.translation()),
                 rotation: pose3.rotation().to_quaternion_xyzw(),
                 axis_length: p.axis_length,
-                label: Some(node.name.clone()),
+                label: choices.labels.then(|| node.name.clone()),
             }),
         );
     }

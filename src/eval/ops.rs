@@ -294,21 +294,19 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                 }
             }
         }
-        match noise {
-            StepNoise::Same(noise) if self.wants(Method::VectorSpace) => {
-                match G::ssc_odometry(&start_right, &increments, noise) {
-                    Some(Ok(track)) => tracks.push(track),
-                    Some(Err(e)) => self.method_failed(None, Method::VectorSpace, e.to_string()),
-                    None => {}
+        if self.wants(Method::VectorSpace) {
+            match (noise, noise.as_slice()) {
+                (StepNoise::Same(_), [same]) => {
+                    match G::ssc_odometry(&start_right, &increments, same) {
+                        Some(Ok(track)) => tracks.push(track),
+                        Some(Err(e)) => {
+                            self.method_failed(None, Method::VectorSpace, e.to_string())
+                        }
+                        None => {}
+                    }
                 }
+                _ => self.method_failed(None, Method::VectorSpace, "needs one Σ_w".into()),
             }
-            StepNoise::PerStep(_) if self.wants(Method::VectorSpace) => self.method_failed(
-                None,
-                Method::VectorSpace,
-                "the vector-space odometry baseline takes one noise covariance for every step"
-                    .to_owned(),
-            ),
-            _ => {}
         }
         let last = controls.len() as u64;
         let name = self.output();
@@ -318,22 +316,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let mut current: Option<Vec<G>> = self
             .monte_carlo
             .then(|| self.particles_of(&start, start_particles).as_ref().clone());
-        let sampler_of = |cov: TangentMatrix<N>| {
-            Sampler::new(&UncertainPose::new_unchecked(
-                G::identity(),
-                cov,
-                Side::Right,
-            ))
-        };
-        let samplers = match noise {
-            StepNoise::Same(cov) => sampler_of(*cov).map(|s| vec![s]),
-            StepNoise::PerStep(covs) if current.is_some() => covs
-                .iter()
-                .map(|c| sampler_of(*c))
-                .collect::<Result<_, _>>(),
-            StepNoise::PerStep(_) => Ok(Vec::new()),
-        }
-        .map_err(|e| self.math(e))?;
+        let samplers = Sampler::<G, N>::right_noise(noise.as_slice()).map_err(|e| self.math(e))?;
         self.push_step(&name, 0, last, step_estimates(0), current.as_deref())?;
         for (k, control) in controls.iter().enumerate() {
             if self.settings.cancelled() {

@@ -37,8 +37,8 @@ pub use located::{InputError, Locator};
 /// The file an [`Input`] came from, kept to locate later (evaluation) errors in it.
 #[derive(Debug, Clone)]
 pub enum Source {
-    /// A TOML scenario.
-    Scenario(scenario::Scenario),
+    /// A TOML scenario (boxed: its typed file is large).
+    Scenario(Box<scenario::Scenario>),
     /// A g2o / GTSAM pose graph.
     Graph(graph::Graph),
 }
@@ -54,6 +54,20 @@ impl Source {
         match self {
             Source::Scenario(_) => Format::Scenario,
             Source::Graph(_) => Format::Graph,
+        }
+    }
+
+    /// What the file holds beyond the plan, for `report --json`: a graph's counts (vertices,
+    /// edges, chain edges, loop closures); `null` for a scenario.
+    ///
+    /// ```
+    /// let (source, _) = posecov::input::open("gtsam_pose2example").unwrap();
+    /// assert_eq!(source.facts()["loop_closures"], 2);
+    /// ```
+    pub fn facts(&self) -> serde_json::Value {
+        match self {
+            Source::Scenario(_) => serde_json::Value::Null,
+            Source::Graph(g) => serde_json::to_value(g.summary()).unwrap_or_default(),
         }
     }
 
@@ -158,7 +172,7 @@ pub fn open_file(path: &Path) -> Result<(Source, Input), InputError> {
         Format::Scenario => {
             let s = scenario::Scenario::load(path)?;
             let input = scenario::lower(&s)?;
-            Ok((Source::Scenario(s), input))
+            Ok((Source::Scenario(Box::new(s)), input))
         }
         Format::Graph => {
             let (g, input) = graph::read_file(path)?;
@@ -180,7 +194,7 @@ pub fn open_text(text: &str, origin: &str, format: Format) -> Result<(Source, In
         Format::Scenario => {
             let s = scenario::Scenario::parse(text, origin)?;
             let input = scenario::lower(&s)?;
-            Ok((Source::Scenario(s), input))
+            Ok((Source::Scenario(Box::new(s)), input))
         }
         Format::Graph => {
             let (g, input) = graph::read_text(text, origin)?;
@@ -251,6 +265,8 @@ pub struct DrawChoices {
     pub shown: BTreeMap<String, bool>,
     /// Pairs of pose names joined by a line (a pose graph's loop closures).
     pub links: Vec<(String, String)>,
+    /// Whether frames carry their names (off for a graph's many vertices).
+    pub labels: bool,
 }
 
 impl Default for DrawChoices {
@@ -267,6 +283,7 @@ impl Default for DrawChoices {
             top_view: None,
             shown: BTreeMap::new(),
             links: Vec::new(),
+            labels: true,
         }
     }
 }

@@ -70,6 +70,19 @@ impl<const N: usize> StepNoise<N> {
         }
     }
 
+    /// The covariances given: one for every step, or one per step.
+    ///
+    /// ```
+    /// use posecov::propagate::odometry::StepNoise;
+    /// assert_eq!(StepNoise::Same(nalgebra::Matrix3::<f64>::identity()).as_slice().len(), 1);
+    /// ```
+    pub fn as_slice(&self) -> &[TangentMatrix<N>] {
+        match self {
+            StepNoise::Same(m) => std::slice::from_ref(m),
+            StepNoise::PerStep(v) => v,
+        }
+    }
+
     /// Each covariance checked (finite, symmetric, PSD) and symmetrised; a per-step list
     /// must have one per step. Errors: the first bad covariance's, or the count.
     ///
@@ -125,9 +138,9 @@ pub fn propagate_increments<G: LieGroup<N>, const N: usize>(
 
 /// [`propagate_increments`] with Σ_w given per step ([`StepNoise`]): X_{k+1} = X_k · U_k ·
 /// Exp(w_k), w_k ~ N(0, Σ_{w,k}) — a pose graph's odometry chain, Σ_{w,k} the covariance of
-/// edge k (k, k+1) in the body frame of vertex k+1 ([CONVENTIONS §9]).
+/// edge k (k, k+1) in the body frame of vertex k+1 ([CONVENTIONS §10]).
 ///
-/// [CONVENTIONS §9]: crate::conventions#9-pose-graphs-g2o-and-gtsam
+/// [CONVENTIONS §10]: crate::conventions#10-pose-graphs-g2o-and-gtsam
 ///
 /// ```
 /// use posecov::lie::{LieGroup, Se2};

@@ -238,6 +238,28 @@ impl<G: LieGroup<N>, const N: usize> Sampler<G, N> {
         })
     }
 
+    /// One sampler of identity · Exp(w), w ~ N(0, Σ_k), per covariance (the noise of each
+    /// step of a propagation). Errors: a non-finite covariance.
+    ///
+    /// ```
+    /// use posecov::lie::So2;
+    /// use posecov::sample::Sampler;
+    /// let s = Sampler::<So2, 1>::right_noise(&[nalgebra::Matrix1::new(4.0)]).unwrap();
+    /// assert_eq!(s[0].factor()[(0, 0)], 2.0);
+    /// ```
+    pub fn right_noise(covariances: &[TangentMatrix<N>]) -> Result<Vec<Self>> {
+        covariances
+            .iter()
+            .map(|c| {
+                Self::new(&UncertainPose::new_unchecked(
+                    G::identity(),
+                    *c,
+                    Side::Right,
+                ))
+            })
+            .collect()
+    }
+
     /// The square root L (L Lᵀ = Σ) the sampler uses.
     ///
     /// ```

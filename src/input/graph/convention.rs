@@ -1,5 +1,5 @@
 //! What a g2o edge's information matrix means in posecov's terms, and what GTSAM makes of
-//! it ([CONVENTIONS §9]).
+//! it ([CONVENTIONS §10]).
 //!
 //! An edge (i, j) with measurement Z and information Ω says X_j ≈ X_i · Z. g2o's error is
 //! computed from Δ = Z⁻¹ · X_i⁻¹ · X_j:
@@ -25,10 +25,12 @@
 //! of g2o's (its Σ is Ω⁻¹ reordered, [`se3_cov_as_gtsam_reads`]). For `EDGE_SE2` both agree
 //! (`NoiseFormatG2O`, order x, y, θ = GTSAM's Pose2 tangent order).
 //!
-//! [CONVENTIONS §9]: crate::conventions#9-pose-graphs-g2o-and-gtsam
+//! [CONVENTIONS §10]: crate::conventions#10-pose-graphs-g2o-and-gtsam
 //! [CONVENTIONS §1–2]: crate::conventions
 
-use nalgebra::{Matrix3, Matrix6, SMatrix};
+use nalgebra::{Matrix6, SMatrix};
+
+use crate::interop::cov_to_rotation_first;
 
 /// The symmetric matrix whose upper triangle is `upper`, row by row
 /// (m₀₀ m₀₁ … m₀ₙ m₁₁ … mₙₙ), as g2o and GTSAM store information matrices.
@@ -106,22 +108,9 @@ pub fn se3_cov_from_g2o_error_cov(cov_error: &Matrix6<f64>) -> Matrix6<f64> {
 /// assert!((cov[(3, 3)] - 1.0).abs() < 1e-15);
 /// ```
 pub fn se3_cov_as_gtsam_reads(information: &Matrix6<f64>) -> Option<Matrix6<f64>> {
-    let mut swapped = Matrix6::zeros();
-    let block = |m: &Matrix6<f64>, r: usize, c: usize| -> Matrix3<f64> {
-        m.fixed_view::<3, 3>(r, c).into_owned()
-    };
-    // Ω_gtsam = [[Ω_θθ, Ω_θt], [Ω_tθ, Ω_tt]] (dataset.cpp, ParseMeasurement<Pose3>).
-    swapped
-        .fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&block(information, 3, 3));
-    swapped
-        .fixed_view_mut::<3, 3>(3, 3)
-        .copy_from(&block(information, 0, 0));
-    swapped
-        .fixed_view_mut::<3, 3>(3, 0)
-        .copy_from(&block(information, 0, 3));
-    swapped
-        .fixed_view_mut::<3, 3>(0, 3)
-        .copy_from(&block(information, 3, 0));
-    swapped.cholesky().map(|c| c.inverse())
+    // Ω_gtsam = [[Ω_θθ, Ω_θt], [Ω_tθ, Ω_tt]] (dataset.cpp, ParseMeasurement<Pose3>): the one
+    // rotation-first permutation, applied to the information.
+    cov_to_rotation_first(information)
+        .cholesky()
+        .map(|c| c.inverse())
 }

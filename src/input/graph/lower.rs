@@ -7,20 +7,23 @@ use nalgebra::SMatrix;
 
 use super::convention::{from_upper_triangle, se3_cov_from_g2o_error_cov};
 use super::parse::{Dimension, Kind, Record, Records, information_axes};
-use super::{InputError, Locator, Summary};
+use super::{InputError, Locator, Residual, Summary};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
 use crate::plan::{
     AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, limits,
 };
-use crate::uncertain::{Method, Side, UncertainPose};
+use crate::uncertain::{Method, Side, UncertainPose, chi2_radius};
 
 /// Most loop closures evaluated and drawn with their uncertainty (evenly chosen); the rest
 /// are counted in the text panel.
 pub const MAX_LOOP_CLOSURES: usize = 30;
 
 /// Most vertex estimates drawn as axes (evenly chosen, plus the loop closures' ends).
-pub const MAX_DRAWN_VERTICES: usize = 2000;
+pub const MAX_DRAWN_VERTICES: usize = 300;
+
+/// Frames carry their names only up to this many vertices and loop closures.
+const MAX_LABELLED: usize = 40;
 
 /// What the two pose-graph groups need besides being Lie groups.
 trait GraphGroup<const N: usize>: LieGroup<N> {
@@ -260,6 +263,39 @@ fn evenly(n: usize, max: usize) -> Vec<usize> {
     (0..max).map(|k| k * (n - 1) / (max - 1).max(1)).collect()
 }
 
+/// Every loop closure's [`Residual`] at the file's estimates.
+fn residuals<G: LieGroup<N>, const N: usize>(
+    vertices: &BTreeMap<u64, (G, usize)>,
+    edges: &[Edge<G, N>],
+    loops: &[usize],
+) -> Vec<Residual> {
+    let radius_95 = chi2_radius(0.95, N).unwrap_or(f64::NAN);
+    loops
+        .iter()
+        .map(|&i| {
+            let e = &edges[i];
+            let (xi, xj) = (vertices[&e.from].0, vertices[&e.to].0);
+            let r = e
+                .measurement
+                .inverse()
+                .compose(&xi.inverse().compose(&xj))
+                .log();
+            // Σ is positive definite (the inverse of a positive-definite Ω, scaled).
+            let d2 = e
+                .cov
+                .cholesky()
+                .map_or(f64::INFINITY, |c| (r.transpose() * c.solve(&r))[(0, 0)]);
+            Residual {
+                from: e.from,
+                to: e.to,
+                line: e.line,
+                mahalanobis: d2.max(0.0).sqrt(),
+                radius_95,
+            }
+        })
+        .collect()
+}
+
 fn vertex_name(id: u64) -> String {
     format!("v{id}")
 }
@@ -293,6 +329,7 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         sample_axes: false,
         ..DrawChoices::default()
     };
+    choices.labels = drawn_ids.len() + drawn_loops.len() <= MAX_LABELLED;
     let mut operation_lines = Vec::new();
     for id in &drawn_ids {
         let name = vertex_name(*id);
@@ -353,16 +390,37 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         choices.axis_length =
             Some((0.3 * median).clamp(limits::MIN_AXIS_LENGTH, limits::MAX_AXIS_LENGTH));
     }
+    let mut residuals = residuals(vertices, edges, &loops);
+    let loop_closures_inconsistent = residuals
+        .iter()
+        .filter(|r| r.mahalanobis > r.radius_95)
+        .count();
+    residuals.sort_by(|a, b| b.mahalanobis.total_cmp(&a.mahalanobis));
+    residuals.truncate(10);
     let summary = Summary {
         vertices: vertices.len(),
         edges: edges.len(),
         chain_edges: chain.len(),
         loop_closures: loops.len(),
         loop_closures_drawn: drawn_loops.len(),
+        vertices_drawn: drawn_ids.len(),
+        loop_closures_inconsistent,
+        worst_loop_closures: residuals,
     };
     let chain_end = first + chain.len() as u64;
     let about = About {
-        title: format!("Pose graph {}", locator.file()),
+        title: format!(
+            "Pose graph {}: {} {} poses, {} odometry edges, {} loop closures",
+            locator.file(),
+            summary.vertices,
+            if G::KIND.is_planar() {
+                "SE(2)"
+            } else {
+                "SE(3)"
+            },
+            summary.chain_edges,
+            summary.loop_closures
+        ),
         description: describe(G::KIND.is_planar(), &summary, first, chain_end, records),
         source: String::new(),
     };
@@ -379,12 +437,23 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
 }
 
 fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Records) -> String {
+    let chain = if s.chain_edges == 0 {
+        format!(
+            "- **No odometry chain**: no edge joins v{first} to v{}, so nothing is propagated.\n",
+            first.saturating_add(1)
+        )
+    } else {
+        format!(
+            "- **Odometry chain** `odometry_chain`: the {} edges between consecutive vertex ids, \
+             v{first} → v{chain_end}, composed from v{first}'s estimate with each edge's \
+             covariance (first order in colour, Monte Carlo as the cloud). Scrub the `step` \
+             timeline: step k is vertex v{first}+k, and the banana grows as the errors of every \
+             edge add up.\n",
+            s.chain_edges
+        )
+    };
     let mut d = format!(
-        "**{} vertices, {} edges** ({}).\n\n\
-         - **Odometry chain** `odometry_chain`: the {} edges between consecutive vertex ids, \
-         v{first} → v{chain_end}, composed from v{first}'s estimate with each edge's covariance \
-         (first order in colour, Monte Carlo as the cloud). Scrub the `step` timeline: step k is \
-         vertex v{first}+k, and the banana grows as the errors of every edge add up.\n\
+        "**{} vertices, {} edges** ({}).\n\n{chain}\
          - **Vertex estimates** `v<id>`: the file's poses, as axes. Where they part from the \
          chain's mean, the file's estimate is not dead reckoning (e.g. it was optimised).\n\
          - **Loop closures** (the other {} edges): a grey line between the two vertices, and \
@@ -392,20 +461,50 @@ fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Rec
         s.vertices,
         s.edges,
         if planar { "SE(2)" } else { "SE(3)" },
-        s.chain_edges,
         s.loop_closures,
     );
+    if s.vertices_drawn < s.vertices {
+        d.push_str(&format!(
+            "\n{} of the {} vertex estimates are drawn (evenly chosen, and the drawn loop closures' ends).\n",
+            s.vertices_drawn, s.vertices
+        ));
+    }
     if s.loop_closures_drawn < s.loop_closures {
         d.push_str(&format!(
             "\n{} of the {} loop closures are drawn (evenly chosen).\n",
             s.loop_closures_drawn, s.loop_closures
         ));
     }
-    if s.vertices as u64 > chain_end - first + 1 {
+    if s.chain_edges > 0 && s.vertices as u64 > chain_end - first + 1 {
         d.push_str(&format!(
-            "\nThe chain stops at v{chain_end}: no edge joins it to v{}.\n",
-            chain_end + 1
+            "\nThe chain stops at v{chain_end}: no edge joins it to v{} (the later vertices are \
+             drawn, not propagated).\n",
+            chain_end.saturating_add(1)
         ));
+    }
+    if s.loop_closures > 0 {
+        d.push_str(&format!(
+            "\n**Loop closures against the estimates**: {} of {} put vertex j outside their own \
+             95 % region around X_i · Z (Mahalanobis distance d of X_j under the edge's Σ beyond \
+             √χ²₉₅ = {:.2}).",
+            s.loop_closures_inconsistent,
+            s.loop_closures,
+            s.worst_loop_closures
+                .first()
+                .map_or(f64::NAN, |r| r.radius_95)
+        ));
+        let worst: Vec<String> = s
+            .worst_loop_closures
+            .iter()
+            .take(5)
+            .map(|r| {
+                format!(
+                    "v{} → v{} (line {}): d = {:.3}",
+                    r.from, r.to, r.line, r.mahalanobis
+                )
+            })
+            .collect();
+        d.push_str(&format!(" Largest: {}.\n", worst.join("; ")));
     }
     for (tag, n) in &records.skipped {
         d.push_str(&format!("\nSkipped {n} `{tag}` record(s) (not drawn).\n"));

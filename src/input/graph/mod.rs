@@ -12,7 +12,7 @@
 //!
 //! The edge covariance is posecov's right-perturbation Σ over [ρ; θ] — for `EDGE_SE3:QUAT`
 //! with the rotation block scaled from the quaternion's vector part, see [`convention`] and
-//! [CONVENTIONS §9](crate::conventions#9-pose-graphs-g2o-and-gtsam).
+//! [CONVENTIONS §10](crate::conventions#10-pose-graphs-g2o-and-gtsam).
 //!
 //! ```
 //! use posecov::input::graph::read_text;
@@ -39,7 +39,7 @@ pub use lower::MAX_LOOP_CLOSURES;
 pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
 
 /// The counts a graph file holds, for messages, the text panel and `report --json`.
-#[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct Summary {
     /// Vertices.
     pub vertices: usize,
@@ -52,6 +52,30 @@ pub struct Summary {
     /// Loop closures evaluated and drawn with their uncertainty (at most
     /// [`MAX_LOOP_CLOSURES`]).
     pub loop_closures_drawn: usize,
+    /// Vertex estimates drawn as axes (at most 300, plus the drawn loop closures' ends).
+    pub vertices_drawn: usize,
+    /// Loop closures whose vertex estimates lie outside the edge's own 95 % region
+    /// ([`Residual::mahalanobis`] beyond [`Residual::radius_95`]).
+    pub loop_closures_inconsistent: usize,
+    /// The loop closures that disagree most with the vertex estimates (at most 10, worst first).
+    pub worst_loop_closures: Vec<Residual>,
+}
+
+/// How far a loop closure i → j is from the file's estimates: r = Log(Z⁻¹ · X_i⁻¹ · X_j)
+/// (the edge's error at the estimates, right form, [ρ; θ]) measured with the edge's Σ,
+/// d = √(rᵀ Σ⁻¹ r), beside the χ² radius that holds 95 % of the edge's Gaussian.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Residual {
+    /// Vertex i.
+    pub from: u64,
+    /// Vertex j.
+    pub to: u64,
+    /// The edge's line.
+    pub line: usize,
+    /// d = √(rᵀ Σ⁻¹ r).
+    pub mahalanobis: f64,
+    /// √χ²_n(0.95), n = 3 (SE(2)) or 6 (SE(3)).
+    pub radius_95: f64,
 }
 
 /// A read graph file: where its records are (to locate later errors) and what it holds.
@@ -139,6 +163,8 @@ pub fn read_file(path: &Path) -> Result<(Graph, Input), InputError> {
 ///
 /// See the [module docs](self) for an example.
 pub fn read_text(text: &str, origin: &str) -> Result<(Graph, Input), InputError> {
+    // A byte-order mark some editors write is not part of the first tag.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let locator = Locator::new(origin, text);
     let records = parse::read_records(&locator)?;
     let (input, operation_lines, summary) = lower::lower(&locator, &records)?;

@@ -194,7 +194,7 @@ impl Lowering<'_> {
             axis_length: spec.axis_length.as_ref().map(|l| *l.get_ref()),
             top_view: spec.view.map(|v| v == super::schema::View::Top),
             shown,
-            links: Vec::new(),
+            ..DrawChoices::default()
         })
     }
 
