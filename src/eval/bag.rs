@@ -71,8 +71,8 @@ pub enum PoseState {
     },
     /// 3-D: SE(3), body-frame right form, with its cloud.
     Spatial {
-        /// The Gaussian.
-        pose: UncertainPose<Se3, 6>,
+        /// The Gaussian (boxed: 6 × 6).
+        pose: Box<UncertainPose<Se3, 6>>,
         /// Samples μ · Exp(ε).
         cloud: Vec<Se3>,
     },
@@ -239,7 +239,7 @@ fn meaning(
         let right = ros_cov_to_right(cov_ros, mean.rotation());
         UncertainPose::try_new(*mean, right, Side::Right)
             .map(|pose| PoseState::Spatial {
-                pose,
+                pose: Box::new(pose),
                 cloud: Vec::new(),
             })
             .map_err(invalid)
@@ -276,6 +276,7 @@ fn with_cloud(state: PoseState, settings: &BagEvalSettings, family: u64, index: 
 mod tests {
     use super::*;
     use crate::interop::RosPoseWithCovariance;
+    use crate::lie::LieGroup;
 
     #[test]
     fn planar_meaning_is_the_ros_conversion_restricted_to_the_plane() {

@@ -45,21 +45,12 @@ pub const MAX_DRAWN_LIMIT: usize = 5000;
 pub const MAX_SERIES: usize = 20_000;
 
 /// What to read and how much to keep.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct BagOptions {
     /// Topics to read (`--topic`, repeatable); empty: every pose topic.
     pub topics: Vec<String>,
     /// Draw every N-th message (`--every N`); `None`: at most [`DEFAULT_MAX_DRAWN`].
     pub every: Option<u64>,
-}
-
-impl Default for BagOptions {
-    fn default() -> Self {
-        Self {
-            topics: Vec::new(),
-            every: None,
-        }
-    }
 }
 
 /// Reads a log into a [`BagPlan`]; its format by content and extension ([`format::detect`]).
