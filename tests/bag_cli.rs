@@ -4,6 +4,8 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+mod rrd;
+
 const BIN: &str = env!("CARGO_BIN_EXE_posecov");
 const TEST2: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),

@@ -95,16 +95,7 @@ fn check_overrides(overrides: &Overrides) -> Result<(BagOptions, usize), AppErro
         }
         .into());
     }
-    if let Some(p) = overrides.confidence
-        && !(p > 0.0 && p < 1.0)
-    {
-        return Err(SettingsError {
-            flag: "--confidence",
-            value: p.to_string(),
-            expected: "a probability strictly between 0 and 1, e.g. 0.95".to_owned(),
-        }
-        .into());
-    }
+    super::settings::check_confidence(overrides.confidence)?;
     let samples = overrides.samples.unwrap_or(DEFAULT_CLOUD_SAMPLES as u64);
     if !(1..=MAX_CLOUD_SAMPLES).contains(&samples) {
         return Err(SettingsError {

@@ -52,6 +52,18 @@ pub struct Settings {
     pub draw: DrawSettings,
 }
 
+/// `--confidence` must be a probability strictly between 0 and 1 (every input's check).
+pub(super) fn check_confidence(confidence: Option<f64>) -> Result<(), SettingsError> {
+    match confidence {
+        Some(p) if !(p > 0.0 && p < 1.0) => Err(SettingsError {
+            flag: "--confidence",
+            value: p.to_string(),
+            expected: "a probability strictly between 0 and 1, e.g. 0.95".to_owned(),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Resolves the settings of `input` under `overrides` (values in the file were checked when
 /// it was read; flags are checked here and named in errors).
 ///
@@ -92,15 +104,7 @@ pub fn resolve(
             expected: format!("use {} ..= {}", limits::MIN_SAMPLES, limits::MAX_SAMPLES),
         });
     }
-    if let Some(p) = overrides.confidence
-        && !(p > 0.0 && p < 1.0)
-    {
-        return Err(SettingsError {
-            flag: "--confidence",
-            value: p.to_string(),
-            expected: "a probability strictly between 0 and 1, e.g. 0.95".to_owned(),
-        });
-    }
+    check_confidence(overrides.confidence)?;
     if let Some(b) = overrides.block_samples
         && !(1..=limits::MAX_SAMPLES).contains(&b)
     {

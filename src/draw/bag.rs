@@ -131,15 +131,7 @@ fn extent(e: &BagEvaluation) -> f64 {
         .flat_map(|t| t.trajectory.iter().map(|(_, p)| Vector3::from(*p)))
         .filter(|p| p.iter().all(|v| v.is_finite()))
         .collect();
-    if points.is_empty() {
-        return 1.0;
-    }
-    let centroid = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
-    let r = points
-        .iter()
-        .map(|p| (p - centroid).norm())
-        .fold(0.0, f64::max);
-    if r > 1e-9 { r } else { 1.0 }
+    super::extent_of(&points)
 }
 
 /// Pushes items made by a shape helper (which logs on steps) at a stamp instead.
@@ -168,16 +160,18 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
         .map(|(_, q)| flat(t.planar, &Vector3::from(*q)))
         .filter(|q| q.iter().all(|v| v.is_finite()))
         .collect();
-    put(
-        p,
-        format!("{base}/trajectory"),
-        Timing::Static,
-        ItemKind::LineStrips(LineStrips {
-            strips: vec![strip],
-            color: color.with_alpha(220),
-            radius: 0.003 * p.extent,
-        }),
-    );
+    if !strip.is_empty() {
+        put(
+            p,
+            format!("{base}/trajectory"),
+            Timing::Static,
+            ItemKind::LineStrips(LineStrips {
+                strips: vec![strip],
+                color: color.with_alpha(220),
+                radius: 0.003 * p.extent,
+            }),
+        );
+    }
     history(p, &base, t);
     let r_pos = chi2_radius(p.confidence(), t.position_dof);
     let r_disc = chi2_radius(p.confidence(), 2);

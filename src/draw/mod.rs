@@ -393,6 +393,11 @@ fn scene_extent<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> f64 {
                 .flat_map(|p| p.poses.iter().map(|x| *x.to_se3().translation())),
         )
         .collect();
+    extent_of(&points)
+}
+
+/// The largest distance of a point from the points' centroid (1 m for none, or all equal).
+fn extent_of(points: &[Vector3<f64>]) -> f64 {
     if points.is_empty() {
         return 1.0;
     }

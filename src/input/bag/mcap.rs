@@ -87,6 +87,7 @@ pub(super) fn read(
                         } else {
                             schema
                         };
+                        collector.declare(&c.topic, &type_name, kind.as_ref());
                         channels.insert(
                             c.id,
                             Chan {

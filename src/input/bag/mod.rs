@@ -177,6 +177,40 @@ impl<'a> Collector<'a> {
         self.cancelled
     }
 
+    /// A topic the log declares (a ROS 1 connection, an MCAP channel), so that a topic with
+    /// no messages is still listed.
+    fn declare(
+        &mut self,
+        topic: &str,
+        type_name: &str,
+        kind: Option<&Result<PoseMessageKind, String>>,
+    ) {
+        match kind {
+            Some(Ok(kind)) if self.selected(topic) => {
+                if !self.topics.contains_key(topic) {
+                    let state = TopicState::new(*kind, self.options.every);
+                    self.topics.insert(topic.to_owned(), state);
+                }
+            }
+            Some(Ok(_)) => {
+                self.not_selected.insert(topic.to_owned(), ());
+            }
+            other => {
+                if !self.skipped.contains_key(topic) {
+                    let label = match other {
+                        Some(Err(why)) => why.clone(),
+                        _ => type_name.to_owned(),
+                    };
+                    self.skipped.insert(topic.to_owned(), (label, 0));
+                }
+            }
+        }
+    }
+
+    fn selected(&self, topic: &str) -> bool {
+        self.options.topics.is_empty() || self.options.topics.iter().any(|t| t == topic)
+    }
+
     /// One message: `kind` is `None` for another type, `Some(Err(why))` for a pose type whose
     /// definition does not match.
     fn message(
@@ -204,7 +238,7 @@ impl<'a> Collector<'a> {
                 return;
             }
         };
-        if !self.options.topics.is_empty() && !self.options.topics.iter().any(|t| t == topic) {
+        if !self.selected(topic) {
             if !self.not_selected.contains_key(topic) {
                 self.not_selected.insert(topic.to_owned(), ());
             }
@@ -212,29 +246,8 @@ impl<'a> Collector<'a> {
         }
         let every = self.options.every;
         if !self.topics.contains_key(topic) {
-            self.topics.insert(
-                topic.to_owned(),
-                TopicState {
-                    kind,
-                    frame_id: None,
-                    child_frame_id: None,
-                    count: 0,
-                    from_log: 0,
-                    out_of_order: 0,
-                    last_stamp: None,
-                    range: None,
-                    health: Health::default(),
-                    trend: health::Trend::default(),
-                    usable: 0,
-                    planar: true,
-                    drawn: match every {
-                        Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
-                        None => Decimator::new(1, DEFAULT_MAX_DRAWN),
-                    },
-                    trajectory: Decimator::new(1, MAX_SERIES),
-                    series: Decimator::new(1, MAX_SERIES),
-                },
-            );
+            self.topics
+                .insert(topic.to_owned(), TopicState::new(kind, every));
         }
         let Some(state) = self.topics.get_mut(topic) else {
             return;
@@ -298,6 +311,29 @@ impl<'a> Collector<'a> {
 }
 
 impl TopicState {
+    fn new(kind: PoseMessageKind, every: Option<u64>) -> Self {
+        TopicState {
+            kind,
+            frame_id: None,
+            child_frame_id: None,
+            count: 0,
+            from_log: 0,
+            out_of_order: 0,
+            last_stamp: None,
+            range: None,
+            health: Health::default(),
+            trend: health::Trend::default(),
+            usable: 0,
+            planar: true,
+            drawn: match every {
+                Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
+                None => Decimator::new(1, DEFAULT_MAX_DRAWN),
+            },
+            trajectory: Decimator::new(1, MAX_SERIES),
+            series: Decimator::new(1, MAX_SERIES),
+        }
+    }
+
     fn add(&mut self, decoded: Result<Decoded, DecodeError>, log_time_ns: i64) {
         let index = self.count;
         self.count += 1;
@@ -409,6 +445,42 @@ impl TopicState {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_declared_topic_without_messages_is_listed_and_drawable() {
+        let options = BagOptions::default();
+        let mut c = Collector::new(&options, None);
+        let kind = Ok(PoseMessageKind::PoseWithCovarianceStamped);
+        c.declare(
+            "/empty",
+            "geometry_msgs/PoseWithCovarianceStamped",
+            Some(&kind),
+        );
+        c.declare("/camera", "sensor_msgs/Image", None);
+        let plan = c.finish(Path::new("x.bag"), LogFormat::Ros1Bag).unwrap();
+        assert_eq!(plan.topics.len(), 1);
+        assert_eq!(
+            (plan.topics[0].name.as_str(), plan.topics[0].count),
+            ("/empty", 0)
+        );
+        assert!(!plan.topics[0].planar);
+        assert_eq!(plan.skipped[0].count, 0);
+        let e = crate::eval::bag::evaluate_bag(&plan, &Default::default());
+        let about = crate::input::About {
+            title: "t".into(),
+            description: String::new(),
+            source: String::new(),
+        };
+        let settings = crate::draw::bag::BagDrawSettings {
+            about,
+            confidence: 0.95,
+            axis_length: None,
+        };
+        let text = crate::draw::bag::description(&plan, &e, 0.95);
+        assert!(text.contains("0 messages"), "{text}");
+        let scene = crate::draw::bag::bag_scene(&e, &settings, &text);
+        assert!(scene.validate().is_ok());
+    }
 
     #[test]
     fn decimation_is_bounded_and_even() {

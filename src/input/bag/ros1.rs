@@ -116,7 +116,9 @@ pub(super) fn read(
     for record in bag.index_records() {
         match record {
             Ok(IndexRecord::Connection(c)) => {
-                conns.insert(c.id, conn_of(&c));
+                let conn = conn_of(&c);
+                collector.declare(&conn.topic, &conn.type_name, conn.kind.as_ref());
+                conns.insert(c.id, conn);
             }
             Ok(IndexRecord::ChunkInfo(info)) => chunk_positions.push(info.chunk_pos),
             Ok(_) => {}
