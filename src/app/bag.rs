@@ -270,6 +270,7 @@ pub fn report_json(run: &LogRun) -> serde_json::Value {
                 "every": t.stride,
                 "health": health,
                 "min_eigenvalue": t.health.min_eigenvalue,
+                "twist_sigma_last": t.twist_sigmas(),
             })
         })
         .collect();

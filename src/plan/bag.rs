@@ -17,6 +17,9 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+/// A variance at or above this is a placeholder ("not estimated"), not a measurement.
+pub const PLACEHOLDER: f64 = 1e6;
+
 /// Number of entries of a ROS 6 × 6 covariance (row-major).
 pub const COV_LEN: usize = 36;
 
@@ -278,6 +281,28 @@ pub struct TopicPlan {
     pub trajectory: Vec<(i64, [f64; 3])>,
     /// Time series (bounded, in stamp order).
     pub series: Vec<SeriesPoint>,
+}
+
+impl TopicPlan {
+    /// √ of the twist covariance's diagonal (vx vy vz ωx ωy ωz, in the child frame) of the last
+    /// drawn Odometry message, where finite and not a placeholder (`None` per entry otherwise;
+    /// `None` for other types).
+    ///
+    /// ```
+    /// use posecov::input::bag::{BagOptions, read_bag};
+    /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
+    /// let plan = read_bag(path.as_ref(), &BagOptions::default(), &mut |_, _| {}, None).unwrap();
+    /// let sigma = plan.topics[0].twist_sigmas().unwrap();
+    /// assert!((sigma[0].unwrap() - 0.001f64.sqrt()).abs() < 1e-12);
+    /// assert_eq!(sigma[3], None); // a 1e6 placeholder
+    /// ```
+    pub fn twist_sigmas(&self) -> Option<[Option<f64>; 6]> {
+        let twist = self.drawn.last()?.message.twist_covariance?;
+        Some(std::array::from_fn(|i| {
+            let v = twist[i * 7];
+            (v.is_finite() && (0.0..PLACEHOLDER).contains(&v)).then(|| v.sqrt())
+        }))
+    }
 }
 
 /// A topic of another message type, skipped.

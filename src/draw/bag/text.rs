@@ -119,6 +119,22 @@ fn topic(s: &mut String, t: &TopicPlan, e: &crate::eval::bag::TopicEvaluation, p
             let _ = writeln!(s, "| {word} | {} | {} |", c.count, secs(c.first_stamp_ns));
         }
     }
+    if let Some(sig) = t.twist_sigmas() {
+        let names = ["vx", "vy", "vz", "ωx", "ωy", "ωz"];
+        let parts: Vec<String> = sig
+            .iter()
+            .zip(names)
+            .map(|(v, n)| match v {
+                Some(v) => format!("σ{n} {v:.3}"),
+                None => format!("σ{n} –"),
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "\nTwist covariance of the last drawn message (child frame; m/s, rad/s; – placeholder): {}.",
+            parts.join(", ")
+        );
+    }
     let invalid = e.poses.iter().filter(|q| !q.state.is_drawable()).count();
     let placeholders3d = e
         .poses

@@ -5,8 +5,7 @@ use nalgebra::{DMatrix, SymmetricEigen};
 
 use crate::plan::bag::{COV_LEN, Issue};
 
-/// A variance at or above this is a placeholder ("not estimated"), not a measurement.
-pub const PLACEHOLDER: f64 = 1e6;
+pub use crate::plan::bag::PLACEHOLDER;
 /// Relative tolerance of the symmetry check: |Σᵢⱼ − Σⱼᵢ| ≤ tol · max(1, max |Σᵢᵢ|).
 pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
 /// Relative tolerance of the PSD check: λ_min ≥ −tol · max(λ_max, tiny).
