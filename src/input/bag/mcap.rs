@@ -11,20 +11,13 @@ use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use super::decode::ros2_kind;
-use super::{Codec, Collector};
+use super::{Codec, Collector, Stream};
 use crate::input::InputError;
-use crate::plan::bag::PoseMessageKind;
 
 /// The largest record (or decompressed chunk) read: larger ones are refused, not allocated.
 pub const RECORD_LIMIT: usize = 1 << 30;
 /// At most this many bytes are read from the file at a time.
 const READ_PIECE: usize = 1 << 20;
-
-struct Chan {
-    topic: String,
-    type_name: String,
-    kind: Option<Result<PoseMessageKind, String>>,
-}
 
 /// Streams every message of the file into `collector`.
 pub(super) fn read(
@@ -46,7 +39,7 @@ pub(super) fn read(
         LinearReaderOptions::default().with_record_length_limit(RECORD_LIMIT),
     );
     let mut schemas: HashMap<u16, (String, String)> = HashMap::new();
-    let mut channels: HashMap<u16, Chan> = HashMap::new();
+    let mut channels: HashMap<u16, Stream> = HashMap::new();
     let mut done = 0u64;
     let mut last_report = 0u64;
     while let Some(event) = reader.next_event() {
@@ -90,7 +83,7 @@ pub(super) fn read(
                         collector.declare(&c.topic, &type_name, kind.as_ref());
                         channels.insert(
                             c.id,
-                            Chan {
+                            Stream {
                                 topic: c.topic,
                                 type_name,
                                 kind,
@@ -101,21 +94,17 @@ pub(super) fn read(
                         if collector.stop() {
                             return Ok(());
                         }
-                        let Some(chan) = channels.get(&header.channel_id) else {
-                            return Err(fail(format!(
-                                "a message on channel {} that the file never declares",
-                                header.channel_id
-                            )));
-                        };
-                        let log_ns = i64::try_from(header.log_time).unwrap_or(i64::MAX);
-                        collector.message(
-                            &chan.topic,
-                            &chan.type_name,
-                            chan.kind.as_ref(),
-                            log_ns,
-                            &data,
-                            Codec::Cdr,
-                        );
+                        let id = header.channel_id;
+                        collector
+                            .message_on(
+                                channels.get(&id),
+                                "channel",
+                                id.into(),
+                                header.log_time,
+                                &data,
+                                Codec::Cdr,
+                            )
+                            .map_err(fail)?;
                     }
                     _ => {}
                 }

@@ -84,6 +84,14 @@ pub fn read_bag(
     collector.finish(path, format)
 }
 
+/// A connection (ROS 1) or channel (MCAP): its topic, type and what posecov makes of it
+/// (`None`: another type; `Some(Err(why))`: a pose type in another definition or encoding).
+struct Stream {
+    topic: String,
+    type_name: String,
+    kind: Option<Result<PoseMessageKind, String>>,
+}
+
 /// How a message's bytes are encoded.
 #[derive(Debug, Clone, Copy)]
 enum Codec {
@@ -209,6 +217,28 @@ impl<'a> Collector<'a> {
 
     fn selected(&self, topic: &str) -> bool {
         self.options.topics.is_empty() || self.options.topics.iter().any(|t| t == topic)
+    }
+
+    /// One message on stream `id` (`streams[id]`), logged at `log_time` ns; an undeclared
+    /// stream is an error (`what` names connection or channel).
+    fn message_on(
+        &mut self,
+        stream: Option<&Stream>,
+        what: &str,
+        id: u64,
+        log_time: u64,
+        bytes: &[u8],
+        codec: Codec,
+    ) -> Result<(), String> {
+        let Some(stream) = stream else {
+            return Err(format!(
+                "a message on {what} {id} that the file never declares"
+            ));
+        };
+        let log_ns = i64::try_from(log_time).unwrap_or(i64::MAX);
+        let kind = stream.kind.as_ref();
+        self.message(&stream.topic, &stream.type_name, kind, log_ns, bytes, codec);
+        Ok(())
     }
 
     /// One message: `kind` is `None` for another type, `Some(Err(why))` for a pose type whose

@@ -12,21 +12,13 @@ use rosbag::record_types::Chunk;
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
 use super::decode::ros1_kind;
-use super::{Codec, Collector};
+use super::{Codec, Collector, Stream};
 use crate::input::InputError;
 use crate::input::format::ROSBAG_MAGIC as ROS1_MAGIC;
-use crate::plan::bag::PoseMessageKind;
 
-/// A connection: topic, type, what posecov makes of it.
-struct Conn {
-    topic: String,
-    type_name: String,
-    kind: Option<Result<PoseMessageKind, String>>,
-}
-
-fn conn_of(c: &rosbag::record_types::Connection<'_>) -> Conn {
+fn conn_of(c: &rosbag::record_types::Connection<'_>) -> Stream {
     let md5: String = c.md5sum.iter().map(|b| format!("{b:02x}")).collect();
-    Conn {
+    Stream {
         topic: c.topic.to_owned(),
         type_name: c.tp.to_owned(),
         kind: ros1_kind(c.tp, &md5),
@@ -111,7 +103,7 @@ pub(super) fn read(
     })?;
     // Connections from the index section (every topic and type up front), then any the
     // chunks declare themselves.
-    let mut conns: HashMap<u32, Conn> = HashMap::new();
+    let mut conns: HashMap<u32, Stream> = HashMap::new();
     let mut chunk_positions = Vec::new();
     for record in bag.index_records() {
         match record {
@@ -168,21 +160,17 @@ pub(super) fn read(
                         if collector.stop() {
                             return Ok(());
                         }
-                        let Some(conn) = conns.get(&m.conn_id) else {
-                            return Err(fail(format!(
-                                "chunk {done} of {total}: a message on connection {} that the bag never declares",
-                                m.conn_id
-                            )));
-                        };
-                        let log_ns = i64::try_from(m.time).unwrap_or(i64::MAX);
-                        collector.message(
-                            &conn.topic,
-                            &conn.type_name,
-                            conn.kind.as_ref(),
-                            log_ns,
-                            m.data,
-                            Codec::Ros1,
-                        );
+                        let id = m.conn_id;
+                        collector
+                            .message_on(
+                                conns.get(&id),
+                                "connection",
+                                id.into(),
+                                m.time,
+                                m.data,
+                                Codec::Ros1,
+                            )
+                            .map_err(|e| fail(format!("chunk {done} of {total}: {e}")))?;
                     }
                     Err(e) => return Err(fail(format!("chunk {done} of {total}: {e}"))),
                 }
