@@ -295,6 +295,14 @@ pub fn report_json(run: &LogRun) -> serde_json::Value {
 }
 
 /// The text report: the summary the text panel shows.
+///
+/// ```
+/// use posecov::app::{Overrides, bag};
+/// let place = bag::locate("jackal_odometry").unwrap().unwrap();
+/// let run = bag::run(&place, "jackal_odometry", &Overrides::default(), None).unwrap();
+/// assert!(bag::report_text(&run).contains("| placeholder (≥ 1e6) | 3060 | 47.584 s |"));
+/// assert!(bag::check_line(&run).starts_with("jackal_odometry: ok (1 pose topic(s), 6121 messages"));
+/// ```
 pub fn report_text(run: &LogRun) -> String {
     format!(
         "{} — {} ({:.1} % regions, seed {})\n\n{}",
@@ -306,7 +314,7 @@ pub fn report_text(run: &LogRun) -> String {
     )
 }
 
-/// One line: topics, messages, drawn items, health issues.
+/// One line: topics, messages, drawn items, health issues (example at [`report_text`]).
 pub fn check_line(run: &LogRun) -> String {
     let issues: u64 = run
         .plan

@@ -48,6 +48,12 @@ pub fn find(name: &str) -> Option<&'static BundledLog> {
 
 /// The bundled logs as [`Example`]s (no text: they are binary; `posecov list` takes their
 /// titles from [`find`]).
+///
+/// ```
+/// use posecov::input::Format;
+/// let formats: Vec<Format> = posecov::input::bag::bundled::examples().map(|e| e.format).collect();
+/// assert_eq!(formats, [Format::Ros1Bag, Format::Mcap]);
+/// ```
 pub fn examples() -> impl Iterator<Item = Example> {
     LOGS.iter().map(|l| Example {
         name: l.name,
