@@ -110,6 +110,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 samples: if monte_carlo { block.len() } else { 0 },
                 block_samples: block.len(),
                 methods: settings.methods.clone(),
+                unscented: settings.unscented,
                 nodes: Vec::new(),
                 points: Vec::new(),
                 paths: Vec::new(),

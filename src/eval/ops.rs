@@ -18,7 +18,7 @@ use crate::propagate::first_order::{self, CorrelatedPair};
 use crate::propagate::fourth_order::Order;
 use crate::propagate::fusion::{FusionOptions, fuse};
 use crate::propagate::odometry::{InputNoise, propagate_increments, propagate_tangent_inputs};
-use crate::propagate::sigma_point::{self, Unscented};
+use crate::propagate::sigma_point;
 use crate::sample::{Sampler, fill_par_from, retract, standard_normal};
 use crate::uncertain::{Method, Side, UncertainPose};
 
@@ -93,7 +93,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let mut out = vec![first];
         out.extend(extra);
         if self.wants(Method::SigmaPoints) && !inputs.is_empty() {
-            match sigma_point::map(inputs, &map, &Unscented::default()) {
+            match sigma_point::map(inputs, &map, &self.settings.unscented) {
                 Ok(result) => out.push(result),
                 Err(e) => self.method_failed(None, Method::SigmaPoints, e.to_string()),
             }
@@ -526,7 +526,8 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         self.out.findings.push(Finding::Fusion {
             output: self.output(),
             inputs: estimates.len(),
-            cost: fused.cost,
+            // Barfoot & Furgale's V carries the ½ that the Gauss–Newton objective J omits.
+            cost: 0.5 * fused.cost,
             iterations: fused.iterations,
         });
         // Fusion has no sampled counterpart: Monte Carlo downstream continues from samples

@@ -39,8 +39,10 @@
 mod mesh;
 mod palette;
 mod validate;
+mod view;
 
 pub use mesh::unit_sphere_mesh;
+pub use view::{Camera, View3d, grid_columns, rotate};
 pub use palette::NOMINAL;
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
@@ -325,6 +327,9 @@ pub struct Scene {
     /// A planar scene (SE(2), SO(2)) lives in the x–y plane: the sink declares +y as the
     /// viewer's up axis so the default camera faces that plane instead of grazing it.
     pub planar: bool,
+    /// The 3-D views, each with its camera; empty: one view of the whole world, framed by the
+    /// viewer.
+    pub views: Vec<View3d>,
 }
 
 impl Scene {
@@ -342,6 +347,7 @@ impl Scene {
             plots: Vec::new(),
             series: Vec::new(),
             planar: false,
+            views: Vec::new(),
         }
     }
 
