@@ -1,0 +1,337 @@
+//! `report --json` carries every number the viewer shows, under stable keys, and each is
+//! recomputed here from the evaluation's own particles or inputs:
+//! `monte_carlo[*].uncentred_about_nominal_{left,right}`, `cartesian_mean`, `lie_mean_*`,
+//! `covariance_right`; `results[*].relative_error_vs_monte_carlo`; the fusion cost V (with
+//! Barfoot & Furgale's ½); `meta.sigma_points` and `[methods.sigma_points]` in files.
+
+use nalgebra::{DMatrix, Matrix3};
+use posecov::app::{Loaded, Overrides, load_text, pipeline, report_json};
+use posecov::eval::AnyEvaluation;
+use posecov::lie::{LieGroup, Se2};
+use posecov::sample::uncentred_covariance;
+use posecov::uncertain::Side;
+use serde_json::Value;
+
+fn run(text: &str, samples: u64) -> (Loaded, AnyEvaluation, Value) {
+    let loaded = load_text(text, "t.toml").expect("loads");
+    let overrides = Overrides {
+        samples: Some(samples),
+        ..Default::default()
+    };
+    let (evaluation, _) = pipeline(&loaded, &overrides, None).expect("evaluates");
+    let json = report_json("t", &loaded, &evaluation, 0.95);
+    (loaded, evaluation, json)
+}
+
+fn matrix(v: &Value) -> DMatrix<f64> {
+    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).expect("rows of numbers");
+    DMatrix::from_fn(rows.len(), rows[0].len(), |r, c| rows[r][c])
+}
+
+fn close(a: &DMatrix<f64>, b: &DMatrix<f64>, tol: f64) -> bool {
+    (a - b).norm() <= tol * b.norm().max(1e-12)
+}
+
+const COMPOUND: &str = r#"[scenario]
+title = "t"
+group = "se2"
+seed = 4
+methods = ["first_order", "second_order", "monte_carlo"]
+[[pose]]
+name = "start"
+mean = { xy_theta = [0.0, 0.0, 0.0] }
+cov = { std = [0.0001, 0.0001, 0.0001], side = "left" }
+[[pose]]
+name = "step"
+mean = { xy_theta = [1.0, 0.0, 0.0] }
+[[operation]]
+kind = "compound"
+input = "start"
+by = "step"
+steps = 3
+noise = { std = [0.0, 0.0, 0.1], side = "left" }
+output = "robot"
+"#;
+
+#[test]
+fn uncentred_monte_carlo_covariance_about_the_nominal_is_reported_on_both_sides() {
+    let (_, evaluation, json) = run(COMPOUND, 500);
+    let AnyEvaluation::Se2(e) = &evaluation else {
+        panic!("SE(2)")
+    };
+    let node = e
+        .nodes
+        .iter()
+        .rfind(|n| n.name == "robot")
+        .expect("last step");
+    let particles = node.particles.as_ref().expect("a short propagation keeps particles");
+    let label = format!("robot@{}", node.step.expect("a step"));
+    let record = json["monte_carlo"]
+        .as_array()
+        .expect("monte_carlo is an array")
+        .iter()
+        .find(|r| r["label"] == label.as_str())
+        .expect("the last step's record");
+    for (key, side) in [
+        ("uncentred_about_nominal_left", Side::Left),
+        ("uncentred_about_nominal_right", Side::Right),
+    ] {
+        let reported = matrix(&record[key]);
+        let direct: Matrix3<f64> = uncentred_covariance(particles, &node.nominal, side).unwrap();
+        let direct = DMatrix::from_column_slice(3, 3, direct.as_slice());
+        assert!(close(&reported, &direct, 1e-9), "{key}: {reported} vs {direct}");
+    }
+    // The two sides differ (the pose is 3 m out), so the right one is not a copy.
+    assert!(!close(
+        &matrix(&record["uncentred_about_nominal_left"]),
+        &matrix(&record["uncentred_about_nominal_right"]),
+        1e-3
+    ));
+    assert_eq!(record["samples"], 500);
+    // The Lie mean and the centred covariance are the Monte Carlo estimate of `results`.
+    let mc = json["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["label"] == label.as_str() && r["method"] == "monte_carlo")
+        .expect("the Monte Carlo estimate");
+    assert_eq!(record["lie_mean_tangent"], mc["mean_tangent"]);
+    assert_eq!(record["lie_mean_matrix"], mc["mean_matrix"]);
+    assert_eq!(record["covariance_right"], mc["covariance"]);
+    // No Cartesian mean is asked for by compounding: the key is there, null.
+    assert!(record["cartesian_mean"].is_null());
+}
+
+#[test]
+fn every_methods_error_is_the_relative_frobenius_distance_to_monte_carlo() {
+    let (_, _, json) = run(COMPOUND, 400);
+    let results = json["results"].as_array().unwrap();
+    let mut checked = 0;
+    for r in results.iter().filter(|r| r["method"] != "monte_carlo") {
+        let mc = results
+            .iter()
+            .find(|m| m["label"] == r["label"] && m["method"] == "monte_carlo")
+            .expect("Monte Carlo ran at every step");
+        let error = r["relative_error_vs_monte_carlo"]
+            .as_f64()
+            .expect("an error for every method where Monte Carlo ran");
+        // Both on the right side: convert a left-form estimate with its own mean's adjoint.
+        let mut cov = matrix(&r["covariance"]);
+        if r["side"] == "left" {
+            let t: Vec<f64> = serde_json::from_value(r["mean_tangent"].clone()).unwrap();
+            let mean = Se2::exp(&nalgebra::Vector3::new(t[0], t[1], t[2]));
+            let ad = mean.inverse().adj();
+            let ad = DMatrix::from_column_slice(3, 3, ad.as_slice());
+            cov = &ad * cov * ad.transpose();
+        }
+        let reference = matrix(&mc["covariance"]);
+        let expected = (&cov - &reference).norm() / reference.norm();
+        assert!(
+            (error - expected).abs() < 1e-9 * expected.max(1.0),
+            "{}: {error} vs {expected}",
+            r["label"]
+        );
+        checked += 1;
+    }
+    assert!(checked >= 6, "first and second order at 3 steps: {checked}");
+}
+
+#[test]
+fn the_differential_drive_reports_its_cartesian_and_lie_means() {
+    let text = r#"[scenario]
+title = "t"
+group = "se2"
+seed = 2
+methods = ["closed_form", "monte_carlo"]
+[[operation]]
+kind = "diff_drive"
+wheel_radius = 0.033
+wheelbase = 0.2
+duration = 1.0
+diffusion = 2.0
+speed = 1.0
+turn_rate = 0.0
+dt = 0.01
+output = "end"
+"#;
+    let (_, evaluation, json) = run(text, 300);
+    let AnyEvaluation::Se2(e) = &evaluation else {
+        panic!("SE(2)")
+    };
+    let node = e.nodes.iter().find(|n| n.name == "end").expect("the end pose");
+    let particles = node.particles.as_ref().expect("particles");
+    let direct = particles
+        .iter()
+        .map(|g| *g.to_se3().translation())
+        .sum::<nalgebra::Vector3<f64>>()
+        / particles.len() as f64;
+    let record = json["monte_carlo"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["label"] == "end")
+        .expect("the end record");
+    let cartesian: Vec<f64> = serde_json::from_value(record["cartesian_mean"].clone()).unwrap();
+    for k in 0..3 {
+        assert!((cartesian[k] - direct[k]).abs() < 1e-12, "{cartesian:?} vs {direct}");
+    }
+    let lie = node.monte_carlo.as_ref().unwrap().stats.mean.log();
+    let reported: Vec<f64> = serde_json::from_value(record["lie_mean_tangent"].clone()).unwrap();
+    for k in 0..3 {
+        assert!((reported[k] - lie[k]).abs() < 1e-12);
+    }
+    // The curved cloud's Cartesian mean lies behind its Lie mean (it retreats inside the banana).
+    let finding = json["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["kind"] == "diff_drive_means")
+        .expect("the means finding");
+    assert_eq!(finding["cartesian_mean"][0].as_f64().unwrap(), cartesian[0]);
+    assert!(finding["lie_mean"][0].as_f64().unwrap() > cartesian[0]);
+}
+
+#[test]
+fn the_fusion_cost_is_barfoot_and_furgales_v_with_the_half() {
+    let text = r#"[scenario]
+title = "t"
+group = "se2"
+methods = ["first_order"]
+[[pose]]
+name = "a"
+mean = { xy_theta = [1.0, 0.0, 0.1] }
+cov = { std = [0.1, 0.2, 0.05] }
+[[pose]]
+name = "b"
+mean = { xy_theta = [1.2, 0.1, 0.0] }
+cov = { std = [0.2, 0.1, 0.1] }
+[[operation]]
+kind = "fuse"
+inputs = ["a", "b"]
+output = "f"
+"#;
+    let (_, _, json) = run(text, 50);
+    let fused = json["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["label"] == "f")
+        .expect("the fused estimate");
+    let t: Vec<f64> = serde_json::from_value(fused["mean_tangent"].clone()).unwrap();
+    let x = Se2::exp(&nalgebra::Vector3::new(t[0], t[1], t[2]));
+    // V = ½ Σ eᵢᵀ Σᵢ⁻¹ eᵢ, eᵢ = Log(μᵢ⁻¹ X) (right form), from the inputs as written above.
+    let inputs = [
+        (Se2::from_xy_theta(1.0, 0.0, 0.1), [0.1, 0.2, 0.05]),
+        (Se2::from_xy_theta(1.2, 0.1, 0.0), [0.2, 0.1, 0.1]),
+    ];
+    let v: f64 = 0.5
+        * inputs
+            .iter()
+            .map(|(mu, std)| {
+                let e = mu.inverse().compose(&x).log();
+                (0..3).map(|k| e[k] * e[k] / (std[k] * std[k])).sum::<f64>()
+            })
+            .sum::<f64>();
+    let finding = json["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["kind"] == "fusion")
+        .expect("the fusion finding");
+    let cost = finding["cost"].as_f64().unwrap();
+    assert!(v > 0.1, "the estimates disagree: V = {v}");
+    assert!((cost - v).abs() < 1e-9 * v, "reported {cost}, V = {v}");
+}
+
+/// A heading σ of 2 rad: at α = 1 (γ = √3) the inverse's sigma points turn 3.46 rad > π.
+const SIGMA: &str = r#"[scenario]
+title = "t"
+group = "se2"
+methods = ["first_order", "sigma_points"]
+[[pose]]
+name = "a"
+mean = { xy_theta = [1.0, 0.0, 0.0] }
+cov = { std = [0.1, 0.1, 2.0] }
+[[operation]]
+kind = "inverse"
+input = "a"
+output = "b"
+"#;
+
+fn covariance_of(json: &Value, method: &str) -> DMatrix<f64> {
+    let r = json["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["label"] == "b" && r["method"] == method)
+        .expect("an estimate");
+    matrix(&r["covariance"])
+}
+
+#[test]
+fn sigma_point_parameters_come_from_the_file_and_reach_the_report() {
+    let (_, _, default) = run(SIGMA, 50);
+    assert_eq!(default["meta"]["sigma_points"]["alpha"], 1.0);
+    assert_eq!(default["meta"]["sigma_points"]["beta"], 2.0);
+    assert_eq!(default["meta"]["sigma_points"]["kappa"], 0.0);
+    let text = format!("{SIGMA}[methods.sigma_points]\nalpha = 0.3\nkappa = 1.0\n");
+    let (_, _, tuned) = run(&text, 50);
+    assert_eq!(tuned["meta"]["sigma_points"]["alpha"], 0.3);
+    assert_eq!(tuned["meta"]["sigma_points"]["beta"], 2.0);
+    assert_eq!(tuned["meta"]["sigma_points"]["kappa"], 1.0);
+    // The wrap-around caveat: inversion is linear in the tangent, so sigma points equal first
+    // order — while every sigma point turns less than π. At α = 1 they turn 3.46 rad and wrap;
+    // at α = 0.3 (γ = 0.6) they stay inside and agree to round-off.
+    let first = covariance_of(&default, "exact"); // inversion moves a Gaussian exactly to first order
+    assert!(!close(&covariance_of(&default, "sigma_points"), &first, 0.05));
+    assert!(close(&covariance_of(&tuned, "sigma_points"), &first, 1e-9));
+}
+
+#[test]
+fn bad_sigma_point_parameters_and_cameras_are_named_where_they_are_written() {
+    for (extra, expected) in [
+        (
+            "[methods.sigma_points]\nalpha = 0.0\n",
+            "methods.sigma_points.alpha: 0 is out of range",
+        ),
+        (
+            "[methods.sigma_points]\nkappa = -3.0\n",
+            "methods.sigma_points.kappa: -3 is out of range: a finite κ > −3",
+        ),
+        ("[methods.sigma_points]\ngamma = 1.0\n", "unknown field `gamma`"),
+        (
+            "[draw]\ncamera = { position = [0.0, 0.0, 5.0], direction = [0.0, 0.0, 1.0] }\n",
+            "draw.camera: give `position` or `direction`, not both",
+        ),
+        (
+            "[draw]\ncamera = { direction = [0.0, 0.0, 1.0] }\n",
+            "draw.camera: up = [0.0, 0.0, 1.0] lies along the line of sight",
+        ),
+        (
+            "[draw]\ncamera = { position = [1.0, 1.0, 1.0], target = [1.0, 1.0, 1.0] }\n",
+            "draw.camera: the eye `position` is at its `target`",
+        ),
+        ("[draw]\nlayout = \"grid\"\n", "unknown variant `grid`"),
+    ] {
+        let text = format!("{SIGMA}{extra}");
+        let err = load_text(&text, "t.toml").unwrap_err().to_string();
+        assert!(err.starts_with("t.toml:"), "{err}");
+        assert!(err.contains(expected), "{extra}: {err}");
+    }
+}
+
+#[test]
+fn a_file_camera_is_the_views_camera() {
+    let text = format!(
+        "{SIGMA}[draw]\ncamera = {{ position = [1.0, -4.0, 3.0], target = [1.0, 0.0, 0.0] }}\n"
+    );
+    let loaded = load_text(&text, "t.toml").unwrap();
+    let (_, scene) = pipeline(&loaded, &Overrides::default(), None).unwrap();
+    assert!(!scene.views.is_empty());
+    for view in &scene.views {
+        let camera = view.camera.expect("a camera");
+        assert_eq!(camera.position, [1.0, -4.0, 3.0]);
+        assert_eq!(camera.target, [1.0, 0.0, 0.0]);
+        assert_eq!(camera.up, [0.0, 0.0, 1.0]);
+    }
+}
