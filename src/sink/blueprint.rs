@@ -12,8 +12,9 @@
 //! - `container/<id>`: `ContainerBlueprint` (kind, contents, shares);
 //! - `view/<id>`: `ViewBlueprint` (class, name, origin), `view/<id>/ViewContents` (the query),
 //!   `view/<id>/EyeControls3D` (a view property: eye position, look target, up);
-//! - `view/<id>/ViewContents/overrides/<entity>`: `EntityBehavior { visible: false }` for
-//!   entities that start hidden (the viewer's own eye toggle writes the same component there);
+//! - `view/<id>/ViewContents/overrides/<entity>/visualizers`: `EntityBehavior { visible:
+//!   false }` for entities that start hidden (where the viewer's own eye toggle writes it; the
+//!   children inherit it);
 //! - `blueprint_panel`, `selection_panel`, `time_panel`: panel states.
 //!
 //! Ids are fixed per position in the layout, so the blueprint's content is deterministic too.
@@ -218,8 +219,10 @@ fn log_view3d(
         bp.log(format!("{path}/EyeControls3D"), &eye(camera))?;
     }
     for hidden in &view.hidden {
+        // The viewer's own eye toggle writes here (`ViewContents::blueprint_base_visualizer_
+        // path_for_entity`: the entity's override base, `…/overrides/<entity>/visualizers`).
         bp.log(
-            format!("{path}/ViewContents/overrides/{hidden}"),
+            format!("{path}/ViewContents/overrides/{hidden}/visualizers"),
             &EntityBehavior::new().with_visible(Visible::from(false)),
         )?;
     }
