@@ -64,7 +64,10 @@ fn uncentred_monte_carlo_covariance_about_the_nominal_is_reported_on_both_sides(
         .iter()
         .rfind(|n| n.name == "robot")
         .expect("last step");
-    let particles = node.particles.as_ref().expect("a short propagation keeps particles");
+    let particles = node
+        .particles
+        .as_ref()
+        .expect("a short propagation keeps particles");
     let label = format!("robot@{}", node.step.expect("a step"));
     let record = json["monte_carlo"]
         .as_array()
@@ -79,7 +82,10 @@ fn uncentred_monte_carlo_covariance_about_the_nominal_is_reported_on_both_sides(
         let reported = matrix(&record[key]);
         let direct: Matrix3<f64> = uncentred_covariance(particles, &node.nominal, side).unwrap();
         let direct = DMatrix::from_column_slice(3, 3, direct.as_slice());
-        assert!(close(&reported, &direct, 1e-9), "{key}: {reported} vs {direct}");
+        assert!(
+            close(&reported, &direct, 1e-9),
+            "{key}: {reported} vs {direct}"
+        );
     }
     // The two sides differ (the pose is 3 m out), so the right one is not a copy.
     assert!(!close(
@@ -158,7 +164,11 @@ output = "end"
     let AnyEvaluation::Se2(e) = &evaluation else {
         panic!("SE(2)")
     };
-    let node = e.nodes.iter().find(|n| n.name == "end").expect("the end pose");
+    let node = e
+        .nodes
+        .iter()
+        .find(|n| n.name == "end")
+        .expect("the end pose");
     let particles = node.particles.as_ref().expect("particles");
     let direct = particles
         .iter()
@@ -173,7 +183,10 @@ output = "end"
         .expect("the end record");
     let cartesian: Vec<f64> = serde_json::from_value(record["cartesian_mean"].clone()).unwrap();
     for k in 0..3 {
-        assert!((cartesian[k] - direct[k]).abs() < 1e-12, "{cartesian:?} vs {direct}");
+        assert!(
+            (cartesian[k] - direct[k]).abs() < 1e-12,
+            "{cartesian:?} vs {direct}"
+        );
     }
     let lie = node.monte_carlo.as_ref().unwrap().stats.mean.log();
     let reported: Vec<f64> = serde_json::from_value(record["lie_mean_tangent"].clone()).unwrap();
@@ -283,7 +296,11 @@ fn sigma_point_parameters_come_from_the_file_and_reach_the_report() {
     // order — while every sigma point turns less than π. At α = 1 they turn 3.46 rad and wrap;
     // at α = 0.3 (γ = 0.6) they stay inside and agree to round-off.
     let first = covariance_of(&default, "exact"); // inversion moves a Gaussian exactly to first order
-    assert!(!close(&covariance_of(&default, "sigma_points"), &first, 0.05));
+    assert!(!close(
+        &covariance_of(&default, "sigma_points"),
+        &first,
+        0.05
+    ));
     assert!(close(&covariance_of(&tuned, "sigma_points"), &first, 1e-9));
 }
 
@@ -298,7 +315,10 @@ fn bad_sigma_point_parameters_and_cameras_are_named_where_they_are_written() {
             "[methods.sigma_points]\nkappa = -3.0\n",
             "methods.sigma_points.kappa: -3 is out of range: a finite κ > −3",
         ),
-        ("[methods.sigma_points]\ngamma = 1.0\n", "unknown field `gamma`"),
+        (
+            "[methods.sigma_points]\ngamma = 1.0\n",
+            "unknown field `gamma`",
+        ),
         (
             "[draw]\ncamera = { position = [0.0, 0.0, 5.0], direction = [0.0, 0.0, 1.0] }\n",
             "draw.camera: give `position` or `direction`, not both",

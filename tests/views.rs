@@ -35,7 +35,9 @@ fn positions(kind: &ItemKind) -> Vec<[f64; 3]> {
 /// Every drawn point of `view` lies inside its camera's 55° field of view (at the aspect of a
 /// quarter of a 1024×640 window, the narrowest cell a scenario's grid gives).
 fn assert_in_view(name: &str, scene: &Scene, view: &View3d) {
-    let camera = view.camera.unwrap_or_else(|| panic!("{name}/{}: no camera", view.name));
+    let camera = view
+        .camera
+        .unwrap_or_else(|| panic!("{name}/{}: no camera", view.name));
     let eye = Vector3::from(camera.position);
     let forward = (Vector3::from(camera.target) - eye).normalize();
     let right = forward.cross(&Vector3::from(camera.up)).normalize();
@@ -49,7 +51,12 @@ fn assert_in_view(name: &str, scene: &Scene, view: &View3d) {
         for p in positions(&item.kind) {
             let d = Vector3::from(p) - eye;
             let depth = d.dot(&forward);
-            assert!(depth > 0.0, "{name}/{}: {} behind the eye", view.name, item.path);
+            assert!(
+                depth > 0.0,
+                "{name}/{}: {} behind the eye",
+                view.name,
+                item.path
+            );
             let (x, y) = (d.dot(&right) / depth, d.dot(&up) / depth);
             assert!(
                 x.abs() <= tan_x * 1.001 && y.abs() <= tan_y * 1.001,
@@ -88,7 +95,10 @@ fn planar_scenes_are_seen_from_above_with_x_to_the_right() {
         let sight = (Vector3::from(camera.target) - Vector3::from(camera.position)).normalize();
         assert!(sight.z < -0.99, "{name}: looks along {sight}");
         let right = sight.cross(&Vector3::from(camera.up)).normalize();
-        assert!((right - Vector3::x()).norm() < 1e-6, "{name}: screen right is {right}");
+        assert!(
+            (right - Vector3::x()).norm() < 1e-6,
+            "{name}: screen right is {right}"
+        );
     }
 }
 
@@ -108,7 +118,12 @@ fn crowded_scenes_get_one_view_per_pose_or_per_method() {
     let se3 = scene_of("se3_global_vs_local");
     assert_eq!(
         names(&se3),
-        ["first order", "second order", "fourth order", "sigma points"]
+        [
+            "first order",
+            "second order",
+            "fourth order",
+            "sigma points"
+        ]
     );
     // Each method's view shows its own banana surface and the Monte Carlo cloud, no other method.
     for view in &se3.views {
@@ -121,7 +136,12 @@ fn crowded_scenes_get_one_view_per_pose_or_per_method() {
         let slug = view.name.replace(' ', "_");
         assert!(paths.contains(&format!("world/world_from_b/{slug}/banana").as_str()));
         assert!(paths.contains(&"world/world_from_b/monte_carlo/cloud"));
-        for other in ["first_order", "second_order", "fourth_order", "sigma_points"] {
+        for other in [
+            "first_order",
+            "second_order",
+            "fourth_order",
+            "sigma_points",
+        ] {
             if other != slug {
                 assert!(
                     !paths.iter().any(|p| p.contains(&format!("/{other}/"))),
@@ -134,7 +154,10 @@ fn crowded_scenes_get_one_view_per_pose_or_per_method() {
     // One view with the main method: the others start hidden, the vector-space ellipse stays.
     let robot = scene_of("camera_on_robot");
     assert_eq!(robot.views.len(), 1);
-    assert_eq!(robot.views[0].hidden, ["world/map_from_camera/sigma_points"]);
+    assert_eq!(
+        robot.views[0].hidden,
+        ["world/map_from_camera/sigma_points"]
+    );
     assert!(robot.description_markdown.contains("Hidden at first"));
 }
 

@@ -272,7 +272,12 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         names.dedup();
         let most_methods = drawn
             .iter()
-            .map(|n| n.estimates.iter().filter(|x| is_analytic(n, x.result.method)).count())
+            .map(|n| {
+                n.estimates
+                    .iter()
+                    .filter(|x| is_analytic(n, x.result.method))
+                    .count()
+            })
             .max()
             .unwrap_or(0);
         p.layout = views::default_layout(G::KIND.is_rotation_only(), names.len(), most_methods);
@@ -491,7 +496,8 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
         let drawn = match p.methods.iter().position(|(n, _)| *n == node.name) {
             Some(i) => &mut p.methods[i].1,
             None => {
-                p.methods.push((node.name.clone(), views::PoseMethods::default()));
+                p.methods
+                    .push((node.name.clone(), views::PoseMethods::default()));
                 &mut p.methods.last_mut().expect("just pushed").1
             }
         };

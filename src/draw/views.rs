@@ -9,7 +9,8 @@
 //! **Camera**: planar scenes are seen from straight above with x to the right and y up (the
 //! eye tilted 2° towards −y so that orbiting turns about z); 3-D scenes look along the
 //! direction in which what is drawn is thinnest (the smallest principal axis of all drawn
-//! points, seen from above and tilted 25° so depth still reads), rotations from the (+x, +y,
+//! points, tilted 25° towards up so depth still reads; a scene lying flat, thin within 35° of
+//! up, from 30° off the vertical on the −y side, x to the right), rotations from the (+x, +y,
 //! +z) octant; `[draw] camera` overrides. The eye then stands at the distance at which every
 //! drawn point of the view fits the viewer's 55° field of view with a margin.
 
@@ -32,6 +33,10 @@ const MARGIN: f64 = 1.2;
 const TOP_TILT_DEG: f64 = 2.0;
 /// Tilt of a 3-D view off its thinnest direction.
 const OBLIQUE_TILT_DEG: f64 = 25.0;
+/// A scene whose thinnest direction is within this angle of up lies flat...
+const FLAT_DEG: f64 = 35.0;
+/// ...and is seen from this far off the vertical, from −y.
+const FLAT_TILT_DEG: f64 = 30.0;
 
 /// Which methods were drawn for one pose: the main one and the others (slugs).
 #[derive(Default, Debug)]
@@ -219,7 +224,10 @@ pub(super) fn camera(points: &[Vector3<f64>], plan: &ViewPlan, aspect: f64) -> O
     let choice = plan.camera.unwrap_or_default();
     let up = choice.up.map_or(Vector3::z(), Vector3::from).normalize();
     if let Some(position) = choice.position {
-        let target = choice.target.map(Vector3::from).or_else(|| centre(points))?;
+        let target = choice
+            .target
+            .map(Vector3::from)
+            .or_else(|| centre(points))?;
         return Some(Camera {
             position,
             target: target.into(),
@@ -269,16 +277,13 @@ fn oblique(points: &[Vector3<f64>], up: &Vector3<f64>) -> Vector3<f64> {
     if n.dot(up) < 0.0 {
         n = -n;
     }
-    // Tilt away from the up axis (towards the viewer's "south"), or, when n is (nearly) up,
-    // towards −y like the top view.
-    let horizontal = n - up * n.dot(up);
-    let towards = if horizontal.norm() > 1e-3 {
-        -horizontal.normalize()
-    } else {
-        -Vector3::y()
-    };
-    let base = if n.dot(up) > 0.999 { *up } else { n };
-    tilted(&base, &towards, -OBLIQUE_TILT_DEG)
+    // Lying (nearly) flat: seen from the south and above, x still to the right.
+    if n.dot(up) > FLAT_DEG.to_radians().cos() {
+        return tilted(up, &Vector3::y(), -FLAT_TILT_DEG);
+    }
+    // Standing up: tilted from its thin direction towards the up axis, so depth reads.
+    let towards = (up - n * n.dot(up)).normalize();
+    tilted(&n, &towards, OBLIQUE_TILT_DEG)
 }
 
 /// The middle of the points' bounding box.
@@ -300,7 +305,10 @@ fn fit(
     aspect: f64,
 ) -> (Vector3<f64>, f64) {
     let forward = -towards_eye;
-    let right = forward.cross(up).try_normalize(1e-9).unwrap_or_else(Vector3::x);
+    let right = forward
+        .cross(up)
+        .try_normalize(1e-9)
+        .unwrap_or_else(Vector3::x);
     let screen_up = right.cross(&forward);
     let coords: Vec<Vector3<f64>> = points
         .iter()
@@ -323,7 +331,8 @@ fn fit(
         .iter()
         .map(|c| (c - target_coords).norm())
         .fold(0.0, f64::max);
-    let target = right * target_coords.x + screen_up * target_coords.y + towards_eye * target_coords.z;
+    let target =
+        right * target_coords.x + screen_up * target_coords.y + towards_eye * target_coords.z;
     (target, distance.max(0.5 * extent).max(0.05))
 }
 
@@ -347,7 +356,10 @@ mod tests {
         let points = [Vector3::new(-1.0, -1.0, 0.0), Vector3::new(3.0, 1.0, 0.0)];
         let c = camera(&points, &plan(&poses, true), ASPECT).unwrap();
         let (eye, target) = (Vector3::from(c.position), Vector3::from(c.target));
-        assert!((target - Vector3::new(1.0, 0.0, 0.0)).norm() < 0.05, "{target}");
+        assert!(
+            (target - Vector3::new(1.0, 0.0, 0.0)).norm() < 0.05,
+            "{target}"
+        );
         let sight = (target - eye).normalize();
         // Looking down, within the tilt; the screen's right is +x.
         assert!(sight.z < -(TOP_TILT_DEG + 0.1).to_radians().cos());

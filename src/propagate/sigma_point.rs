@@ -21,13 +21,19 @@
 //! elements the output is then exactly linear in that input's tangent
 //! (X · Exp(ε) · Y = XY · Exp(Ad_{Y⁻¹} ε)), so for compose, between, inverse and their chains
 //! the unscented covariance equals the first-order one (cross terms between inputs, which
-//! 4th-order compounding captures, never appear). It differs where the nonlinearity sits
-//! inside one input, e.g. X · Exp(u + w) ([REFERENCE_CASES R4]) or a map using an input twice.
+//! 4th-order compounding captures, never appear) — **as long as every sigma point's rotation
+//! stays below π**. The points sit at ±γ times the columns of the square root, γ = α√(L + κ):
+//! at α = 1 an SE(3) composition (L = 12) with a 1 rad deviation puts them 3.46 rad out, where
+//! Log wraps them to the other side and the covariance shrinks (an SE(2) inverse with a 2 rad
+//! heading σ comes out 34 % off at α = 1 and exact at α = 0.3). It also differs where the
+//! nonlinearity sits inside one input, e.g. X · Exp(u + w) ([REFERENCE_CASES R4]) or a map
+//! using an input twice.
 //!
 //! # Parameters
 //! Defaults α = 1, β = 2, κ = 0 (λ = 0: points at ±√L σ, W₀⁽ᵐ⁾ = 0, all weights ≥ 0, so the
 //! covariance stays PSD); β = 2 is optimal for Gaussian inputs. Smaller α pulls the points
-//! in towards the first-order result.
+//! in towards the first-order result (and inside the wrap-around at π). A scenario sets them
+//! with `[methods.sigma_points] alpha, beta, kappa`.
 //!
 //! ```
 //! use posecov::lie::{LieGroup, Se2};

@@ -42,8 +42,8 @@ mod validate;
 mod view;
 
 pub use mesh::unit_sphere_mesh;
-pub use view::{Camera, View3d, grid_columns, rotate};
 pub use palette::NOMINAL;
+pub use view::{Camera, View3d, grid_columns, rotate};
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
 pub type Vec3 = [f64; 3];
@@ -324,8 +324,8 @@ pub struct Scene {
     pub plots: Vec<Plot>,
     /// Plot lines, each under the path of its plot.
     pub series: Vec<ScalarSeries>,
-    /// A planar scene (SE(2), SO(2)) lives in the x–y plane: the sink declares +y as the
-    /// viewer's up axis so the default camera faces that plane instead of grazing it.
+    /// A planar scene (SE(2), SO(2), or `view = "top"`) lies in the x–y plane: its views are
+    /// seen from straight above ([`View3d::camera`]).
     pub planar: bool,
     /// The 3-D views, each with its camera; empty: one view of the whole world, framed by the
     /// viewer.

@@ -61,7 +61,10 @@ impl Camera {
             })
         };
         let all = self.position.iter().chain(&self.target).chain(&self.up);
-        if !all.into_iter().all(|v| v.is_finite() && (*v as f32).is_finite()) {
+        if !all
+            .into_iter()
+            .all(|v| v.is_finite() && (*v as f32).is_finite())
+        {
             return bad("a coordinate is not a finite number (as f32)");
         }
         let sight: Vec3 = [0, 1, 2].map(|i| self.target[i] - self.position[i]);
@@ -125,7 +128,8 @@ impl View3d {
             path.strip_prefix(root.as_str())
                 .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
         };
-        (self.include.is_empty() || self.include.iter().any(under)) && !self.exclude.iter().any(under)
+        (self.include.is_empty() || self.include.iter().any(under))
+            && !self.exclude.iter().any(under)
     }
 
     /// Checks the camera and that every path lies under [`WORLD`].

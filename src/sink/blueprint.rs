@@ -87,9 +87,8 @@ fn layout_messages(
             let grid = log_container(&bp, &mut ids, ContainerKind::Grid, &left, &[])?;
             bp.log(
                 grid.as_str(),
-                &ContainerBlueprint::update_fields().with_grid_columns(GridColumns(
-                    UInt32(scene::grid_columns(left.len()) as u32),
-                )),
+                &ContainerBlueprint::update_fields()
+                    .with_grid_columns(GridColumns(UInt32(scene::grid_columns(left.len()) as u32))),
             )?;
             grid
         }
@@ -104,7 +103,13 @@ fn layout_messages(
     let mut shares = vec![3.0];
     for plot in &scene.plots {
         let origin = format!("{}/{}", scene::PLOTS, plot.id);
-        right.push(log_view(&bp, &mut ids, "TimeSeries", &plot.label(), &origin)?);
+        right.push(log_view(
+            &bp,
+            &mut ids,
+            "TimeSeries",
+            &plot.label(),
+            &origin,
+        )?);
         shares.push(2.0);
     }
     let right = log_container(&bp, &mut ids, ContainerKind::Vertical, &right, &shares)?;
@@ -199,11 +204,7 @@ fn log_view(
 }
 
 /// Logs a 3-D view of the world: its query, its eye and its hidden entities.
-fn log_view3d(
-    bp: &rr::RecordingStream,
-    ids: &mut Ids,
-    view: &View3d,
-) -> Result<String, SinkError> {
+fn log_view3d(bp: &rr::RecordingStream, ids: &mut Ids, view: &View3d) -> Result<String, SinkError> {
     let path = format!("view/{}", ids.next().text);
     bp.log(
         format!("{path}/ViewContents"),

@@ -33,10 +33,10 @@ pub mod viewer;
 
 use std::path::PathBuf;
 
+pub use self::blueprint::send_layout;
 pub use self::rerun::{
     LogOutcome, STEP_TIMELINE, log_part_cancellable, log_scene, log_scene_cancellable,
 };
-pub use self::blueprint::send_layout;
 pub use self::stream::{SinkGuard, open_stream, scene_to_rrd_bytes};
 pub use self::viewer::{NativeViewer, find_native_viewer, render_png};
 

@@ -318,9 +318,9 @@ pub struct CameraSpec {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum View {
-    /// Face the x–y plane (planar motion; the viewer's up axis is +y).
+    /// From straight above the x–y plane, x to the right (planar motion).
     Top,
-    /// z up, seen from an angle.
+    /// z up, seen from the direction chosen for the scene.
     Perspective,
 }
 
