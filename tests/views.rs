@@ -7,9 +7,6 @@ use nalgebra::Vector3;
 use posecov::app::{Overrides, load, pipeline};
 use posecov::input::scenario::bundled::BUNDLED;
 use posecov::scene::{ItemKind, Scene, View3d};
-use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
-use rerun::external::re_log_encoding::DecoderApp;
-use rerun::log::{Chunk, LogMsg};
 
 fn scene_of(name: &str) -> Scene {
     let loaded = load(name).expect("bundled");
@@ -162,7 +159,10 @@ fn crowded_scenes_get_one_view_per_pose_or_per_method() {
 }
 
 /// The blueprint store's chunks of a recording.
-fn blueprint_chunks(bytes: &[u8]) -> Vec<Chunk> {
+#[cfg(feature = "viewer")]
+fn blueprint_chunks(bytes: &[u8]) -> Vec<rerun::log::Chunk> {
+    use rerun::external::re_log_encoding::DecoderApp;
+    use rerun::log::{Chunk, LogMsg};
     DecoderApp::decode_eager(std::io::Cursor::new(bytes))
         .expect("an .rrd stream")
         .map(|m| m.expect("decodable"))
@@ -175,8 +175,10 @@ fn blueprint_chunks(bytes: &[u8]) -> Vec<Chunk> {
         .collect()
 }
 
+#[cfg(feature = "viewer")]
 #[test]
 fn the_blueprint_carries_each_camera_and_each_hidden_entity() {
+    use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
     let scene = scene_of("camera_on_robot");
     let bytes = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("c", 0)).unwrap();
     let paths: Vec<String> = blueprint_chunks(&bytes)
