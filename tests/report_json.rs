@@ -23,6 +23,24 @@ fn run(text: &str, samples: u64) -> (Loaded, AnyEvaluation, Value) {
     (loaded, evaluation, json)
 }
 
+/// The last SE(2) node named `name` (its particles are kept: the plans here are short).
+fn last_node<'e>(evaluation: &'e AnyEvaluation, name: &str) -> &'e posecov::eval::Node<Se2, 3> {
+    let AnyEvaluation::Se2(e) = evaluation else {
+        panic!("SE(2)")
+    };
+    e.nodes.iter().rfind(|n| n.name == name).expect("the node")
+}
+
+/// The entry of the array `json[key]` that `pick` selects.
+fn entry<'j>(json: &'j Value, key: &str, pick: impl Fn(&Value) -> bool) -> &'j Value {
+    json[key]
+        .as_array()
+        .unwrap_or_else(|| panic!("{key} is an array"))
+        .iter()
+        .find(|v| pick(v))
+        .unwrap_or_else(|| panic!("no such entry in {key}"))
+}
+
 fn matrix(v: &Value) -> DMatrix<f64> {
     let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).expect("rows of numbers");
     DMatrix::from_fn(rows.len(), rows[0].len(), |r, c| rows[r][c])
@@ -56,25 +74,13 @@ output = "robot"
 #[test]
 fn uncentred_monte_carlo_covariance_about_the_nominal_is_reported_on_both_sides() {
     let (_, evaluation, json) = run(COMPOUND, 500);
-    let AnyEvaluation::Se2(e) = &evaluation else {
-        panic!("SE(2)")
-    };
-    let node = e
-        .nodes
-        .iter()
-        .rfind(|n| n.name == "robot")
-        .expect("last step");
+    let node = last_node(&evaluation, "robot");
     let particles = node
         .particles
         .as_ref()
         .expect("a short propagation keeps particles");
     let label = format!("robot@{}", node.step.expect("a step"));
-    let record = json["monte_carlo"]
-        .as_array()
-        .expect("monte_carlo is an array")
-        .iter()
-        .find(|r| r["label"] == label.as_str())
-        .expect("the last step's record");
+    let record = entry(&json, "monte_carlo", |r| r["label"] == label.as_str());
     for (key, side) in [
         ("uncentred_about_nominal_left", Side::Left),
         ("uncentred_about_nominal_right", Side::Right),
@@ -95,12 +101,9 @@ fn uncentred_monte_carlo_covariance_about_the_nominal_is_reported_on_both_sides(
     ));
     assert_eq!(record["samples"], 500);
     // The Lie mean and the centred covariance are the Monte Carlo estimate of `results`.
-    let mc = json["results"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|r| r["label"] == label.as_str() && r["method"] == "monte_carlo")
-        .expect("the Monte Carlo estimate");
+    let mc = entry(&json, "results", |r| {
+        r["label"] == label.as_str() && r["method"] == "monte_carlo"
+    });
     assert_eq!(record["lie_mean_tangent"], mc["mean_tangent"]);
     assert_eq!(record["lie_mean_matrix"], mc["mean_matrix"]);
     assert_eq!(record["covariance_right"], mc["covariance"]);
@@ -161,26 +164,14 @@ dt = 0.01
 output = "end"
 "#;
     let (_, evaluation, json) = run(text, 300);
-    let AnyEvaluation::Se2(e) = &evaluation else {
-        panic!("SE(2)")
-    };
-    let node = e
-        .nodes
-        .iter()
-        .find(|n| n.name == "end")
-        .expect("the end pose");
+    let node = last_node(&evaluation, "end");
     let particles = node.particles.as_ref().expect("particles");
     let direct = particles
         .iter()
         .map(|g| *g.to_se3().translation())
         .sum::<nalgebra::Vector3<f64>>()
         / particles.len() as f64;
-    let record = json["monte_carlo"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|r| r["label"] == "end")
-        .expect("the end record");
+    let record = entry(&json, "monte_carlo", |r| r["label"] == "end");
     let cartesian: Vec<f64> = serde_json::from_value(record["cartesian_mean"].clone()).unwrap();
     for k in 0..3 {
         assert!(
@@ -194,12 +185,7 @@ output = "end"
         assert!((reported[k] - lie[k]).abs() < 1e-12);
     }
     // The curved cloud's Cartesian mean lies behind its Lie mean (it retreats inside the banana).
-    let finding = json["findings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|f| f["kind"] == "diff_drive_means")
-        .expect("the means finding");
+    let finding = entry(&json, "findings", |f| f["kind"] == "diff_drive_means");
     assert_eq!(finding["cartesian_mean"][0].as_f64().unwrap(), cartesian[0]);
     assert!(finding["lie_mean"][0].as_f64().unwrap() > cartesian[0]);
 }
@@ -224,12 +210,7 @@ inputs = ["a", "b"]
 output = "f"
 "#;
     let (_, _, json) = run(text, 50);
-    let fused = json["results"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|r| r["label"] == "f")
-        .expect("the fused estimate");
+    let fused = entry(&json, "results", |r| r["label"] == "f");
     let t: Vec<f64> = serde_json::from_value(fused["mean_tangent"].clone()).unwrap();
     let x = Se2::exp(&nalgebra::Vector3::new(t[0], t[1], t[2]));
     // V = ½ Σ eᵢᵀ Σᵢ⁻¹ eᵢ, eᵢ = Log(μᵢ⁻¹ X) (right form), from the inputs as written above.
@@ -245,12 +226,7 @@ output = "f"
                 (0..3).map(|k| e[k] * e[k] / (std[k] * std[k])).sum::<f64>()
             })
             .sum::<f64>();
-    let finding = json["findings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|f| f["kind"] == "fusion")
-        .expect("the fusion finding");
+    let finding = entry(&json, "findings", |f| f["kind"] == "fusion");
     let cost = finding["cost"].as_f64().unwrap();
     assert!(v > 0.1, "the estimates disagree: V = {v}");
     assert!((cost - v).abs() < 1e-9 * v, "reported {cost}, V = {v}");
@@ -272,12 +248,9 @@ output = "b"
 "#;
 
 fn covariance_of(json: &Value, method: &str) -> DMatrix<f64> {
-    let r = json["results"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|r| r["label"] == "b" && r["method"] == method)
-        .expect("an estimate");
+    let r = entry(json, "results", |r| {
+        r["label"] == "b" && r["method"] == method
+    });
     matrix(&r["covariance"])
 }
 

@@ -3,6 +3,9 @@
 //! the blueprint carries each camera (`EyeControls3D`) and each hidden entity
 //! (`EntityBehavior`) where the viewer reads them.
 
+#[cfg(feature = "viewer")]
+mod rrd;
+
 use nalgebra::Vector3;
 use posecov::app::{Overrides, load, pipeline};
 use posecov::input::scenario::bundled::BUNDLED;
@@ -158,30 +161,13 @@ fn crowded_scenes_get_one_view_per_pose_or_per_method() {
     assert!(robot.description_markdown.contains("Hidden at first"));
 }
 
-/// The blueprint store's chunks of a recording.
-#[cfg(feature = "viewer")]
-fn blueprint_chunks(bytes: &[u8]) -> Vec<rerun::log::Chunk> {
-    use rerun::external::re_log_encoding::DecoderApp;
-    use rerun::log::{Chunk, LogMsg};
-    DecoderApp::decode_eager(std::io::Cursor::new(bytes))
-        .expect("an .rrd stream")
-        .map(|m| m.expect("decodable"))
-        .filter_map(|m| match m {
-            LogMsg::ArrowMsg(store, arrow) if store.kind() == rerun::StoreKind::Blueprint => {
-                Some(Chunk::from_arrow_msg(&arrow).expect("a chunk"))
-            }
-            _ => None,
-        })
-        .collect()
-}
-
 #[cfg(feature = "viewer")]
 #[test]
 fn the_blueprint_carries_each_camera_and_each_hidden_entity() {
     use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
     let scene = scene_of("camera_on_robot");
     let bytes = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("c", 0)).unwrap();
-    let paths: Vec<String> = blueprint_chunks(&bytes)
+    let paths: Vec<String> = rrd::store_chunks(&bytes, rerun::StoreKind::Blueprint)
         .iter()
         .map(|c| c.entity_path().to_string())
         .collect();
@@ -197,7 +183,7 @@ fn the_blueprint_carries_each_camera_and_each_hidden_entity() {
     // The layout is deterministic: the same scene gives the same blueprint paths.
     let again = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("c", 0)).unwrap();
     let mut a = paths.clone();
-    let mut b: Vec<String> = blueprint_chunks(&again)
+    let mut b: Vec<String> = rrd::store_chunks(&again, rerun::StoreKind::Blueprint)
         .iter()
         .map(|c| c.entity_path().to_string())
         .collect();
