@@ -480,8 +480,16 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
         }
         return;
     }
+    // Every method's regions on the main method's side: a banana is a 3-D slice of the tangent
+    // ellipsoid along its largest principal directions, which depend on the side, so one
+    // Gaussian read on two sides would look like two.
+    let side = node
+        .estimates
+        .iter()
+        .find(|e| Some(e.result.method) == primary)
+        .map(|e| e.result.pose.side());
     for estimate in &node.estimates {
-        let pose = estimate.result.pose;
+        let pose = side.map_or(estimate.result.pose, |s| estimate.result.pose.to_side(s));
         let method = estimate.result.method;
         if method == Method::MonteCarlo && node.particles.is_some() {
             continue; // the cloud itself shows Monte Carlo
