@@ -275,6 +275,121 @@ fn sigma_point_parameters_come_from_the_file_and_reach_the_report() {
         0.05
     ));
     assert!(close(&covariance_of(&tuned, "sigma_points"), &first, 1e-9));
+    // …and the report says where they wrap.
+    let wrap = wrap_finding(&default).expect("a wrap-around finding at α = 1");
+    assert!((wrap["largest_rotation_rad"].as_f64().unwrap() - 3f64.sqrt() * 2.0).abs() < 1e-12);
+    assert!(wrap_finding(&tuned).is_none());
+}
+
+/// The `sigma_points_wrap` finding of `json`, if any.
+fn wrap_finding(json: &Value) -> Option<&Value> {
+    json["findings"]
+        .as_array()
+        .expect("findings")
+        .iter()
+        .find(|f| f["kind"] == "sigma_points_wrap")
+}
+
+/// A compose of two uncertain SE(2) poses, `a` with a heading σ of √2 rad: L = 6, γ = √6 at
+/// α = 1, so its heading sigma points turn √12 = 3.46 rad.
+const WRAP: &str = r#"[scenario]
+title = "t"
+group = "se2"
+methods = ["first_order", "sigma_points"]
+[[pose]]
+name = "a"
+mean = { xy_theta = [2.0, 1.0, 0.5] }
+cov = { std = [0.05, 0.05, 1.4142135623730951] }
+[[pose]]
+name = "m"
+mean = { xy_theta = [1.5, 0.0, 0.0] }
+cov = { std = [0.05, 0.05, 0.05] }
+[[operation]]
+kind = "compose"
+lhs = "a"
+rhs = "m"
+output = "b"
+"#;
+
+#[test]
+fn sigma_points_beyond_pi_are_a_finding_with_the_angle_and_the_alpha_that_avoids_it() {
+    let (_, _, wide) = run(WRAP, 50);
+    let wrap = wrap_finding(&wide).expect("a wrap-around finding at α = 1");
+    let turn = 12f64.sqrt();
+    assert_eq!(wrap["output"], "b");
+    assert_eq!(wrap["alpha"], 1.0);
+    assert!((wrap["largest_rotation_rad"].as_f64().unwrap() - turn).abs() < 1e-12);
+    let below = wrap["alpha_below_pi"].as_f64().unwrap();
+    assert!((below - std::f64::consts::PI / turn).abs() < 1e-12);
+    // The wrapped points lose (1 − ((2π − √12)/√12)²) of the heading's share: 34 % off.
+    let first = covariance_of(&wide, "first_order");
+    let sigma = covariance_of(&wide, "sigma_points");
+    let off = (&sigma - &first).norm() / first.norm();
+    assert!((off - 0.3375).abs() < 1e-3, "{off}");
+
+    // Just below that α every point stays within π: no finding, first order to 1e-9.
+    let text = format!("{WRAP}[methods.sigma_points]\nalpha = {}\n", below * 0.99);
+    let (loaded, _, inside) = run(&text, 50);
+    assert!(wrap_finding(&inside).is_none());
+    assert!(close(
+        &covariance_of(&inside, "sigma_points"),
+        &covariance_of(&inside, "first_order"),
+        1e-9
+    ));
+    // The text panel says it where it applies, and only there.
+    let (_, scene) = pipeline(&loaded, &Overrides::default(), None).unwrap();
+    assert!(!scene.description_markdown.contains("wrap"));
+    let (_, scene) = pipeline(
+        &load_text(WRAP, "t.toml").unwrap(),
+        &Overrides::default(),
+        None,
+    )
+    .unwrap();
+    let md = &scene.description_markdown;
+    assert!(
+        md.contains("**Sigma points wrap around** for `b`: one turns 3.46 rad"),
+        "{md}"
+    );
+    assert!(md.contains("a turn of -2.82 rad"), "{md}");
+    assert!(
+        md.contains("any α below 0.907 (now 1), e.g. `[methods.sigma_points] alpha = 0.9`"),
+        "{md}"
+    );
+}
+
+#[test]
+fn no_bundled_scenario_wraps_its_sigma_points_until_alpha_pushes_them_past_pi() {
+    let mut with_sigma_points = Vec::new();
+    for b in posecov::input::scenario::bundled::BUNDLED {
+        let (_, evaluation, json) = run(b.text, 16);
+        assert!(wrap_finding(&json).is_none(), "{}", b.name);
+        if evaluation
+            .run()
+            .3
+            .contains(&posecov::uncertain::Method::SigmaPoints)
+        {
+            with_sigma_points.push(b.name);
+        }
+    }
+    assert_eq!(
+        with_sigma_points,
+        ["camera_on_robot", "se3_global_vs_local"]
+    );
+    // camera_on_robot: heading σ 20°, L = 3, so its points turn α√3 · 20° — past π at α = 6.
+    let mut loaded = posecov::app::load("camera_on_robot").unwrap();
+    loaded.input.defaults.sigma_points = Some(posecov::propagate::sigma_point::Unscented {
+        alpha: 6.0,
+        ..Default::default()
+    });
+    let overrides = Overrides {
+        samples: Some(16),
+        ..Default::default()
+    };
+    let (evaluation, _) = pipeline(&loaded, &overrides, None).unwrap();
+    let json = report_json("t", &loaded, &evaluation, 0.95);
+    let wrap = wrap_finding(&json).expect("α = 6 pushes them past π");
+    let turn = 6.0 * 3f64.sqrt() * 20f64.to_radians();
+    assert!((wrap["largest_rotation_rad"].as_f64().unwrap() - turn).abs() < 1e-12);
 }
 
 #[test]

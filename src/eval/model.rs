@@ -221,6 +221,19 @@ pub enum Finding {
         /// How many later recorded steps of the same output and method are indefinite too.
         later_steps: u64,
     },
+    /// A sigma point of an operation's inputs turns further than π: Log wraps it to the other
+    /// side, so the unscented estimate departs from first order even where the operation is
+    /// linear in each input's tangent ([`wrap_around`](crate::propagate::sigma_point::wrap_around)).
+    SigmaPointsWrap {
+        /// The output.
+        output: String,
+        /// The largest rotation angle |θ| (rad) of any sigma point's tangent offset.
+        largest_rotation_rad: f64,
+        /// The α used.
+        alpha: f64,
+        /// Every α below this keeps all sigma points within π (α · π / largest rotation).
+        alpha_below_pi: f64,
+    },
     /// Recorded steps of a long propagation were thinned ([`StepPolicy`](crate::plan::StepPolicy)).
     StepsThinned {
         /// The output.

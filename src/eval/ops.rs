@@ -18,7 +18,6 @@ use crate::propagate::first_order::{self, CorrelatedPair};
 use crate::propagate::fourth_order::Order;
 use crate::propagate::fusion::{FusionOptions, fuse};
 use crate::propagate::odometry::{InputNoise, propagate_increments, propagate_tangent_inputs};
-use crate::propagate::sigma_point;
 use crate::sample::{Sampler, fill_par_from, retract, standard_normal};
 use crate::uncertain::{Method, Side, UncertainPose};
 
@@ -93,10 +92,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let mut out = vec![first];
         out.extend(extra);
         if self.wants(Method::SigmaPoints) && !inputs.is_empty() {
-            match sigma_point::map(inputs, &map, &self.settings.unscented) {
-                Ok(result) => out.push(result),
-                Err(e) => self.method_failed(None, Method::SigmaPoints, e.to_string()),
-            }
+            out.extend(self.sigma_points(inputs, map));
         }
         out
     }

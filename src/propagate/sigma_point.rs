@@ -23,11 +23,13 @@
 //! the unscented covariance equals the first-order one (cross terms between inputs, which
 //! 4th-order compounding captures, never appear) — **as long as every sigma point's rotation
 //! stays below π**. The points sit at ±γ times the columns of the square root, γ = α√(L + κ):
-//! at α = 1 an SE(3) composition (L = 12) with a 1 rad deviation puts them 3.46 rad out, where
-//! Log wraps them to the other side and the covariance shrinks (an SE(2) inverse with a 2 rad
-//! heading σ comes out 34 % off at α = 1 and exact at α = 0.3). It also differs where the
-//! nonlinearity sits inside one input, e.g. X · Exp(u + w) ([REFERENCE_CASES R4]) or a map
-//! using an input twice.
+//! at α = 1 an SE(2) pose with a 2 rad heading σ moved by a known transform (L = 3) puts them
+//! √3 · 2 = 3.46 rad out. Exp of a 3.46 rad turn is the same rotation as −(2π − 3.46) =
+//! −2.82 rad, so Log brings the point back on the other side and its share of the covariance
+//! shrinks by (2.82 / 3.46)² = 0.66: the unscented covariance comes out 34 % below first
+//! order (exact at α = 0.3). [`wrap_around`] measures the largest turn for given inputs, and
+//! the evaluation reports it where it exceeds π. It also differs where the nonlinearity sits
+//! inside one input, e.g. X · Exp(u + w) ([REFERENCE_CASES R4]) or a map using an input twice.
 //!
 //! # Parameters
 //! Defaults α = 1, β = 2, κ = 0 (λ = 0: points at ±√L σ, W₀⁽ᵐ⁾ = 0, all weights ≥ 0, so the
@@ -144,6 +146,15 @@ impl Unscented {
     }
 }
 
+/// The tangent offsets of one input's sigma points: column j is γ Lⱼ (the points sit at
+/// μ ⊕ (±γ Lⱼ), L Lᵀ = Σ).
+fn offsets<G: LieGroup<N>, const N: usize>(
+    input: &UncertainPose<G, N>,
+    w: &SigmaWeights,
+) -> Result<TangentMatrix<N>> {
+    Ok(covariance_square_root(input.cov())? * w.scale)
+}
+
 /// The 2L + 1 input tuples (flattened, k inputs per tuple) and their mean / covariance weights.
 fn sigma_points<G: LieGroup<N>, const N: usize>(
     inputs: &[UncertainPose<G, N>],
@@ -154,8 +165,7 @@ fn sigma_points<G: LieGroup<N>, const N: usize>(
     let mut tuples = means.clone();
     let (mut wm, mut wc) = (vec![w.mean_centre], vec![w.cov_centre]);
     for (i, input) in inputs.iter().enumerate() {
-        let root: TangentMatrix<N> = covariance_square_root(input.cov())? * w.scale;
-        for column in root.column_iter() {
+        for column in offsets(input, w)?.column_iter() {
             for sign in [1.0, -1.0] {
                 let mut tuple = means.clone();
                 tuple[i] = retract(input.mean(), &(column * sign), input.side());
@@ -231,4 +241,176 @@ pub fn compose<G: LieGroup<N>, const N: usize>(
     params: &Unscented,
 ) -> Result<Propagated<G, N>> {
     map(&[*a, *b], |x: &[G]| x[0].compose(&x[1]), params)
+}
+
+/// How far the sigma points of some inputs turn, where one turns further than π.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WrapAround {
+    /// The largest rotation angle |θ| (rad) of any sigma point's tangent offset ±γ Lᵢ,ⱼ from
+    /// its input's mean, θ the rotation part ([`LieGroup::rotation_range`]).
+    pub largest_rotation: f64,
+    /// The α used.
+    pub alpha: f64,
+    /// The α at which the largest rotation is exactly π: the offsets scale with
+    /// γ = α√(L + κ), so every α below α · π / |θ|max keeps every sigma point inside.
+    pub alpha_below_pi: f64,
+}
+
+/// The largest rotation angle |θ| (rad) reached by any sigma point of `inputs` under `params`:
+/// max over inputs i and columns j of ‖θ(γ Lᵢ,ⱼ)‖, the rotation part of the tangent offset
+/// (the same square roots and γ as [`map`]; 0 for no inputs).
+///
+/// Errors: bad parameters ([`Unscented::weights`]), a non-finite covariance.
+///
+/// ```
+/// use posecov::lie::{LieGroup, Se2};
+/// use posecov::propagate::sigma_point::{Unscented, largest_rotation};
+/// use posecov::uncertain::{Side, UncertainPose};
+/// let a = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.1, 2.0], Side::Right).unwrap();
+/// // L = 3, γ = √3: the heading offset is √3 · 2 rad.
+/// let turn = largest_rotation(&[a], &Unscented::default()).unwrap();
+/// assert!((turn - 3f64.sqrt() * 2.0).abs() < 1e-12);
+/// ```
+pub fn largest_rotation<G: LieGroup<N>, const N: usize>(
+    inputs: &[UncertainPose<G, N>],
+    params: &Unscented,
+) -> Result<f64> {
+    if inputs.is_empty() {
+        return Ok(0.0);
+    }
+    let w = params.weights(inputs.len() * N)?;
+    let range = G::rotation_range();
+    let mut largest: f64 = 0.0;
+    for input in inputs {
+        for column in offsets(input, &w)?.column_iter() {
+            largest = largest.max(column.rows(range.start, range.len()).norm());
+        }
+    }
+    Ok(largest)
+}
+
+/// Where a sigma point of `inputs` turns further than π ([module docs](self#when-it-differs-from-first-order)):
+/// there Log wraps it to the other side and the unscented estimate departs from first order.
+/// `None` while every sigma point stays within π.
+///
+/// Errors: as [`largest_rotation`].
+///
+/// ```
+/// use posecov::lie::{LieGroup, Se2};
+/// use posecov::propagate::sigma_point::{Unscented, wrap_around};
+/// use posecov::uncertain::{Side, UncertainPose};
+/// let a = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.1, 2.0], Side::Right).unwrap();
+/// let wrap = wrap_around(&[a], &Unscented::default()).unwrap().unwrap();
+/// assert!((wrap.alpha_below_pi - std::f64::consts::PI / (3f64.sqrt() * 2.0)).abs() < 1e-12);
+/// let inside = Unscented { alpha: 0.3, ..Default::default() };
+/// assert_eq!(wrap_around(&[a], &inside).unwrap(), None);
+/// ```
+pub fn wrap_around<G: LieGroup<N>, const N: usize>(
+    inputs: &[UncertainPose<G, N>],
+    params: &Unscented,
+) -> Result<Option<WrapAround>> {
+    let largest = largest_rotation(inputs, params)?;
+    Ok((largest > std::f64::consts::PI).then(|| WrapAround {
+        largest_rotation: largest,
+        alpha: params.alpha,
+        alpha_below_pi: params.alpha * std::f64::consts::PI / largest,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::{PI, TAU};
+
+    use nalgebra::{Matrix3, Vector3};
+
+    use super::*;
+    use crate::lie::Se2;
+    use crate::propagate::first_order;
+
+    fn se2(xy_theta: [f64; 3], std: [f64; 3]) -> UncertainPose<Se2, 3> {
+        let mean = Se2::from_xy_theta(xy_theta[0], xy_theta[1], xy_theta[2]);
+        UncertainPose::try_from_std_devs(mean, std, Side::Right).unwrap()
+    }
+
+    fn relative(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
+        (a - b).norm() / b.norm()
+    }
+
+    /// First order with the heading σ's share scaled by r = ((2π − θ)/θ)²: a sigma point at
+    /// a turn θ ∈ (π, 2π) is the same pose as one at θ − 2π, so Log brings it back shorter.
+    fn wrapped_first_order(
+        first: &Matrix3<f64>,
+        lever: &Se2,
+        heading_var: f64,
+        turn: f64,
+    ) -> Matrix3<f64> {
+        let r = ((TAU - turn) / turn).powi(2);
+        let ad = lever.inverse().adj() * Vector3::z();
+        first - ad * ad.transpose() * heading_var * (1.0 - r)
+    }
+
+    #[test]
+    fn a_known_mount_on_a_2_rad_heading_wraps_at_alpha_1_and_not_at_0_3() {
+        // The camera-on-robot case with a heading σ of 2 rad: L = 3, γ = √3, turn √3 · 2.
+        let robot = se2([2.0, 1.0, 0.5], [0.05, 0.05, 2.0]);
+        let mount = Se2::from_xy_theta(1.5, 0.0, 0.0);
+        let f = |x: &[Se2]| x[0].compose(&mount);
+        let first = *first_order::change_frame_right(&robot, &mount).pose.cov();
+
+        let wide = Unscented::default();
+        let turn = largest_rotation(&[robot], &wide).unwrap();
+        assert!((turn - 3f64.sqrt() * 2.0).abs() < 1e-12, "{turn}");
+        let wrap = wrap_around(&[robot], &wide).unwrap().expect("beyond π");
+        assert_eq!(wrap.largest_rotation, turn);
+        assert_eq!(wrap.alpha, 1.0);
+        assert!((wrap.alpha_below_pi - PI / turn).abs() < 1e-15);
+        let unscented = *map(&[robot], f, &wide).unwrap().pose.cov();
+        let expected = wrapped_first_order(&first, &mount, 4.0, turn);
+        assert!(relative(&unscented, &expected) < 1e-9);
+        // (2.82 / 3.46)² = 0.662 of the heading share survives: 33.8 % off in all.
+        let off = relative(&unscented, &first);
+        assert!((off - 0.3377).abs() < 5e-4, "{off}");
+
+        let narrow = Unscented { alpha: 0.3, ..wide };
+        assert!((largest_rotation(&[robot], &narrow).unwrap() - 0.3 * turn).abs() < 1e-12);
+        assert_eq!(wrap_around(&[robot], &narrow).unwrap(), None);
+        let unscented = *map(&[robot], f, &narrow).unwrap().pose.cov();
+        assert!(relative(&unscented, &first) < 1e-9);
+    }
+
+    #[test]
+    fn a_compose_of_two_uncertain_poses_wraps_at_sqrt_12_rad() {
+        // L = 6, γ = √6; a heading σ of √2 rad puts the points √12 = 3.46 rad out.
+        let a = se2([2.0, 1.0, 0.5], [0.05, 0.05, 2f64.sqrt()]);
+        let b = se2([1.5, 0.0, 0.0], [0.05, 0.05, 0.05]);
+        let first = *first_order::compose(&a, &b).pose.cov();
+        let wide = Unscented::default();
+        let turn = largest_rotation(&[a, b], &wide).unwrap();
+        assert!((turn - 12f64.sqrt()).abs() < 1e-12, "{turn}");
+        assert!(wrap_around(&[a, b], &wide).unwrap().is_some());
+        let unscented = *compose(&a, &b, &wide).unwrap().pose.cov();
+        let expected = wrapped_first_order(&first, b.mean(), 2.0, turn);
+        assert!(relative(&unscented, &expected) < 1e-9);
+
+        let below = wrap_around(&[a, b], &wide).unwrap().unwrap().alpha_below_pi;
+        let inside = Unscented {
+            alpha: below * 0.99,
+            ..wide
+        };
+        assert_eq!(wrap_around(&[a, b], &inside).unwrap(), None);
+        let unscented = *compose(&a, &b, &inside).unwrap().pose.cov();
+        assert!(relative(&unscented, &first) < 1e-9);
+    }
+
+    #[test]
+    fn only_the_rotation_part_counts() {
+        // Large translation σ, small heading σ: no sigma point turns far.
+        let a = se2([0.0, 0.0, 0.0], [50.0, 50.0, 0.1]);
+        let turn = largest_rotation(&[a], &Unscented::default()).unwrap();
+        assert!((turn - 3f64.sqrt() * 0.1).abs() < 1e-12, "{turn}");
+        assert_eq!(
+            largest_rotation::<Se2, 3>(&[], &Unscented::default()).unwrap(),
+            0.0
+        );
+    }
 }
