@@ -443,3 +443,36 @@ fn a_file_camera_is_the_views_camera() {
         assert_eq!(camera.up, [0.0, 0.0, 1.0]);
     }
 }
+
+/// The text panel lists the Monte Carlo cloud only where Monte Carlo ran.
+#[test]
+fn the_text_panel_names_the_monte_carlo_cloud_only_where_monte_carlo_ran() {
+    let without = WRAP.replace(
+        "methods = [\"first_order\", \"sigma_points\"]",
+        "methods = [\"first_order\"]",
+    );
+    let with = WRAP.replace(
+        "methods = [\"first_order\", \"sigma_points\"]",
+        "methods = [\"first_order\", \"monte_carlo\"]",
+    );
+    let overrides = Overrides {
+        samples: Some(50),
+        ..Default::default()
+    };
+    let text = |toml: &str| {
+        let loaded = load_text(toml, "t.toml").unwrap();
+        pipeline(&loaded, &overrides, None)
+            .unwrap()
+            .1
+            .description_markdown
+    };
+    let md = text(&without);
+    assert!(md.contains("| first order |"), "{md}");
+    assert!(!md.contains("Monte Carlo"), "{md}");
+    assert!(!md.contains("grey cloud"), "{md}");
+    let md = text(&with);
+    assert!(
+        md.contains("| Monte Carlo samples | grey cloud (50 samples, seed 0) |\n\n"),
+        "{md}"
+    );
+}

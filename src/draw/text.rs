@@ -38,11 +38,14 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
         for method in &e.methods {
             let _ = writeln!(s, "| {} | {} |", method.label(), method.color_name());
         }
-        let _ = writeln!(
-            s,
-            "| Monte Carlo samples | grey cloud ({} samples, seed {}) |\n",
-            e.samples, e.seed
-        );
+        if e.methods.contains(&Method::MonteCarlo) {
+            let _ = writeln!(
+                s,
+                "| Monte Carlo samples | grey cloud ({} samples, seed {}) |",
+                e.samples, e.seed
+            );
+        }
+        s.push('\n');
     }
     if e.methods.contains(&Method::SigmaPoints) {
         let u = &e.unscented;

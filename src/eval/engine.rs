@@ -12,7 +12,8 @@ use super::model::{Estimate, Evaluation, Finding, McSummary, Node, PointNode, Ro
 use super::{EvalError, EvalSettings};
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::plan::{OpKind, Operand, Plan, PoseValue, limits};
-use crate::propagate::{Propagated, relative_frobenius_error, sigma_point};
+use crate::propagate::sigma_point::JointInputs;
+use crate::propagate::{Propagated, relative_frobenius_error};
 use crate::sample::{CHUNK_SIZE, MeanError, Sampler, sample_statistics, uncentred_covariance};
 use crate::uncertain::{Method, Side, UncertainPose};
 
@@ -233,16 +234,17 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
         });
     }
 
-    /// The sigma-point estimate of the current output through `map`, and a finding where a
-    /// sigma point turns further than π ([`sigma_point::wrap_around`]); a failure is a finding.
+    /// The sigma-point estimate of the current output through `map` over the inputs' joint
+    /// tangent, and a finding where a sigma point turns further than π
+    /// ([`JointInputs::wrap_around`]); a failure is a finding.
     pub(super) fn sigma_points(
         &mut self,
-        inputs: &[UncertainPose<G, N>],
+        inputs: crate::Result<JointInputs<G, N>>,
         map: impl Fn(&[G]) -> G,
     ) -> Option<Propagated<G, N>> {
         let params = &self.settings.unscented;
-        let run = sigma_point::map(inputs, map, params)
-            .and_then(|estimate| Ok((estimate, sigma_point::wrap_around(inputs, params)?)));
+        let run =
+            inputs.and_then(|inputs| Ok((inputs.map(map, params)?, inputs.wrap_around(params)?)));
         match run {
             Ok((estimate, wrap)) => {
                 if let Some(w) = wrap {

@@ -223,7 +223,7 @@ pub enum Finding {
     },
     /// A sigma point of an operation's inputs turns further than π: Log wraps it to the other
     /// side, so the unscented estimate departs from first order even where the operation is
-    /// linear in each input's tangent ([`wrap_around`](crate::propagate::sigma_point::wrap_around)).
+    /// linear in each input's tangent ([`JointInputs::wrap_around`](crate::propagate::sigma_point::JointInputs::wrap_around)).
     SigmaPointsWrap {
         /// The output.
         output: String,
