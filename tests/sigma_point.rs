@@ -11,7 +11,7 @@
 mod common;
 
 use common::{evaluate_plan, mc_settings, mc_stats, nodes, odometry_plan, tangent_controls};
-use nalgebra::{Matrix6, Vector6};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use posecov::Error;
 use posecov::lie::{LieGroup, Se2, Se3, So3};
 use posecov::plan::{OdometryModel, Op, Plan};
@@ -255,4 +255,156 @@ fn typed_errors_for_bad_parameters() {
         map(&none, |_: &[Se3]| Se3::identity(), &Unscented::default()),
         Err(Error::TooFewSamples { .. })
     ));
+}
+
+/// The estimate of `method` at the node `name` of `e` (right side).
+fn estimate_of<G: LieGroup<N>, const N: usize>(
+    e: &posecov::eval::Evaluation<G, N>,
+    name: &str,
+    method: Method,
+) -> UncertainPose<G, N> {
+    let node = nodes(e, name)[0];
+    let found = node.estimates.iter().find(|x| x.result.method == method);
+    found
+        .unwrap_or_else(|| panic!("{name}: no {method:?}"))
+        .result
+        .pose
+        .to_side(Side::Right)
+}
+
+/// Two SE(2) poses of one odometry chain: Y = X · U · Exp(η), so εY = Ad_{U⁻¹} εX + η and
+/// Σ_XY = Σ_X Ad_{U⁻¹}ᵀ (strongly correlated), all scaled by `scale`.
+fn chain_pair(scale: f64) -> (UncertainPose<Se2, 3>, UncertainPose<Se2, 3>, Matrix3<f64>) {
+    let x_mean = Se2::from_xy_theta(2.0, 1.0, 0.4);
+    let step = Se2::from_xy_theta(1.5, 0.2, 0.3);
+    let l = Matrix3::new(0.1, 0.0, 0.0, 0.02, 0.08, 0.0, 0.01, -0.02, 0.1) * scale;
+    let cov_x = l * l.transpose();
+    let ad = step.inverse().adj();
+    let cov_y = ad * cov_x * ad.transpose()
+        + Matrix3::from_diagonal(&Vector3::new(0.02, 0.01, 0.03)) * scale * scale;
+    let x = UncertainPose::try_new(x_mean, cov_x, Side::Right).unwrap();
+    let y = UncertainPose::try_new(x_mean.compose(&step), cov_y, Side::Right).unwrap();
+    (x, y, cov_x * ad.transpose())
+}
+
+/// A plan with `X`, `Y` and their correlated between and compose (Σ_XY = `cross`).
+fn correlated_plan(
+    x: UncertainPose<Se2, 3>,
+    y: UncertainPose<Se2, 3>,
+    cross: Matrix3<f64>,
+) -> Plan<Se2, 3> {
+    let mut plan = Plan::<Se2, 3>::default();
+    let (a, b) = (plan.uncertain("x", x), plan.uncertain("y", y));
+    let cross_cov = Some(cross);
+    plan.operation(
+        "between",
+        Op::Between {
+            lhs: a,
+            rhs: b,
+            cross_cov,
+        },
+    );
+    plan.operation(
+        "compose",
+        Op::Compose {
+            lhs: a,
+            rhs: b,
+            cross_cov,
+        },
+    );
+    plan
+}
+
+/// Sigma points of a correlated pair run over the joint 2N-dimensional tangent [εX; εY] with
+/// the joint covariance: with small noise they equal Mangelson et al.'s correlated first
+/// order (not the independent formula), with large noise they sit at Monte Carlo.
+#[test]
+fn correlated_pairs_move_both_inputs_in_every_sigma_point() {
+    let mut settings = mc_settings(2, 5);
+    settings.methods = vec![Method::FirstOrder, Method::SigmaPoints];
+    let (x, y, cross) = chain_pair(1e-3);
+    let e = evaluate_plan(correlated_plan(x, y, cross), &settings);
+    for (name, independent) in [
+        ("between", first_order::between(&x, &y)),
+        ("compose", first_order::compose(&x, &y)),
+    ] {
+        let sigma = estimate_of(&e, name, Method::SigmaPoints);
+        let first = estimate_of(&e, name, Method::FirstOrder);
+        let to_first = relative_frobenius_error(sigma.cov(), first.cov());
+        let to_independent = relative_frobenius_error(sigma.cov(), independent.pose.cov());
+        println!(
+            "{name}, σ ~ 1e-4: sigma points vs correlated first order {to_first:.1e}, vs independent {to_independent:.2}"
+        );
+        assert!(to_first < 1e-6, "{name}: {to_first}");
+        assert!(to_independent > 0.3, "{name}: {to_independent}");
+    }
+
+    let (x, y, cross) = chain_pair(2.0);
+    let mut settings = mc_settings(100_000, 23);
+    settings.methods = vec![Method::FirstOrder, Method::SigmaPoints, Method::MonteCarlo];
+    let e = evaluate_plan(correlated_plan(x, y, cross), &settings);
+    for (name, f) in [
+        (
+            "between",
+            (|g: &[Se2]| g[0].between(&g[1])) as fn(&[Se2]) -> Se2,
+        ),
+        ("compose", |g: &[Se2]| g[0].compose(&g[1])),
+    ] {
+        let truth = mc_stats(nodes(&e, name)[0]);
+        let sigma = estimate_of(&e, name, Method::SigmaPoints);
+        let first = estimate_of(&e, name, Method::FirstOrder);
+        // What the sigma points gave before they saw Σ_XY: the inputs as independent.
+        let blind = map(&[x, y], f, &Unscented::default()).unwrap();
+        let err = |c: &Matrix3<f64>| relative_frobenius_error(c, &truth.cov);
+        println!(
+            "{name}, σ ~ 0.2: vs Monte Carlo sigma points {:.2} %, first order {:.2} %, independent sigma points {:.1} %",
+            100.0 * err(sigma.cov()),
+            100.0 * err(first.cov()),
+            100.0 * err(blind.pose.cov())
+        );
+        assert!(err(sigma.cov()) < 0.03, "{name}");
+        assert!(err(blind.pose.cov()) > 0.3, "{name}");
+    }
+}
+
+/// The wrap-around finding measures the joint sigma points: SO(2) inputs with σ = s rad and
+/// ρ = 0.5 have joint principal axes (1, 1) (σ² · 1.5) and (1, −1) (σ² · 0.5), so with γ = √2
+/// each input turns at most √0.75 · √2 · s = √1.5 · s, not the independent √2 · s.
+#[test]
+fn the_wrap_around_finding_measures_the_joint_sigma_points() {
+    use posecov::eval::Finding;
+    use posecov::lie::So2;
+    let mut settings = mc_settings(2, 5);
+    settings.methods = vec![Method::FirstOrder, Method::SigmaPoints];
+    let turns = |s: f64| {
+        let p = UncertainPose::try_from_std_devs(So2::from_angle(0.2), [s], Side::Right).unwrap();
+        let mut plan = Plan::<So2, 1>::default();
+        let (a, b) = (plan.uncertain("a", p), plan.uncertain("b", p));
+        let cross_cov = Some(nalgebra::Matrix1::new(0.5 * s * s));
+        plan.operation(
+            "ab",
+            Op::Compose {
+                lhs: a,
+                rhs: b,
+                cross_cov,
+            },
+        );
+        let e = evaluate_plan(plan, &settings);
+        e.findings
+            .iter()
+            .filter_map(|f| match f {
+                Finding::SigmaPointsWrap {
+                    largest_rotation_rad,
+                    ..
+                } => Some(*largest_rotation_rad),
+                _ => None,
+            })
+            .collect::<Vec<f64>>()
+    };
+    // s = 2.4: independent points would turn 3.39 rad (beyond π), the joint ones 2.94.
+    assert!(2.4 * 2f64.sqrt() > std::f64::consts::PI);
+    assert_eq!(turns(2.4), Vec::<f64>::new());
+    let found = turns(3.0);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!((found[0] - 1.5f64.sqrt() * 3.0).abs() < 1e-12, "{found:?}");
 }

@@ -136,8 +136,11 @@ pub fn pipeline(
     Ok((evaluation, scene))
 }
 
-/// The JSON report of an evaluation: the settings it ran with, every estimate with its error
-/// against Monte Carlo, and every finding. Keys are stable (see the README).
+/// The JSON report of an evaluation: the settings it ran with (`meta`, with the sigma-point
+/// parameters), every estimate with its error against Monte Carlo (`results`), every node's
+/// Monte Carlo statistics (`monte_carlo`: Lie mean, centred covariance, uncentred covariance
+/// about the nominal on both sides, Cartesian mean) and every finding (`findings`, e.g. the
+/// fusion cost V). Keys are stable (see the README).
 ///
 /// ```
 /// use posecov::app::{Overrides, load, pipeline, report_json};
@@ -153,6 +156,7 @@ pub fn report_json(
     confidence: f64,
 ) -> serde_json::Value {
     let (seed, samples, block_samples, methods) = evaluation.run();
+    let sigma = loaded.input.defaults.sigma_points.unwrap_or_default();
     serde_json::json!({
         "scenario": name,
         "format": loaded.source.format(),
@@ -167,8 +171,10 @@ pub fn report_json(
             "block_samples": block_samples,
             "confidence": confidence,
             "methods": methods,
+            "sigma_points": { "alpha": sigma.alpha, "beta": sigma.beta, "kappa": sigma.kappa },
         },
         "results": evaluation.records(),
+        "monte_carlo": evaluation.monte_carlo_records(),
         "findings": evaluation.findings(),
     })
 }

@@ -130,6 +130,7 @@ pub fn resolve(
             methods: file.methods.clone(),
             block_samples: overrides.block_samples.map(|b| b as usize),
             steps,
+            unscented: file.sigma_points.unwrap_or_default(),
             cancel,
         },
         draw: DrawSettings {

@@ -17,9 +17,9 @@
 use nalgebra::{Matrix2, Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
 
 use super::shapes::{self, AXIS_COLORS, chi2_radius, ellipsoid_of};
-use super::{DrawSettings, Painter, v3};
+use super::{DrawSettings, Painter, v3, views};
 use crate::eval::bag::{BagEvaluation, PoseState, RvizNumbers, TopicEvaluation};
-use crate::input::{About, DrawChoices};
+use crate::input::{About, DrawChoices, Layout};
 use crate::lie::{GroupKind, LieGroup, Se3};
 use crate::plan::StepPolicy;
 use crate::scene::{
@@ -90,6 +90,8 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
         },
         axis_length,
         extent,
+        layout: Layout::Together,
+        methods: Vec::new(),
     };
     p.scene.planar = planar;
     p.scene.timeline = Timeline::Stamp;
@@ -97,6 +99,15 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
         draw_topic(&mut p, k, topic);
     }
     plots(&mut p.scene, e);
+    // Views and cameras as for every scene: a planar log from straight above.
+    let plan = views::ViewPlan {
+        poses: &p.methods,
+        rotation_only: false,
+        top: planar,
+        layout: p.layout,
+        camera: None,
+    };
+    p.scene.views = views::views(&p.scene, &plan);
     p.scene
 }
 

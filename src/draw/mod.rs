@@ -32,7 +32,7 @@ use std::collections::BTreeMap;
 use nalgebra::Vector3;
 
 use crate::eval::{AnyEvaluation, Evaluation, Node, PathKind, Role};
-use crate::input::{About, DrawChoices, Input};
+use crate::input::{About, DrawChoices, Input, Layout};
 use crate::lie::{GroupKind, LieGroup, Se3};
 use crate::plan::StepPolicy;
 use crate::scene::{
@@ -45,6 +45,7 @@ pub mod bag;
 mod plots;
 mod shapes;
 mod text;
+mod views;
 
 use shapes::chi2_radius;
 
@@ -157,10 +158,13 @@ fn part_of<G: LieGroup<N>, const N: usize>(
 /// Which poses are drawn: each pose's own choice, else uncertain poses and results, and known
 /// transforms `a_from_b` only when `a` is the root frame (the parent of the first uncertain
 /// input) — a relative mount such as `robot_from_camera` drawn at world coordinates would
-/// mislead. Results named `a_from_b` with `a` not the root are relative too.
+/// mislead. Results named `a_from_b` with `a` not the root are relative too — except rotations,
+/// which all turn about the same origin: each result gets its own view.
 struct Shown<'a> {
     root: Option<&'a str>,
     choices: &'a DrawChoices,
+    /// Rotations all sit at the origin, each in its own view: every result is drawn.
+    rotation_only: bool,
 }
 
 impl<'a> Shown<'a> {
@@ -173,7 +177,11 @@ impl<'a> Shown<'a> {
             .iter()
             .find(|n| n.role == Role::Input)
             .and_then(|n| parent_frame(&n.name));
-        Self { root, choices }
+        Self {
+            root,
+            choices,
+            rotation_only: G::KIND.is_rotation_only(),
+        }
     }
 
     fn node<G: LieGroup<N>, const N: usize>(&self, node: &Node<G, N>) -> bool {
@@ -181,6 +189,7 @@ impl<'a> Shown<'a> {
             return *choice;
         }
         match (self.root, parent_frame(&node.name)) {
+            _ if self.rotation_only && node.role == Role::Output => true,
             (Some(root), Some(parent)) => parent == root,
             _ => node.role != Role::Fixed,
         }
@@ -200,6 +209,11 @@ struct Painter<'s> {
     axis_length: f64,
     /// Size of the drawing, metres ([`scene_extent`]).
     extent: f64,
+    /// How the 3-D views split methods and poses (decided before drawing: one view per method
+    /// draws every method's banana as a surface).
+    layout: Layout,
+    /// Per drawn uncertain pose, the methods drawn for it (for the views).
+    methods: Vec<(String, views::PoseMethods)>,
 }
 
 impl<'s> Painter<'s> {
@@ -223,6 +237,8 @@ impl<'s> Painter<'s> {
             kind: G::KIND,
             axis_length,
             extent,
+            methods: Vec::new(),
+            layout: settings.choices.layout.unwrap_or(Layout::Main),
         }
     }
 
@@ -247,6 +263,26 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     let choices = &settings.choices;
     p.scene.planar = choices.top_view.unwrap_or(G::KIND.is_planar());
     let shown = Shown::new(e, choices);
+    if choices.layout.is_none() {
+        let drawn: Vec<&Node<G, N>> = e
+            .nodes
+            .iter()
+            .filter(|n| shown.node(n) && n.role != Role::Fixed)
+            .collect();
+        let mut names: Vec<&str> = drawn.iter().map(|n| n.name.as_str()).collect();
+        names.dedup();
+        let most_methods = drawn
+            .iter()
+            .map(|n| {
+                n.estimates
+                    .iter()
+                    .filter(|x| is_analytic(n, x.result.method))
+                    .count()
+            })
+            .max()
+            .unwrap_or(0);
+        p.layout = views::default_layout(G::KIND.is_rotation_only(), names.len(), most_methods);
+    }
     for node in e.nodes.iter().filter(|n| shown.node(n)) {
         draw_node(&mut p, node);
     }
@@ -331,6 +367,17 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     let (plots, series) = plots::plots(e);
     p.scene.plots = plots;
     p.scene.series = series;
+    let plan = views::ViewPlan {
+        poses: &p.methods,
+        rotation_only: G::KIND.is_rotation_only(),
+        top: p.scene.planar,
+        layout: p.layout,
+        camera: choices.camera,
+    };
+    p.scene.views = views::views(&p.scene, &plan);
+    if let Some(note) = views::note(&p.scene.views) {
+        p.scene.description_markdown.push_str(&note);
+    }
     p.scene
 }
 
@@ -418,6 +465,11 @@ fn primary_method<G: LieGroup<N>, const N: usize>(node: &Node<G, N>) -> Option<M
         .or(node.estimates.first().map(|e| e.result.method))
 }
 
+/// A method computed for `node` (not Monte Carlo, not an input's given Gaussian).
+fn is_analytic<G: LieGroup<N>, const N: usize>(node: &Node<G, N>, method: Method) -> bool {
+    method != Method::MonteCarlo && !(node.role == Role::Input && method == Method::Exact)
+}
+
 fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>) {
     let choices = &p.settings.choices;
     let (axes, ellipsoids, bananas, orientation) = (
@@ -464,8 +516,16 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
         }
         return;
     }
+    // Every method's regions on the main method's side: a banana is a 3-D slice of the tangent
+    // ellipsoid along its largest principal directions, which depend on the side, so one
+    // Gaussian read on two sides would look like two.
+    let side = node
+        .estimates
+        .iter()
+        .find(|e| Some(e.result.method) == primary)
+        .map(|e| e.result.pose.side());
     for estimate in &node.estimates {
-        let pose = estimate.result.pose;
+        let pose = side.map_or(estimate.result.pose, |s| estimate.result.pose.to_side(s));
         let method = estimate.result.method;
         if method == Method::MonteCarlo && node.particles.is_some() {
             continue; // the cloud itself shows Monte Carlo
@@ -477,6 +537,19 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
         } else {
             method.slug()
         };
+        let drawn = match p.methods.iter().position(|(n, _)| *n == node.name) {
+            Some(i) => &mut p.methods[i].1,
+            None => {
+                p.methods
+                    .push((node.name.clone(), views::PoseMethods::default()));
+                &mut p.methods.last_mut().expect("just pushed").1
+            }
+        };
+        if is_primary {
+            drawn.main = Some(segment);
+        } else if method != Method::MonteCarlo && !drawn.others.contains(&segment) {
+            drawn.others.push(segment);
+        }
         let base = format!("world/{}/{segment}", node.name);
         let color = method.color();
         // The Cartesian ellipsoid: the primary method's (to contrast with its banana) and the
@@ -486,7 +559,7 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
         }
         if bananas && !rotation_only && method != Method::VectorSpace {
             let point_of = |x: &G| *x.to_se3().translation();
-            if is_primary {
+            if is_primary || p.layout == Layout::PerMethod {
                 shapes::banana(p, &base, node.step, &pose, color, point_of);
             } else {
                 shapes::outlines(

@@ -19,22 +19,23 @@ struct PlotKind {
 
 const TRACE_POSITION: PlotKind = PlotKind {
     id: "trace_of_position_covariance_m_body_frame",
-    title: "trace of the position covariance, body frame",
+    // Short enough that a narrow view's title still shows the unit.
+    title: "trace Σ_ρρ, body frame",
     unit: "m²",
 };
 const TRACE_ROTATION: PlotKind = PlotKind {
     id: "trace_of_rotation_covariance_rad",
-    title: "trace of the rotation covariance",
+    title: "trace Σ_θθ",
     unit: "rad²",
 };
 const ALONG_TRACK: PlotKind = PlotKind {
     id: "along_track_variance_x_x_left_form_m",
-    title: "along-track variance Σ_ρxρx, world frame (left form)",
+    title: "along-track Σ_ρxρx, world",
     unit: "m²",
 };
 const ORTHOGONALITY: PlotKind = PlotKind {
     id: "orthogonality_error_max_r_t_r_i",
-    title: "orthogonality error max |RᵗR − I|",
+    title: "max |RᵗR − I|",
     unit: "",
 };
 

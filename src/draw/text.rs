@@ -38,10 +38,23 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
         for method in &e.methods {
             let _ = writeln!(s, "| {} | {} |", method.label(), method.color_name());
         }
+        if e.methods.contains(&Method::MonteCarlo) {
+            let _ = writeln!(
+                s,
+                "| Monte Carlo samples | grey cloud ({} samples, seed {}) |",
+                e.samples, e.seed
+            );
+        }
+        s.push('\n');
+    }
+    if e.methods.contains(&Method::SigmaPoints) {
+        let u = &e.unscented;
         let _ = writeln!(
             s,
-            "| Monte Carlo samples | grey cloud ({} samples, seed {}) |\n",
-            e.samples, e.seed
+            "**Sigma points** (Julier & Uhlmann 2004; α = {}, β = {}, κ = {}): 2L + 1 points at ±γ·√Σ, γ = α√(L + κ), \
+             L the inputs' tangent dimensions. For compose, between and inverse of independent inputs they equal first order \
+             while every sigma point turns less than π.\n",
+            u.alpha, u.beta, u.kappa
         );
     }
     errors_table(&mut s, e);
@@ -190,6 +203,19 @@ fn finding_text(f: &Finding) -> String {
             at(step),
             and_later(*later_steps)
         ),
+        Finding::SigmaPointsWrap {
+            output,
+            largest_rotation_rad: turn,
+            alpha,
+            alpha_below_pi,
+        } => format!(
+            "**Sigma points wrap around** for `{output}`: one turns {turn:.2} rad, beyond π. Its rotation is the same as a turn of \
+             {:.2} rad, so Log brings the point back on the other side and the sigma-point estimate departs from first order \
+             (which it equals for compose, between and inverse only while every point stays within π). A smaller α keeps the points \
+             inside: any α below {alpha_below_pi:.3} (now {alpha}), e.g. `[methods.sigma_points] alpha = {}`.",
+            turn - std::f64::consts::TAU * (turn / std::f64::consts::TAU).round(),
+            round_down(*alpha_below_pi)
+        ),
         Finding::StepsThinned {
             output,
             steps,
@@ -200,6 +226,17 @@ fn finding_text(f: &Finding) -> String {
         Finding::Interrupted => {
             "*Evaluation interrupted: later operations or steps were not evaluated.*".to_owned()
         }
+    }
+}
+
+/// `x` > 0 rounded down to one significant digit (0.907 → 0.9), a value strictly inside a bound.
+fn round_down(x: f64) -> f64 {
+    let scale = 10f64.powf(-x.log10().floor()); // x · scale ∈ [1, 10)
+    let down = (x * scale).floor() / scale;
+    if down < x {
+        down
+    } else {
+        ((x * scale * 10.0).floor() - 1.0) / (scale * 10.0)
     }
 }
 
@@ -232,4 +269,23 @@ fn final_nodes<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Vec<&Nod
         last.insert(&node.name, node);
     }
     order.iter().filter_map(|n| last.get(n).copied()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_down;
+
+    #[test]
+    fn suggested_alphas_are_short_and_strictly_below_the_bound() {
+        for (bound, suggested) in [
+            (0.9069, 0.9),
+            (0.9, 0.89),
+            (3.2, 3.0),
+            (0.0347, 0.03),
+            (12.5, 10.0),
+        ] {
+            assert_eq!(round_down(bound), suggested, "{bound}");
+            assert!(round_down(bound) < bound);
+        }
+    }
 }

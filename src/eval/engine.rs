@@ -12,6 +12,7 @@ use super::model::{Estimate, Evaluation, Finding, McSummary, Node, PointNode, Ro
 use super::{EvalError, EvalSettings};
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::plan::{OpKind, Operand, Plan, PoseValue, limits};
+use crate::propagate::sigma_point::JointInputs;
 use crate::propagate::{Propagated, relative_frobenius_error};
 use crate::sample::{CHUNK_SIZE, MeanError, Sampler, sample_statistics, uncentred_covariance};
 use crate::uncertain::{Method, Side, UncertainPose};
@@ -110,6 +111,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 samples: if monte_carlo { block.len() } else { 0 },
                 block_samples: block.len(),
                 methods: settings.methods.clone(),
+                unscented: settings.unscented,
                 nodes: Vec::new(),
                 points: Vec::new(),
                 paths: Vec::new(),
@@ -230,6 +232,36 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             reason,
             later_steps: 0,
         });
+    }
+
+    /// The sigma-point estimate of the current output through `map` over the inputs' joint
+    /// tangent, and a finding where a sigma point turns further than π
+    /// ([`JointInputs::wrap_around`]); a failure is a finding.
+    pub(super) fn sigma_points(
+        &mut self,
+        inputs: crate::Result<JointInputs<G, N>>,
+        map: impl Fn(&[G]) -> G,
+    ) -> Option<Propagated<G, N>> {
+        let params = &self.settings.unscented;
+        let run =
+            inputs.and_then(|inputs| Ok((inputs.map(map, params)?, inputs.wrap_around(params)?)));
+        match run {
+            Ok((estimate, wrap)) => {
+                if let Some(w) = wrap {
+                    self.out.findings.push(Finding::SigmaPointsWrap {
+                        output: self.current.1.clone(),
+                        largest_rotation_rad: w.largest_rotation,
+                        alpha: w.alpha,
+                        alpha_below_pi: w.alpha_below_pi,
+                    });
+                }
+                Some(estimate)
+            }
+            Err(e) => {
+                self.method_failed(None, Method::SigmaPoints, e.to_string());
+                None
+            }
+        }
     }
 
     /// n particles of `pose` for this run's block.

@@ -44,8 +44,8 @@ mod model;
 mod ops;
 
 pub use model::{
-    AnyEvaluation, Estimate, Evaluation, Finding, MatrixFrame, McSummary, Node, PathKind,
-    PointNode, PosePath, Role,
+    AnyEvaluation, Estimate, Evaluation, Finding, MatrixFrame, McSummary, MonteCarloRecord, Node,
+    PathKind, PointNode, PosePath, Role,
 };
 
 use crate::lie::{Se2, Se3, So2, So3};
@@ -81,6 +81,8 @@ pub struct EvalSettings {
     pub block_samples: Option<usize>,
     /// Which steps of long propagations keep numbers and particles.
     pub steps: StepPolicy,
+    /// Sigma-point parameters α, β, κ (default 1, 2, 0).
+    pub unscented: crate::propagate::sigma_point::Unscented,
     /// Set to stop early (Ctrl-C): the evaluation returns what it has, with
     /// [`Finding::Interrupted`].
     pub cancel: Option<Arc<AtomicBool>>,
@@ -94,6 +96,7 @@ impl Default for EvalSettings {
             methods: Vec::new(),
             block_samples: None,
             steps: StepPolicy::default(),
+            unscented: Default::default(),
             cancel: None,
         }
     }

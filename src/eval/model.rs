@@ -44,6 +44,33 @@ pub struct McSummary<G: LieGroup<N>, const N: usize> {
     pub position_mean: Option<Vector3<f64>>,
 }
 
+/// The Monte Carlo statistics of one node as plain data, for `report --json` (keys stable).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MonteCarloRecord {
+    /// The node (`name`, or `name@step` in a propagation).
+    pub label: String,
+    /// Samples the statistics use.
+    pub samples: usize,
+    /// The nominal (noise-free) pose as a matrix, row-major rows.
+    pub nominal_matrix: Vec<Vec<f64>>,
+    /// The samples' iterative Lie mean as a matrix, row-major rows.
+    pub lie_mean_matrix: Vec<Vec<f64>>,
+    /// The Lie mean as a tangent vector Log(μ), in the conventions' order.
+    pub lie_mean_tangent: Vec<f64>,
+    /// The centred 1/(N−1) covariance about the Lie mean, right side (the `monte_carlo`
+    /// estimate in `results`).
+    pub covariance_right: Vec<Vec<f64>>,
+    /// Barfoot & Furgale's uncentred E\[ξξᵀ\] about the nominal pose, left (world) side,
+    /// ξ = Log(X μ̄⁻¹); `null` where the operation does not compute it.
+    pub uncentred_about_nominal_left: Option<Vec<Vec<f64>>>,
+    /// The same about the nominal pose on the right (body) side, ξ = Log(μ̄⁻¹ X) = Ad_μ̄⁻¹ ξ_left,
+    /// hence Ad_μ̄⁻¹ E\[ξξᵀ\]_left Ad_μ̄⁻¹ᵀ; `null` with the left one.
+    pub uncentred_about_nominal_right: Option<Vec<Vec<f64>>>,
+    /// The Cartesian mean of the samples' positions (x, y, z), which a curved cloud pulls
+    /// inside its banana; `null` where the operation does not compute it.
+    pub cartesian_mean: Option<[f64; 3]>,
+}
+
 /// A named pose at one step, with every method's estimate.
 #[derive(Debug, Clone)]
 pub struct Node<G: LieGroup<N>, const N: usize> {
@@ -194,6 +221,19 @@ pub enum Finding {
         /// How many later recorded steps of the same output and method are indefinite too.
         later_steps: u64,
     },
+    /// A sigma point of an operation's inputs turns further than π: Log wraps it to the other
+    /// side, so the unscented estimate departs from first order even where the operation is
+    /// linear in each input's tangent ([`JointInputs::wrap_around`](crate::propagate::sigma_point::JointInputs::wrap_around)).
+    SigmaPointsWrap {
+        /// The output.
+        output: String,
+        /// The largest rotation angle |θ| (rad) of any sigma point's tangent offset.
+        largest_rotation_rad: f64,
+        /// The α used.
+        alpha: f64,
+        /// Every α below this keeps all sigma points within π (α · π / largest rotation).
+        alpha_below_pi: f64,
+    },
     /// Recorded steps of a long propagation were thinned ([`StepPolicy`](crate::plan::StepPolicy)).
     StepsThinned {
         /// The output.
@@ -218,6 +258,8 @@ pub struct Evaluation<G: LieGroup<N>, const N: usize> {
     pub block_samples: usize,
     /// Methods compared.
     pub methods: Vec<Method>,
+    /// The sigma-point parameters used.
+    pub unscented: crate::propagate::sigma_point::Unscented,
     /// Every pose at every recorded step, in evaluation order.
     pub nodes: Vec<Node<G, N>>,
     /// Uncertain points.
@@ -254,6 +296,43 @@ where
                 node.estimates
                     .iter()
                     .map(move |e| ResultRecord::new(&label, &e.result, e.error_vs_monte_carlo))
+            })
+            .collect()
+    }
+
+    /// The Monte Carlo statistics of every node where Monte Carlo ran (labels as in
+    /// [`records`](Self::records)).
+    ///
+    /// ```
+    /// use posecov::app::{Overrides, load, pipeline};
+    /// let loaded = load("barfoot_compounding").unwrap();
+    /// let (e, _) = pipeline(&loaded, &Overrides { samples: Some(64), ..Default::default() }, None).unwrap();
+    /// let mc = e.monte_carlo_records();
+    /// assert!(mc.iter().any(|r| r.uncentred_about_nominal_right.is_some()));
+    /// ```
+    pub fn monte_carlo_records(&self) -> Vec<MonteCarloRecord> {
+        self.nodes
+            .iter()
+            .filter_map(|node| {
+                let mc = node.monte_carlo.as_ref()?;
+                let label = match node.step {
+                    Some(k) => format!("{}@{k}", node.name),
+                    None => node.name.clone(),
+                };
+                let to_right = node.nominal.inverse().adj();
+                Some(MonteCarloRecord {
+                    label,
+                    samples: mc.stats.count,
+                    nominal_matrix: node.nominal.to_matrix().to_rows(),
+                    lie_mean_matrix: mc.stats.mean.to_matrix().to_rows(),
+                    lie_mean_tangent: mc.stats.mean.log().iter().copied().collect(),
+                    covariance_right: mc.stats.cov.to_rows(),
+                    uncentred_about_nominal_left: mc.uncentred_left.map(|c| c.to_rows()),
+                    uncentred_about_nominal_right: mc
+                        .uncentred_left
+                        .map(|c| (to_right * c * to_right.transpose()).to_rows()),
+                    cartesian_mean: mc.position_mean.map(|p| [p.x, p.y, p.z]),
+                })
             })
             .collect()
     }
@@ -312,6 +391,17 @@ impl AnyEvaluation {
     /// ```
     pub fn records(&self) -> Vec<ResultRecord> {
         with_evaluation!(self, e => e.records())
+    }
+
+    /// The Monte Carlo statistics of every node where Monte Carlo ran.
+    ///
+    /// ```
+    /// use posecov::{eval::{EvalSettings, evaluate}, plan::{AnyPlan, Plan}};
+    /// let e = evaluate(&AnyPlan::So3(Plan::default()), &EvalSettings::default()).unwrap();
+    /// assert!(e.monte_carlo_records().is_empty());
+    /// ```
+    pub fn monte_carlo_records(&self) -> Vec<MonteCarloRecord> {
+        with_evaluation!(self, e => e.monte_carlo_records())
     }
 
     /// The findings.

@@ -20,8 +20,8 @@ use crate::propagate::fusion::{FusionOptions, fuse};
 use crate::propagate::odometry::{
     InputNoise, StepNoise, propagate_increments_each, propagate_tangent_inputs_each,
 };
-use crate::propagate::sigma_point::{self, Unscented};
-use crate::sample::{Sampler, fill_par_from, retract, standard_normal};
+use crate::propagate::sigma_point::JointInputs;
+use crate::sample::{Sampler, fill_par_from, joint_square_root, retract, standard_normal};
 use crate::uncertain::{Method, Side, UncertainPose};
 
 /// Compose (`X · Y`) or between (`X⁻¹ · Y`).
@@ -90,15 +90,12 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         first: Propagated<G, N>,
         extra: Vec<Propagated<G, N>>,
         map: impl Fn(&[G]) -> G + Sync,
-        inputs: &[UncertainPose<G, N>],
+        inputs: crate::Result<JointInputs<G, N>>,
     ) -> Vec<Propagated<G, N>> {
         let mut out = vec![first];
         out.extend(extra);
-        if self.wants(Method::SigmaPoints) && !inputs.is_empty() {
-            match sigma_point::map(inputs, &map, &Unscented::default()) {
-                Ok(result) => out.push(result),
-                Err(e) => self.method_failed(None, Method::SigmaPoints, e.to_string()),
-            }
+        if self.wants(Method::SigmaPoints) {
+            out.extend(self.sigma_points(inputs, map));
         }
         out
     }
@@ -135,7 +132,8 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let (x, px) = self.gaussian(input)?;
         let first = first_order::inverse(&x);
         let particles = px.map(|p| Arc::new(p.iter().map(G::inverse).collect()));
-        let estimates = self.estimates(first, Vec::new(), |g: &[G]| g[0].inverse(), &[x]);
+        let inputs = JointInputs::independent(&[x]);
+        let estimates = self.estimates(first, Vec::new(), |g: &[G]| g[0].inverse(), inputs);
         self.single(estimates, particles)
     }
 
@@ -162,7 +160,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             first,
             extra.into_iter().collect(),
             |g: &[G]| map(&g[0]),
-            &[x],
+            JointInputs::independent(&[x]),
         );
         self.single(estimates, particles)
     }
@@ -179,7 +177,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let (y, py) = self.gaussian(rhs)?;
         let map = move |g: &[G]| pair.apply(&g[0], &g[1]);
         if let Some(cross) = cross_cov {
-            let joint = correlated_pair(&x, &y, cross).map_err(|e| self.math(e))?;
+            let joint = CorrelatedPair::with_cross(&x, &y, cross).map_err(|e| self.math(e))?;
             let first = match pair {
                 Pair::Compose => first_order::compose_correlated(&joint),
                 Pair::Between => first_order::between_correlated(&joint),
@@ -189,8 +187,9 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             } else {
                 None
             };
-            let y = y.to_side(x.side());
-            let estimates = self.estimates(first, Vec::new(), map, &[x, y]);
+            // Sigma points of the joint 2N-dimensional tangent [εX; εY], like the particles.
+            let inputs = Ok(JointInputs::correlated(&joint));
+            let estimates = self.estimates(first, Vec::new(), map, inputs);
             return self.single(estimates, particles);
         }
         let first = match pair {
@@ -219,7 +218,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             }
             extra.extend(self.vector_space(&x, &y));
         }
-        let estimates = self.estimates(first, extra, map, &[x, y]);
+        let estimates = self.estimates(first, extra, map, JointInputs::independent(&[x, y]));
         self.single(estimates, particles)
     }
 
@@ -533,7 +532,8 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         self.out.findings.push(Finding::Fusion {
             output: self.output(),
             inputs: estimates.len(),
-            cost: fused.cost,
+            // Barfoot & Furgale's V carries the ½ that the Gauss–Newton objective J omits.
+            cost: 0.5 * fused.cost,
             iterations: fused.iterations,
         });
         // Fusion has no sampled counterpart: Monte Carlo downstream continues from samples
@@ -668,21 +668,6 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
     }
 }
 
-/// The correlated pair (X, Y) with cross-covariance Σ_XY, Y moved to X's side.
-fn correlated_pair<G: LieGroup<N>, const N: usize>(
-    x: &UncertainPose<G, N>,
-    y: &UncertainPose<G, N>,
-    cross: &TangentMatrix<N>,
-) -> crate::Result<CorrelatedPair<G, N>> {
-    let y = y.to_side(x.side());
-    let mut joint = DMatrix::zeros(2 * N, 2 * N);
-    joint.view_mut((0, 0), (N, N)).copy_from(x.cov());
-    joint.view_mut((0, N), (N, N)).copy_from(cross);
-    joint.view_mut((N, 0), (N, N)).copy_from(&cross.transpose());
-    joint.view_mut((N, N), (N, N)).copy_from(y.cov());
-    CorrelatedPair::try_new(*x.mean(), *y.mean(), &joint, x.side())
-}
-
 /// `x ← f(rng, x)` over a slice, in parallel, deterministic per seed and family.
 fn fill_par_map<G: Copy + Send + Sync>(
     xs: &mut [G],
@@ -696,11 +681,4 @@ fn fill_par_map<G: Copy + Send + Sync>(
             *x = f(rng, x);
         }
     });
-}
-
-/// A square root L Lᵀ = Σ of a PSD joint covariance (eigen-based: tolerates zero rows).
-fn joint_square_root(joint: &DMatrix<f64>) -> DMatrix<f64> {
-    let eig = nalgebra::SymmetricEigen::new(joint.clone());
-    let sqrt = DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0).sqrt()));
-    &eig.eigenvectors * sqrt
 }

@@ -238,6 +238,8 @@ pub struct FileSettings {
     pub confidence: Option<f64>,
     /// Methods to compare.
     pub methods: Vec<Method>,
+    /// Sigma-point parameters (`[methods.sigma_points]`), if given.
+    pub sigma_points: Option<crate::propagate::sigma_point::Unscented>,
 }
 
 /// What an input file asks to draw (validated).
@@ -267,6 +269,41 @@ pub struct DrawChoices {
     pub links: Vec<(String, String)>,
     /// Whether frames carry their names (off for a graph's many vertices).
     pub labels: bool,
+    /// Where the 3-D camera looks from, if the file says; `None`: chosen per scene.
+    pub camera: Option<CameraChoice>,
+    /// How the 3-D views split the methods and poses; `None`: chosen per scene.
+    pub layout: Option<Layout>,
+}
+
+/// A camera asked for by an input (`[draw] camera = {...}`), every part optional: the eye at
+/// `position`, or at the distance that fits the scene along `direction` (from the target
+/// towards the eye); looking at `target` (default: the middle of what is drawn); `up` the
+/// world direction shown up on screen (default +z).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CameraChoice {
+    /// Eye position, world frame (m).
+    pub position: Option<[f64; 3]>,
+    /// Direction from the target towards the eye (any length > 0).
+    pub direction: Option<[f64; 3]>,
+    /// The point looked at, world frame (m).
+    pub target: Option<[f64; 3]>,
+    /// World direction up on screen.
+    pub up: Option<[f64; 3]>,
+}
+
+/// How the 3-D views show several methods and poses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Layout {
+    /// One view, every method drawn and shown.
+    Together,
+    /// One view: the main method in full and Monte Carlo shown, the other methods' outlines
+    /// hidden at first (one click away in the entity tree).
+    Main,
+    /// One view per method, each with the Monte Carlo cloud.
+    PerMethod,
+    /// One view per drawn pose (rotations that would all sit at the origin).
+    PerPose,
 }
 
 impl Default for DrawChoices {
@@ -284,6 +321,8 @@ impl Default for DrawChoices {
             shown: BTreeMap::new(),
             links: Vec::new(),
             labels: true,
+            camera: None,
+            layout: None,
         }
     }
 }

@@ -191,6 +191,32 @@ impl<G: LieGroup<N>, const N: usize> CorrelatedPair<G, N> {
         }
     }
 
+    /// The pair (X, Y) with cross-covariance Σ_XY = `cross_cov` = E\[εX εYᵀ\], `y` moved to the
+    /// side of `x` first; the joint covariance [[Σ_X, Σ_XY], [Σ_XYᵀ, Σ_Y]] is validated as in
+    /// [`CorrelatedPair::try_new`].
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::propagate::first_order::CorrelatedPair;
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// use nalgebra::Matrix3;
+    /// let x = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.1, 0.1], Side::Right).unwrap();
+    /// let pair = CorrelatedPair::with_cross(&x, &x, &(Matrix3::identity() * 0.009)).unwrap();
+    /// assert_eq!(pair.joint()[(0, 3)], 0.009);
+    /// assert!(CorrelatedPair::with_cross(&x, &x, &(Matrix3::identity() * 0.02)).is_err()); // |ρ| > 1
+    /// ```
+    pub fn with_cross(
+        x: &UncertainPose<G, N>,
+        y: &UncertainPose<G, N>,
+        cross_cov: &TangentMatrix<N>,
+    ) -> Result<Self> {
+        let unchecked = Self {
+            cov_xy: *cross_cov,
+            ..Self::independent(x, y)
+        };
+        Self::try_new(*x.mean(), *y.mean(), &unchecked.joint(), x.side())
+    }
+
     /// The joint covariance as a 2N × 2N matrix.
     ///
     /// ```

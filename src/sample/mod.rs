@@ -165,6 +165,23 @@ pub fn covariance_square_root<const N: usize>(cov: &TangentMatrix<N>) -> Result<
     Ok(TangentMatrix::<N>::from_iterator(root.iter().copied()))
 }
 
+/// A square root S Sᵀ = Σ of a PSD covariance of any size (e.g. the 2N × 2N joint covariance
+/// of a correlated pair): S = V diag(√max(λ, 0)) from Σ = V diag(λ) Vᵀ, tolerating zero rows;
+/// S's columns are Σ's principal axes scaled by their standard deviations.
+///
+/// ```
+/// use posecov::sample::joint_square_root;
+/// use nalgebra::DMatrix;
+/// let joint = DMatrix::from_row_slice(2, 2, &[1.0, 0.9, 0.9, 1.0]);
+/// let s = joint_square_root(&joint);
+/// assert!((&s * s.transpose() - joint).norm() < 1e-14);
+/// ```
+pub fn joint_square_root(cov: &DMatrix<f64>) -> DMatrix<f64> {
+    let eig = SymmetricEigen::new(cov.clone());
+    let sqrt = DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.max(0.0).sqrt()));
+    &eig.eigenvectors * sqrt
+}
+
 /// The tangent ξ of `x` about `mean` on `side`: right ξ = Log(μ⁻¹ x), left ξ = Log(x μ⁻¹).
 ///
 /// ```

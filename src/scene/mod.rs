@@ -39,9 +39,11 @@
 mod mesh;
 mod palette;
 mod validate;
+mod view;
 
 pub use mesh::unit_sphere_mesh;
 pub use palette::{LINK, NOMINAL};
+pub use view::{Camera, View3d, grid_columns, rotate};
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
 pub type Vec3 = [f64; 3];
@@ -336,11 +338,14 @@ pub struct Scene {
     pub plots: Vec<Plot>,
     /// Plot lines, each under the path of its plot.
     pub series: Vec<ScalarSeries>,
-    /// A planar scene (SE(2), SO(2)) lives in the x–y plane: the sink declares +y as the
-    /// viewer's up axis so the default camera faces that plane instead of grazing it.
+    /// A planar scene (SE(2), SO(2), or `view = "top"`) lies in the x–y plane: its views are
+    /// seen from straight above ([`View3d::camera`]).
     pub planar: bool,
     /// The timeline of the plot series and the time panel.
     pub timeline: Timeline,
+    /// The 3-D views, each with its camera; empty: one view of the whole world, framed by the
+    /// viewer.
+    pub views: Vec<View3d>,
 }
 
 impl Scene {
@@ -359,6 +364,7 @@ impl Scene {
             series: Vec::new(),
             planar: false,
             timeline: Timeline::Step,
+            views: Vec::new(),
         }
     }
 

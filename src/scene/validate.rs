@@ -90,6 +90,14 @@ pub enum SceneError {
         /// Required root.
         root: &'static str,
     },
+    /// A 3-D view's camera cannot be used.
+    #[error("3-D view {view:?}: bad camera: {reason}")]
+    BadCamera {
+        /// The view's name.
+        view: String,
+        /// Why.
+        reason: &'static str,
+    },
     /// An item lies under a frame's entity, whose transform would move it.
     #[error("{path}: lies under the frame entity {frame}, whose transform would move it")]
     UnderFrame {
@@ -343,7 +351,7 @@ impl Scene {
     /// Checks that the scene can be drawn: every number finite (also as `f32`), quaternions
     /// of unit norm, sizes non-negative and radii positive, parallel arrays of equal length,
     /// triangle indices in range, entity paths well formed, 3-D items under [`WORLD`], series
-    /// under [`PLOTS`], and nothing placed under a [`Frame`]'s entity (its transform would
+    /// under [`PLOTS`], views' subtrees under [`WORLD`] and their cameras usable, and nothing placed under a [`Frame`]'s entity (its transform would
     /// move it).
     ///
     /// ```
@@ -359,6 +367,7 @@ impl Scene {
     pub fn validate(&self) -> Result<(), SceneError> {
         self.items.iter().try_for_each(check_item)?;
         self.series.iter().try_for_each(check_series)?;
+        self.views.iter().try_for_each(super::View3d::check)?;
         // Each item's ancestors looked up among the frames: linear in items × depth.
         let frames: std::collections::HashSet<&str> = self
             .items

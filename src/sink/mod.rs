@@ -1,7 +1,8 @@
 //! Sinks: where a [`Scene`](crate::scene::Scene) goes. Only this module knows Rerun.
 //!
-//! - [`rerun`]: scene → Rerun 0.36 archetypes (batched, one entity per item) and the default
-//!   layout ([`blueprint_for`]).
+//! - [`rerun`]: scene → Rerun 0.36 archetypes (batched, one entity per item).
+//! - [`blueprint`]: the default layout, with each 3-D view's camera and hidden entities
+//!   ([`send_layout`]).
 //! - [`stream`]: opening a [`Sink`] (viewer, file, stdout, web viewer, memory) with
 //!   deterministic content, and finishing it cleanly ([`SinkGuard::finish`]).
 //! - [`viewer`]: finding a native `rerun` 0.36 viewer and rendering PNGs with it.
@@ -25,15 +26,16 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod blueprint;
 pub mod rerun;
 pub mod stream;
 pub mod viewer;
 
 use std::path::PathBuf;
 
+pub use self::blueprint::send_layout;
 pub use self::rerun::{
-    LogOutcome, STEP_TIMELINE, blueprint_for, log_part_cancellable, log_scene,
-    log_scene_cancellable,
+    LogOutcome, STEP_TIMELINE, log_part_cancellable, log_scene, log_scene_cancellable,
 };
 pub use self::stream::{SinkGuard, open_stream, scene_to_rrd_bytes};
 pub use self::viewer::{NativeViewer, find_native_viewer, render_png};

@@ -1,4 +1,4 @@
-//! Scene → Rerun 0.36 archetypes, and the default layout.
+//! Scene → Rerun 0.36 archetypes (the layout is [`super::blueprint`]'s).
 //!
 //! One item becomes one chunk on its own entity path (so each pose × method toggles on its
 //! own), with all its instances batched in one row: a cloud is one `Points3D`, a path of
@@ -9,17 +9,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use ::rerun as rr;
 use rr::AsComponents;
-use rr::blueprint::components::PanelState;
-use rr::blueprint::{
-    Blueprint, BlueprintPanel, Horizontal, SelectionPanel, Spatial3DView, TextDocumentView,
-    TimePanel, TimeSeriesView, Vertical,
-};
 use rr::log::{Chunk, RowId};
 
 use super::SinkError;
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, QuatXyzw,
-    ScalarSeries, Scene, SceneItem, Surface, Timing, Triads, Vec3,
+    ScalarSeries, Scene, SceneItem, Surface, Timing, Triads, Vec3, rotate,
 };
 
 /// Name of the sequence timeline that [`Timing::Step`] items are logged on.
@@ -71,12 +66,9 @@ pub fn log_scene_cancellable(
         rec,
         scene::WORLD,
         Timing::Static,
-        &[&if scene.planar {
-            // Faces the x–y plane: the default camera then looks at a planar scene, not along it.
-            rr::ViewCoordinates::RIGHT_HAND_Y_UP()
-        } else {
-            rr::ViewCoordinates::RIGHT_HAND_Z_UP()
-        }],
+        // z is up in every scene (planar ones lie in the x–y plane, the grid's plane); each
+        // view's camera says where the eye is.
+        &[&rr::ViewCoordinates::RIGHT_HAND_Z_UP()],
     )?;
     send(
         rec,
@@ -138,43 +130,6 @@ fn log_items(
         log_item(rec, item)?;
     }
     Ok(LogOutcome::Complete)
-}
-
-/// The layout sent with a scene: the 3-D view of `world` on the left (two thirds); on the
-/// right the description above one view per [`Plot`](crate::scene::Plot) (its title and unit
-/// as the view's name), or the description alone when the scene has no plots. The time panel shows the `step` timeline,
-/// following the latest data, so a recording opens on its last step instead of replaying.
-///
-/// ```
-/// let _blueprint = posecov::sink::blueprint_for(&posecov::scene::Scene::new("t", "d"));
-/// ```
-pub fn blueprint_for(scene: &Scene) -> Blueprint {
-    let view3d = Spatial3DView::new("3D").with_origin(scene::WORLD);
-    let text = TextDocumentView::new("Description").with_origin(scene::DESCRIPTION);
-    let mut right: Vec<rr::blueprint::ContainerLike> = vec![text.into()];
-    let mut shares = vec![3.0];
-    for plot in &scene.plots {
-        right.push(
-            TimeSeriesView::new(plot.label())
-                .with_origin(format!("{}/{}", scene::PLOTS, plot.id))
-                .into(),
-        );
-        shares.push(2.0);
-    }
-    let right = Vertical::new(right).with_row_shares(shares);
-    Blueprint::new(Horizontal::new([view3d.into(), right.into()]).with_column_shares([2.0, 1.0]))
-        .with_auto_views(false)
-        .with_blueprint_panel(BlueprintPanel::from_state(PanelState::Collapsed))
-        .with_selection_panel(SelectionPanel::from_state(PanelState::Collapsed))
-        .with_time_panel(
-            TimePanel::new()
-                .with_state(PanelState::Collapsed)
-                .with_timeline(match scene.timeline {
-                    scene::Timeline::Step => STEP_TIMELINE,
-                    scene::Timeline::Stamp => STAMP_TIMELINE,
-                })
-                .with_play_state(rr::blueprint::components::PlayState::Following),
-        )
 }
 
 /// Sends one row with all `parts` as one chunk: no log time, no batcher, fixed order.
@@ -377,31 +332,4 @@ fn quat(q: &QuatXyzw) -> rr::Quaternion {
 fn color(c: Color) -> rr::Color {
     let [r, g, b, a] = c.0;
     rr::Color::from_unmultiplied_rgba(r, g, b, a)
-}
-
-/// Rotates `v` by the unit quaternion `q` = `[x, y, z, w]`: v + 2w(u×v) + 2u×(u×v).
-fn rotate(q: &QuatXyzw, v: Vec3) -> Vec3 {
-    let (u, w) = ([q[0], q[1], q[2]], q[3]);
-    let cross = |a: Vec3, b: Vec3| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let uv = cross(u, v);
-    let uuv = cross(u, uv);
-    [0, 1, 2].map(|i| v[i] + 2.0 * (w * uv[i] + uuv[i]))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rotate_matches_a_quarter_turn_about_z() {
-        let s = std::f64::consts::FRAC_1_SQRT_2;
-        let r = rotate(&[0.0, 0.0, s, s], [1.0, 0.0, 0.0]);
-        assert!((r[0]).abs() < 1e-12 && (r[1] - 1.0).abs() < 1e-12 && r[2].abs() < 1e-12);
-    }
 }

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use ::rerun as rr;
 
-use super::{APPLICATION_ID, RecordingIds, Sink, SinkError, blueprint_for, find_native_viewer};
+use super::{APPLICATION_ID, RecordingIds, Sink, SinkError, find_native_viewer, send_layout};
 use crate::scene::Scene;
 
 /// How long a flush to a remote viewer may take before we give up.
@@ -54,8 +54,7 @@ pub fn open_stream(
 ) -> Result<(rr::RecordingStream, SinkGuard), SinkError> {
     let builder = rr::RecordingStreamBuilder::new(APPLICATION_ID)
         .recording_id(ids.recording_id.clone())
-        .send_properties(false)
-        .with_blueprint(blueprint_for(scene));
+        .send_properties(false);
     let plain = |remote| GuardKind::Plain { remote };
     let (rec, kind) = match sink {
         Sink::Save(target) => {
@@ -104,6 +103,7 @@ pub fn open_stream(
     };
     rec.set_log_time_enabled(false);
     rec.set_log_tick_enabled(false);
+    send_layout(&rec, scene)?;
     Ok((rec, SinkGuard { kind }))
 }
 

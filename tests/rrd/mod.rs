@@ -10,11 +10,16 @@ use rerun::log::{Chunk, LogMsg};
 
 /// The recording's (not the blueprint's) chunks, in stream order.
 pub fn recording_chunks(bytes: &[u8]) -> Vec<Chunk> {
+    store_chunks(bytes, rerun::StoreKind::Recording)
+}
+
+/// The chunks of one kind of store (recording or blueprint), in stream order.
+pub fn store_chunks(bytes: &[u8], kind: rerun::StoreKind) -> Vec<Chunk> {
     let decoder = DecoderApp::decode_eager(std::io::Cursor::new(bytes)).expect("an .rrd stream");
     decoder
         .map(|msg| msg.expect("decodable message"))
         .filter_map(|msg| match msg {
-            LogMsg::ArrowMsg(store, arrow) if store.kind() == rerun::StoreKind::Recording => {
+            LogMsg::ArrowMsg(store, arrow) if store.kind() == kind => {
                 Some(Chunk::from_arrow_msg(&arrow).expect("a chunk"))
             }
             _ => None,

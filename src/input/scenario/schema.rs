@@ -24,6 +24,31 @@ pub struct ScenarioFile {
     /// What to draw.
     #[serde(default)]
     pub draw: DrawSpec,
+    /// Parameters of the methods (`[methods.sigma_points]`).
+    #[serde(default)]
+    pub methods: MethodsSpec,
+}
+
+/// `[methods.*]`: parameters of the methods that have some.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MethodsSpec {
+    /// `[methods.sigma_points]`: the unscented transform's α, β, κ.
+    #[serde(default)]
+    pub sigma_points: Option<Spanned<SigmaPointsSpec>>,
+}
+
+/// `[methods.sigma_points]`: Julier & Uhlmann's scaling parameters (defaults α = 1, β = 2,
+/// κ = 0; see [`crate::propagate::sigma_point`]).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SigmaPointsSpec {
+    /// Spread α > 0.
+    pub alpha: Option<f64>,
+    /// Prior-knowledge weight β (2 is optimal for Gaussians).
+    pub beta: Option<f64>,
+    /// Secondary scaling κ; L + κ > 0 for every operation (κ > −DOF).
+    pub kappa: Option<f64>,
 }
 
 /// The Lie group every pose of a scenario lives in (`group = "se2"` etc.).
@@ -266,15 +291,36 @@ pub struct DrawSpec {
     /// How the 3D view faces the scene; default `top` for planar groups, else `perspective`.
     #[serde(default)]
     pub view: Option<View>,
+    /// The 3D camera: `{ position | direction, target, up }`, each optional; overrides `view`.
+    #[serde(default)]
+    pub camera: Option<Spanned<CameraSpec>>,
+    /// How the 3D views show several methods and poses: `together`, `main`, `per_method`,
+    /// `per_pose`; default chosen per scene.
+    #[serde(default)]
+    pub layout: Option<crate::input::Layout>,
+}
+
+/// `[draw] camera = { ... }`: where the 3D eye is and what it looks at (world frame, metres).
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    /// Eye position.
+    pub position: Option<[f64; 3]>,
+    /// Direction from the target towards the eye; the distance is chosen to fit the scene.
+    pub direction: Option<[f64; 3]>,
+    /// The point looked at (default: the middle of what is drawn).
+    pub target: Option<[f64; 3]>,
+    /// World direction up on screen (default +z).
+    pub up: Option<[f64; 3]>,
 }
 
 /// How the 3D view faces the scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum View {
-    /// Face the x–y plane (planar motion; the viewer's up axis is +y).
+    /// From straight above the x–y plane, x to the right (planar motion).
     Top,
-    /// z up, seen from an angle.
+    /// z up, seen from the direction chosen for the scene.
     Perspective,
 }
 

@@ -15,6 +15,7 @@ use super::schema::{CovSpec, DrawSpec, OperationSpec, ScenarioFile};
 use super::values::{SpecGroup, cov_for, mean_for};
 use super::{Scenario, ScenarioError};
 
+mod choices;
 mod operations;
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{GroupKind, LieGroup, Se2, Se3, So2, So3, TangentMatrix};
@@ -158,6 +159,7 @@ impl Lowering<'_> {
             samples: h.samples.as_ref().map(|s| *s.get_ref()),
             confidence: h.confidence.as_ref().map(|c| *c.get_ref()),
             methods,
+            sigma_points: self.sigma_points(&self.file.methods.sigma_points, h.group.dof())?,
         })
     }
 
@@ -194,6 +196,8 @@ impl Lowering<'_> {
             axis_length: spec.axis_length.as_ref().map(|l| *l.get_ref()),
             top_view: spec.view.map(|v| v == super::schema::View::Top),
             shown,
+            camera: self.camera(&spec.camera)?,
+            layout: spec.layout,
             ..DrawChoices::default()
         })
     }

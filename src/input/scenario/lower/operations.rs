@@ -175,13 +175,7 @@ impl Lowering<'_> {
             },
         };
         if let (Some(x), Some(y)) = (given(lhs), given(rhs)) {
-            let y = y.to_side(x.side());
-            let mut joint = DMatrix::zeros(2 * N, 2 * N);
-            joint.view_mut((0, 0), (N, N)).copy_from(x.cov());
-            joint.view_mut((0, N), (N, N)).copy_from(&cross);
-            joint.view_mut((N, 0), (N, N)).copy_from(&cross.transpose());
-            joint.view_mut((N, N), (N, N)).copy_from(y.cov());
-            CorrelatedPair::try_new(*x.mean(), *y.mean(), &joint, x.side()).map_err(|e| {
+            CorrelatedPair::with_cross(&x, &y, &cross).map_err(|e| {
                 at(format!(
                     "the joint covariance [[Σ_X, Σ_XY], [Σ_XYᵀ, Σ_Y]] is invalid: {e}"
                 ))

@@ -1,0 +1,399 @@
+//! The 3-D views of a scene and their cameras.
+//!
+//! **Layout** ([`Layout`]; the file's `[draw] layout`, else chosen here): several rotations
+//! (which would all sit at the origin) get one view per pose; a pose compared by four or more
+//! analytic methods gets one view per method, each with the Monte Carlo cloud; otherwise one
+//! view with the main method in full and the other methods' outlines hidden at first (the
+//! vector-space ellipse, a lesson of its own, stays shown).
+//!
+//! **Camera**: planar scenes are seen from straight above with x to the right and y up (the
+//! eye tilted 2° towards −y so that orbiting turns about z); 3-D scenes look along the
+//! direction in which what is drawn is thinnest (the smallest principal axis of all drawn
+//! points, tilted 25° towards up so depth still reads; a scene lying flat, thin within 35° of
+//! up, from 30° off the vertical on the −y side, x to the right), rotations from the (+x, +y,
+//! +z) octant; `[draw] camera` overrides. The eye then stands at the distance at which every
+//! drawn point of the view fits the viewer's 55° field of view with a margin.
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+
+use crate::input::{CameraChoice, Layout};
+use crate::scene::{Camera, ItemKind, Scene, Vec3, View3d, grid_columns, rotate};
+use crate::uncertain::Method;
+
+/// The segment of an input's own Gaussian.
+const GIVEN: &str = "given";
+/// Rerun's default vertical field of view of a 3-D view (55°).
+const FOV_Y: f64 = 55.0 * std::f64::consts::PI / 180.0;
+/// Width over height assumed for the 3-D area (two thirds of a 16:10 window); a grid of
+/// views divides it ([`grid_columns`]).
+const ASPECT: f64 = 1.15;
+/// Room left around what is drawn.
+const MARGIN: f64 = 1.2;
+/// Tilt of the top view off the vertical, so that orbiting still turns about z.
+const TOP_TILT_DEG: f64 = 2.0;
+/// Tilt of a 3-D view off its thinnest direction.
+const OBLIQUE_TILT_DEG: f64 = 25.0;
+/// A scene whose thinnest direction is within this angle of up lies flat...
+const FLAT_DEG: f64 = 35.0;
+/// ...and is seen from this far off the vertical, from −y.
+const FLAT_TILT_DEG: f64 = 30.0;
+
+/// Which methods were drawn for one pose: the main one and the others (slugs).
+#[derive(Default, Debug)]
+pub(super) struct PoseMethods {
+    pub main: Option<&'static str>,
+    pub others: Vec<&'static str>,
+}
+
+/// What the views are made from besides the scene's items.
+pub(super) struct ViewPlan<'a> {
+    /// Per drawn (uncertain) pose, its methods.
+    pub poses: &'a [(String, PoseMethods)],
+    /// Rotations only (SO(2), SO(3)).
+    pub rotation_only: bool,
+    /// Seen from above (planar scenes, or `view = "top"`).
+    pub top: bool,
+    /// The layout.
+    pub layout: Layout,
+    /// The file's camera.
+    pub camera: Option<CameraChoice>,
+}
+
+/// The layout chosen when the file names none: one view per pose for several rotations, one
+/// view per method when a pose has four or more analytic methods, else [`Layout::Main`].
+pub(super) fn default_layout(rotation_only: bool, poses: usize, most_methods: usize) -> Layout {
+    if rotation_only && poses >= 2 {
+        Layout::PerPose
+    } else if most_methods >= 4 {
+        Layout::PerMethod
+    } else {
+        Layout::Main
+    }
+}
+
+/// The scene's views, each with its camera.
+pub(super) fn views(scene: &Scene, plan: &ViewPlan) -> Vec<View3d> {
+    let layout = plan.layout;
+    let whole = |name: &str| View3d {
+        name: name.to_owned(),
+        ..Default::default()
+    };
+    let mut views = match layout {
+        Layout::Together => vec![whole("3D")],
+        Layout::Main => {
+            let mut view = whole("3D");
+            for (pose, methods) in plan.poses.iter() {
+                view.hidden.extend(
+                    methods
+                        .others
+                        .iter()
+                        .filter(|m| **m != Method::VectorSpace.slug())
+                        .map(|m| format!("world/{pose}/{m}")),
+                );
+            }
+            vec![view]
+        }
+        Layout::PerMethod => per_method(plan),
+        Layout::PerPose => plan
+            .poses
+            .iter()
+            .map(|(pose, _)| View3d {
+                name: pose.clone(),
+                include: vec![format!("world/{pose}")],
+                ..Default::default()
+            })
+            .collect(),
+    };
+    if views.is_empty() {
+        views.push(whole("3D"));
+    }
+    let columns = grid_columns(views.len());
+    let rows = views.len().div_ceil(columns);
+    let aspect = ASPECT * rows as f64 / columns as f64;
+    for view in &mut views {
+        view.camera = camera(&points_of(scene, view), plan, aspect);
+    }
+    views
+}
+
+/// A sentence for the text panel on what the views leave out or hide, if anything.
+pub(super) fn note(views: &[View3d]) -> Option<String> {
+    let hidden: Vec<String> = views
+        .iter()
+        .flat_map(|v| &v.hidden)
+        .map(|p| format!("`{p}`"))
+        .collect();
+    if !hidden.is_empty() {
+        return Some(format!(
+            "*Hidden at first, to keep the picture clear:* {}. Show them with the eye icon in the \
+             blueprint panel (the left panel, under the 3D view).\n\n",
+            hidden.join(", ")
+        ));
+    }
+    (views.len() > 1).then(|| {
+        let names: Vec<&str> = views.iter().map(|v| v.name.as_str()).collect();
+        format!(
+            "*One 3D view each:* {} — same data, one at a time, so nothing hides anything else.\n\n",
+            names.join(", ")
+        )
+    })
+}
+
+/// One view per analytic method, each leaving out the other methods.
+fn per_method(plan: &ViewPlan) -> Vec<View3d> {
+    let mut all: Vec<&'static str> = Vec::new();
+    for (_, m) in plan.poses {
+        // An input's own Gaussian ("given") is shown in every view.
+        for slug in m.main.iter().chain(&m.others).filter(|s| **s != GIVEN) {
+            if !all.contains(slug) {
+                all.push(slug);
+            }
+        }
+    }
+    all.iter()
+        .map(|shown| View3d {
+            name: label_of(shown).to_owned(),
+            exclude: plan
+                .poses
+                .iter()
+                .flat_map(|(pose, m)| {
+                    m.main
+                        .iter()
+                        .chain(&m.others)
+                        .filter(|s| *s != shown && **s != GIVEN)
+                        .map(move |s| format!("world/{pose}/{s}"))
+                })
+                .collect(),
+            ..Default::default()
+        })
+        .collect()
+}
+
+/// The legend label of a method slug.
+fn label_of(slug: &str) -> &'static str {
+    Method::ALL
+        .iter()
+        .find(|m| m.slug() == slug)
+        .map_or("3D", |m| m.label())
+}
+
+/// Every point a view draws: positions, vertices, ellipsoid and axis extremes.
+fn points_of(scene: &Scene, view: &View3d) -> Vec<Vector3<f64>> {
+    let mut out: Vec<Vec3> = Vec::new();
+    for item in scene.items.iter().filter(|i| view.shows(&i.path)) {
+        match &item.kind {
+            ItemKind::Frame(f) => {
+                out.push(f.translation);
+                for k in 0..3 {
+                    let mut axis = [0.0; 3];
+                    axis[k] = f.axis_length;
+                    out.push(add(&f.translation, &rotate(&f.rotation, axis)));
+                }
+            }
+            ItemKind::Triads(t) => out.extend(&t.translations),
+            ItemKind::Points(p) => out.extend(&p.positions),
+            ItemKind::Ellipsoids(e) => {
+                for s in &e.shapes {
+                    for k in 0..3 {
+                        let mut axis = [0.0; 3];
+                        axis[k] = s.half_sizes[k];
+                        let v = rotate(&s.rotation, axis);
+                        out.push(add(&s.center, &v));
+                        out.push(add(&s.center, &v.map(|x| -x)));
+                    }
+                }
+            }
+            ItemKind::Surface(s) => out.extend(&s.vertices),
+            ItemKind::LineStrips(l) => out.extend(l.strips.iter().flatten()),
+            ItemKind::Arrows(a) => {
+                out.extend(&a.origins);
+                out.extend(a.origins.iter().zip(&a.vectors).map(|(o, v)| add(o, v)));
+            }
+            ItemKind::Text(_) => {}
+        }
+    }
+    out.iter().map(|p| Vector3::from(*p)).collect()
+}
+
+fn add(a: &Vec3, b: &Vec3) -> Vec3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// The camera of a view that draws `points` ([module docs](self)); `None` without points.
+pub(super) fn camera(points: &[Vector3<f64>], plan: &ViewPlan, aspect: f64) -> Option<Camera> {
+    let choice = plan.camera.unwrap_or_default();
+    let up = choice.up.map_or(Vector3::z(), Vector3::from).normalize();
+    if let Some(position) = choice.position {
+        let target = choice
+            .target
+            .map(Vector3::from)
+            .or_else(|| centre(points))?;
+        return Some(Camera {
+            position,
+            target: target.into(),
+            up: up.into(),
+        });
+    }
+    if points.is_empty() {
+        return None;
+    }
+    let towards_eye = match choice.direction {
+        Some(d) => Vector3::from(d).normalize(),
+        None if plan.top => tilted(&up, &Vector3::y(), -TOP_TILT_DEG),
+        None if plan.rotation_only => Vector3::new(1.0, 0.8, 0.7).normalize(),
+        None => oblique(points, &up),
+    };
+    let (target, distance) = fit(
+        points,
+        &towards_eye,
+        &up,
+        choice.target.map(Vector3::from),
+        aspect,
+    );
+    Some(Camera {
+        position: (target + towards_eye * distance).into(),
+        target: target.into(),
+        up: up.into(),
+    })
+}
+
+/// `axis` turned by `degrees` towards `towards` (both unit, orthogonal enough).
+fn tilted(axis: &Vector3<f64>, towards: &Vector3<f64>, degrees: f64) -> Vector3<f64> {
+    let side = (towards - axis * axis.dot(towards)).normalize();
+    let a = degrees.to_radians();
+    (axis * a.cos() + side * a.sin()).normalize()
+}
+
+/// The thinnest direction of the points, seen from above (+`up` side), tilted so depth reads.
+fn oblique(points: &[Vector3<f64>], up: &Vector3<f64>) -> Vector3<f64> {
+    let mean = points.iter().sum::<Vector3<f64>>() / points.len() as f64;
+    let spread: Matrix3<f64> = points
+        .iter()
+        .map(|p| (p - mean) * (p - mean).transpose())
+        .sum::<Matrix3<f64>>();
+    let eigen = SymmetricEigen::new(spread);
+    let k = eigen.eigenvalues.imin();
+    let mut n = eigen.eigenvectors.column(k).into_owned();
+    if n.dot(up) < 0.0 {
+        n = -n;
+    }
+    // Lying (nearly) flat: seen from the south and above, x still to the right.
+    if n.dot(up) > FLAT_DEG.to_radians().cos() {
+        return tilted(up, &Vector3::y(), -FLAT_TILT_DEG);
+    }
+    // Standing up: tilted from its thin direction towards the up axis, so depth reads.
+    let towards = (up - n * n.dot(up)).normalize();
+    tilted(&n, &towards, OBLIQUE_TILT_DEG)
+}
+
+/// The middle of the points' bounding box.
+fn centre(points: &[Vector3<f64>]) -> Option<Vector3<f64>> {
+    let first = points.first()?;
+    let (lo, hi) = points
+        .iter()
+        .fold((*first, *first), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+    Some((lo + hi) / 2.0)
+}
+
+/// The look target (the middle of the points as seen along `towards_eye`, unless given) and
+/// the eye's distance from it at which every point fits the field of view.
+fn fit(
+    points: &[Vector3<f64>],
+    towards_eye: &Vector3<f64>,
+    up: &Vector3<f64>,
+    target: Option<Vector3<f64>>,
+    aspect: f64,
+) -> (Vector3<f64>, f64) {
+    let forward = -towards_eye;
+    let right = forward
+        .cross(up)
+        .try_normalize(1e-9)
+        .unwrap_or_else(Vector3::x);
+    let screen_up = right.cross(&forward);
+    let coords: Vec<Vector3<f64>> = points
+        .iter()
+        .map(|p| Vector3::new(p.dot(&right), p.dot(&screen_up), p.dot(towards_eye)))
+        .collect();
+    let target_coords = match target {
+        Some(t) => Vector3::new(t.dot(&right), t.dot(&screen_up), t.dot(towards_eye)),
+        None => centre(&coords).unwrap_or_else(Vector3::zeros),
+    };
+    let (tan_y, tan_x) = ((FOV_Y / 2.0).tan(), (FOV_Y / 2.0).tan() * aspect);
+    let distance = coords
+        .iter()
+        .map(|c| {
+            let d = c - target_coords;
+            d.z + (d.x.abs() / tan_x).max(d.y.abs() / tan_y)
+        })
+        .fold(0.0, f64::max)
+        * MARGIN;
+    let extent = coords
+        .iter()
+        .map(|c| (c - target_coords).norm())
+        .fold(0.0, f64::max);
+    let target =
+        right * target_coords.x + screen_up * target_coords.y + towards_eye * target_coords.z;
+    (target, distance.max(0.5 * extent).max(0.05))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan(poses: &[(String, PoseMethods)], top: bool) -> ViewPlan<'_> {
+        ViewPlan {
+            poses,
+            rotation_only: false,
+            top,
+            layout: Layout::Main,
+            camera: None,
+        }
+    }
+
+    #[test]
+    fn the_top_view_has_x_to_the_right_and_fits_the_points() {
+        let poses = Vec::new();
+        let points = [Vector3::new(-1.0, -1.0, 0.0), Vector3::new(3.0, 1.0, 0.0)];
+        let c = camera(&points, &plan(&poses, true), ASPECT).unwrap();
+        let (eye, target) = (Vector3::from(c.position), Vector3::from(c.target));
+        assert!(
+            (target - Vector3::new(1.0, 0.0, 0.0)).norm() < 0.05,
+            "{target}"
+        );
+        let sight = (target - eye).normalize();
+        // Looking down, within the tilt; the screen's right is +x.
+        assert!(sight.z < -(TOP_TILT_DEG + 0.1).to_radians().cos());
+        let right = sight.cross(&Vector3::from(c.up)).normalize();
+        assert!((right - Vector3::x()).norm() < 1e-6, "{right}");
+        // Both corners inside the horizontal field of view.
+        let half_width = 2.0;
+        assert!(half_width / (eye - target).norm() < (FOV_Y / 2.0).tan() * ASPECT);
+        assert!(c.check("top").is_ok());
+    }
+
+    #[test]
+    fn a_thin_3d_scene_is_seen_across_its_thin_direction() {
+        let poses = Vec::new();
+        // Points in the x–z plane: the thin direction is y.
+        let points: Vec<Vector3<f64>> = (0..20)
+            .map(|i| Vector3::new((i % 5) as f64, 0.01 * (i % 2) as f64, (i / 5) as f64))
+            .collect();
+        let c = camera(&points, &plan(&poses, false), ASPECT).unwrap();
+        let sight = (Vector3::from(c.target) - Vector3::from(c.position)).normalize();
+        let off = sight.dot(&Vector3::y()).abs().acos().to_degrees();
+        assert!((off - OBLIQUE_TILT_DEG).abs() < 1.0, "{off}°");
+    }
+
+    #[test]
+    fn a_file_camera_position_is_kept() {
+        let poses = Vec::new();
+        let mut p = plan(&poses, false);
+        p.camera = Some(CameraChoice {
+            position: Some([1.0, 2.0, 3.0]),
+            ..Default::default()
+        });
+        let c = camera(&[Vector3::zeros()], &p, ASPECT).unwrap();
+        assert_eq!(c.position, [1.0, 2.0, 3.0]);
+        assert_eq!(c.target, [0.0; 3]);
+    }
+}

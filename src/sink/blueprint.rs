@@ -1,0 +1,296 @@
+//! The layout sent with a scene, written as Rerun blueprint archetypes.
+//!
+//! Rerun 0.36's Rust builder (`rerun::blueprint::Spatial3DView`) has no setter for a 3-D view's
+//! eye (`EyeControls3D`) or for an entity's default visibility (`EntityBehavior`), and keeps its
+//! view ids private. A blueprint is an ordinary store of archetypes, though — the Python SDK
+//! writes it that way — so this module logs the same archetypes itself to a blueprint stream
+//! (`RecordingStreamBuilder::blueprint().memory()`) and hands the messages to
+//! [`RecordingStream::send_blueprint`](rr::RecordingStream::send_blueprint) with an activation
+//! command, exactly as `Blueprint::send` does:
+//!
+//! - `viewport`: `ViewportBlueprint` (root container, no automatic views or layout);
+//! - `container/<id>`: `ContainerBlueprint` (kind, contents, shares);
+//! - `view/<id>`: `ViewBlueprint` (class, name, origin), `view/<id>/ViewContents` (the query),
+//!   `view/<id>/EyeControls3D` (a view property: eye position, look target, up);
+//! - `view/<id>/ViewContents/overrides/<entity>/visualizers`: `EntityBehavior { visible:
+//!   false }` for entities that start hidden (where the viewer's own eye toggle writes it; the
+//!   children inherit it);
+//! - `blueprint_panel`, `selection_panel`, `time_panel`: panel states.
+//!
+//! Ids are fixed per position in the layout, so the blueprint's content is deterministic too.
+
+use ::rerun as rr;
+use rr::blueprint::components::{
+    ContainerKind, Eye3DKind, IncludedContent, PanelState, PlayState, QueryExpression,
+    RootContainer, RowShare, TimelineName, ViewClass,
+};
+use rr::components::{Name, Position3D, Vector3D, Visible};
+use rr::external::re_log_types::BlueprintActivationCommand;
+use rr::external::re_sdk_types::blueprint::archetypes::{
+    ContainerBlueprint, EntityBehavior, EyeControls3D, PanelBlueprint, TimePanelBlueprint,
+    ViewBlueprint, ViewContents, ViewportBlueprint,
+};
+use rr::external::re_sdk_types::blueprint::components::{ColumnShare, GridColumns};
+use rr::external::re_sdk_types::datatypes::{Float32, UInt32, Uuid};
+
+use super::rerun::{STAMP_TIMELINE, STEP_TIMELINE};
+use super::{APPLICATION_ID, SinkError};
+use crate::scene::{self, Camera, Scene, View3d};
+
+/// Sends the layout of `scene` through `rec` and makes it the active and default blueprint:
+/// the 3-D views on the left (two thirds; several views in a grid, each with its camera and
+/// its hidden entities), on the right the description above one time-series view per
+/// [`Plot`](crate::scene::Plot) (its title and unit as the view's name). Panels collapsed; the
+/// time panel shows the `step` timeline following the latest data, so a recording opens on its
+/// last step.
+///
+/// # Errors
+/// An SDK error building the blueprint.
+///
+/// ```
+/// use posecov::sink::send_layout;
+/// let (rec, storage) = rerun::RecordingStreamBuilder::new("doc").memory()?;
+/// send_layout(&rec, &posecov::scene::Scene::new("t", "d"))?;
+/// assert!(!storage.take().is_empty());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn send_layout(rec: &rr::RecordingStream, scene: &Scene) -> Result<(), SinkError> {
+    let (messages, activation) = layout_messages(scene)?;
+    rec.send_blueprint(messages, activation);
+    Ok(())
+}
+
+/// The blueprint messages of [`send_layout`] and their activation command.
+fn layout_messages(
+    scene: &Scene,
+) -> Result<(Vec<rr::log::LogMsg>, BlueprintActivationCommand), SinkError> {
+    let (bp, storage) = rr::RecordingStreamBuilder::new(APPLICATION_ID)
+        .blueprint()
+        .memory()?;
+    bp.set_time_sequence("blueprint", 0);
+    let mut ids = Ids::default();
+    let default_view = [View3d {
+        name: "3D".to_owned(),
+        ..Default::default()
+    }];
+    let views: &[View3d] = if scene.views.is_empty() {
+        &default_view
+    } else {
+        &scene.views
+    };
+    let mut left = Vec::new();
+    for view in views {
+        left.push(log_view3d(&bp, &mut ids, view)?);
+    }
+    let left = match left.as_slice() {
+        [one] => one.clone(),
+        _ => {
+            let grid = log_container(&bp, &mut ids, ContainerKind::Grid, &left, &[])?;
+            bp.log(
+                grid.as_str(),
+                &ContainerBlueprint::update_fields()
+                    .with_grid_columns(GridColumns(UInt32(scene::grid_columns(left.len()) as u32))),
+            )?;
+            grid
+        }
+    };
+    let mut right = vec![log_view(
+        &bp,
+        &mut ids,
+        "TextDocument",
+        "Description",
+        scene::DESCRIPTION,
+    )?];
+    let mut shares = vec![3.0];
+    for plot in &scene.plots {
+        let origin = format!("{}/{}", scene::PLOTS, plot.id);
+        right.push(log_view(
+            &bp,
+            &mut ids,
+            "TimeSeries",
+            &plot.label(),
+            &origin,
+        )?);
+        shares.push(2.0);
+    }
+    let right = log_container(&bp, &mut ids, ContainerKind::Vertical, &right, &shares)?;
+    let root = ids.next();
+    log_container_at(
+        &bp,
+        &root,
+        ContainerKind::Horizontal,
+        &[left, right],
+        &[2.0, 1.0],
+    )?;
+    bp.log(
+        "viewport",
+        &ViewportBlueprint::new()
+            .with_root_container(RootContainer(root.uuid))
+            .with_auto_layout(false)
+            .with_auto_views(false),
+    )?;
+    let collapsed = PanelBlueprint::new().with_state(PanelState::Collapsed);
+    bp.log("blueprint_panel", &collapsed)?;
+    bp.log("selection_panel", &collapsed)?;
+    bp.log(
+        "time_panel",
+        &TimePanelBlueprint::new()
+            .with_state(PanelState::Collapsed)
+            .with_timeline(TimelineName(
+                match scene.timeline {
+                    scene::Timeline::Step => STEP_TIMELINE,
+                    scene::Timeline::Stamp => STAMP_TIMELINE,
+                }
+                .into(),
+            ))
+            .with_play_state(PlayState::Following),
+    )?;
+    let messages = storage.take();
+    let store = messages
+        .first()
+        .map(|m| m.store_id().clone())
+        .ok_or_else(|| SinkError::Flush("the blueprint stream produced no messages".into()))?;
+    Ok((messages, BlueprintActivationCommand::make_active(store)))
+}
+
+/// A blueprint id: the UUID and its text, as used in entity paths.
+#[derive(Clone)]
+struct Id {
+    uuid: Uuid,
+    text: String,
+}
+
+/// Fixed ids in layout order (version-4 form, so any UUID parser accepts them).
+#[derive(Default)]
+struct Ids(u64);
+
+impl Ids {
+    fn next(&mut self) -> Id {
+        self.0 += 1;
+        let mut bytes = [0u8; 16];
+        bytes[8..].copy_from_slice(&self.0.to_be_bytes());
+        bytes[0..4].copy_from_slice(b"posc");
+        bytes[6] = 0x40; // version 4
+        bytes[8] = 0x80 | (bytes[8] & 0x3f); // RFC 4122 variant
+        let hex: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
+        let text = format!(
+            "{}-{}-{}-{}-{}",
+            &hex[0..8],
+            &hex[8..12],
+            &hex[12..16],
+            &hex[16..20],
+            &hex[20..32]
+        );
+        Id {
+            uuid: Uuid { bytes },
+            text,
+        }
+    }
+}
+
+/// Logs a view and returns its blueprint path.
+fn log_view(
+    bp: &rr::RecordingStream,
+    ids: &mut Ids,
+    class: &str,
+    name: &str,
+    origin: &str,
+) -> Result<String, SinkError> {
+    let path = format!("view/{}", ids.next().text);
+    bp.log(
+        format!("{path}/ViewContents"),
+        &ViewContents::new([QueryExpression("$origin/**".into())]),
+    )?;
+    bp.log(
+        path.as_str(),
+        &ViewBlueprint::new(ViewClass(class.into()))
+            .with_display_name(Name(name.into()))
+            .with_space_origin(format!("/{origin}")),
+    )?;
+    Ok(path)
+}
+
+/// Logs a 3-D view of the world: its query, its eye and its hidden entities.
+fn log_view3d(bp: &rr::RecordingStream, ids: &mut Ids, view: &View3d) -> Result<String, SinkError> {
+    let path = format!("view/{}", ids.next().text);
+    bp.log(
+        format!("{path}/ViewContents"),
+        &ViewContents::new(query(view).into_iter().map(|q| QueryExpression(q.into()))),
+    )?;
+    bp.log(
+        path.as_str(),
+        &ViewBlueprint::new(ViewClass("3D".into()))
+            .with_display_name(Name(view.name.as_str().into()))
+            .with_space_origin(format!("/{}", scene::WORLD)),
+    )?;
+    if let Some(camera) = &view.camera {
+        bp.log(format!("{path}/EyeControls3D"), &eye(camera))?;
+    }
+    for hidden in &view.hidden {
+        // The viewer's own eye toggle writes here (`ViewContents::blueprint_base_visualizer_
+        // path_for_entity`: the entity's override base, `…/overrides/<entity>/visualizers`).
+        bp.log(
+            format!("{path}/ViewContents/overrides/{hidden}/visualizers"),
+            &EntityBehavior::new().with_visible(Visible::from(false)),
+        )?;
+    }
+    Ok(path)
+}
+
+/// The view's query: its subtrees (or the whole world), minus the excluded ones.
+fn query(view: &View3d) -> Vec<String> {
+    let mut q: Vec<String> = if view.include.is_empty() {
+        vec![format!("+ /{}/**", scene::WORLD)]
+    } else {
+        view.include.iter().map(|p| format!("+ /{p}/**")).collect()
+    };
+    q.extend(view.exclude.iter().map(|p| format!("- /{p}/**")));
+    q
+}
+
+/// An orbiting eye at the camera's position, around its target.
+fn eye(camera: &Camera) -> EyeControls3D {
+    let f = |v: &scene::Vec3| v.map(|x| x as f32);
+    let [px, py, pz] = f(&camera.position);
+    let [tx, ty, tz] = f(&camera.target);
+    EyeControls3D::new()
+        .with_kind(Eye3DKind::Orbital)
+        .with_position(Position3D::new(px, py, pz))
+        .with_look_target(Position3D::new(tx, ty, tz))
+        .with_eye_up(Vector3D::from(f(&camera.up)))
+}
+
+/// Logs a container under a new id and returns its blueprint path.
+fn log_container(
+    bp: &rr::RecordingStream,
+    ids: &mut Ids,
+    kind: ContainerKind,
+    contents: &[String],
+    shares: &[f32],
+) -> Result<String, SinkError> {
+    let id = ids.next();
+    log_container_at(bp, &id, kind, contents, shares)
+}
+
+/// Logs a container at `id`: `shares` are column shares (horizontal) or row shares (vertical).
+fn log_container_at(
+    bp: &rr::RecordingStream,
+    id: &Id,
+    kind: ContainerKind,
+    contents: &[String],
+    shares: &[f32],
+) -> Result<String, SinkError> {
+    let path = format!("container/{}", id.text);
+    let mut archetype = ContainerBlueprint::new(kind)
+        .with_contents(contents.iter().map(|c| IncludedContent(c.as_str().into())));
+    if !shares.is_empty() {
+        archetype = match kind {
+            ContainerKind::Horizontal => {
+                archetype.with_col_shares(shares.iter().map(|&s| ColumnShare(Float32(s))))
+            }
+            _ => archetype.with_row_shares(shares.iter().map(|&s| RowShare(Float32(s)))),
+        };
+    }
+    bp.log(path.as_str(), &archetype)?;
+    Ok(path)
+}
