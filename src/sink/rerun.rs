@@ -173,7 +173,7 @@ pub fn blueprint_for(scene: &Scene) -> Blueprint {
 }
 
 /// Sends one row with all `parts` as one chunk: no log time, no batcher, fixed order.
-fn send(
+pub(super) fn send(
     rec: &rr::RecordingStream,
     path: impl Into<rr::EntityPath>,
     timing: Timing,
