@@ -9,11 +9,12 @@ use std::time::Duration;
 use posecov::app::live::{Edit, EditValue, Live, LiveDocument, Status};
 use posecov::app::{Overrides, load_text, pipeline};
 use posecov::sink::{RecordingIds, Sink, open_stream, scene_to_rrd_bytes};
+use rerun::external::arrow::array::{Array as _, ArrayRef, StringArray};
 use rerun::external::re_entity_db::EntityDb;
 use rerun::external::re_entity_db::external::re_chunk_store::LatestAtQuery;
 use rerun::external::re_log_encoding::DecoderApp;
-use rerun::external::arrow::array::ArrayRef;
 use rerun::external::re_log_types::TimeInt;
+use rerun::external::re_sdk_types::blueprint::archetypes::ViewBlueprint;
 use rerun::log::LogMsg;
 use rerun::{EntityPath, StoreKind};
 
@@ -31,7 +32,8 @@ fn edit(id: &str, value: f64) -> Edit {
 /// A live session on a memory sink, with `samples` set first.
 fn start(name: &str, samples: u64) -> (Arc<Live>, Status) {
     let mut doc = LiveDocument::open(name).unwrap();
-    doc.apply(&edit("scenario.samples", samples as f64)).unwrap();
+    doc.apply(&edit("scenario.samples", samples as f64))
+        .unwrap();
     let (_, scene) = pipeline(doc.loaded(), &Overrides::default(), None).unwrap();
     let ids = RecordingIds::for_scenario(name, 0);
     let (rec, guard) = open_stream(&Sink::Memory, &ids, &scene).unwrap();
@@ -91,11 +93,7 @@ fn shown(db: &EntityDb, path: &EntityPath, step: Option<i64>) -> Vec<(String, Ar
     let mut out: Vec<(String, ArrayRef)> = components
         .iter()
         .filter(|c| **c != clear)
-        .filter_map(|c| {
-            results
-                .component_batch_raw(*c)
-                .map(|a| (c.to_string(), a))
-        })
+        .filter_map(|c| results.component_batch_raw(*c).map(|a| (c.to_string(), a)))
         .collect();
     out.sort_by(|a, b| a.0.cmp(&b.0));
     out
@@ -119,8 +117,14 @@ fn assert_same_view(live: &[u8], fresh: &[u8], last_step: i64) {
         for path in &paths {
             let (x, y) = (shown(&a, path, step), shown(&b, path, step));
             if x != y {
-                let names = |v: &[(String, ArrayRef)]| v.iter().map(|c| c.0.clone()).collect::<Vec<_>>();
-                let differ: Vec<&String> = x.iter().zip(&y).filter(|(p, q)| p != q).map(|(p, _)| &p.0).collect();
+                let names =
+                    |v: &[(String, ArrayRef)]| v.iter().map(|c| c.0.clone()).collect::<Vec<_>>();
+                let differ: Vec<&String> = x
+                    .iter()
+                    .zip(&y)
+                    .filter(|(p, q)| p != q)
+                    .map(|(p, _)| &p.0)
+                    .collect();
                 panic!(
                     "{path} at step {step:?}: live shows {:?}, a fresh recording {:?}; values differ in {differ:?}",
                     names(&x),
@@ -171,7 +175,11 @@ fn a_bad_value_is_refused_with_its_field_and_the_picture_stays() {
     assert_eq!(err.field().as_deref(), Some("pose[0].cov"), "{err}");
     assert!(err.to_string().contains("negative"), "{err}");
     let status = live.status();
-    assert_eq!((status.generation, status.shown), (0, Some(0)), "{status:?}");
+    assert_eq!(
+        (status.generation, status.shown),
+        (0, Some(0)),
+        "{status:?}"
+    );
     let expected = fresh(&live);
     let bytes = live.finish().unwrap().unwrap();
     assert_same_view(&bytes, &expected, 0);
@@ -198,7 +206,8 @@ fn fewer_steps_and_hidden_clouds_leave_nothing_stale() {
 fn reset_returns_to_the_files_picture() {
     let (live, _) = start("na568_se2_odometry", 1024);
     live.apply(&edit("operation[0].noise.std[2]", 0.3)).unwrap();
-    live.apply(&edit("operation[0].controls[6][0]", 1.2)).unwrap();
+    live.apply(&edit("operation[0].controls[6][0]", 1.2))
+        .unwrap();
     let generation = live.reset().unwrap();
     let status = live.wait_done(generation, WAIT);
     assert_eq!(status.shown, Some(generation), "{status:?}");
@@ -208,4 +217,61 @@ fn reset_returns_to_the_files_picture() {
     let expected = fresh(&live);
     let bytes = live.finish().unwrap().unwrap();
     assert_same_view(&bytes, &expected, 10);
+}
+
+/// The plots: each generation's series under `plots/<plot>/g<N>/`, the layout's plot views
+/// rooted there (Rerun does not clear plotted points).
+#[test]
+fn plots_show_the_newest_generation_only() {
+    let (live, _) = start("na568_se2_odometry", 1024);
+    live.apply(&edit("operation[0].noise.std[2]", 0.3)).unwrap();
+    let status = live.wait_done(1, WAIT);
+    assert_eq!(status.shown, Some(1), "{status:?}");
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    if let Some(path) = std::env::var_os("POSECOV_LIVE_RRD") {
+        std::fs::write(path, &bytes).unwrap();
+    }
+    // The newest generation's series hold exactly the fresh recording's points.
+    let series = |bytes: &[u8], prefix: &str| -> Vec<(String, usize)> {
+        let mut v: Vec<(String, usize)> = rrd::recording_chunks(bytes)
+            .iter()
+            .filter_map(|c| {
+                let p = c.entity_path().to_string();
+                let rest = p.strip_prefix("/plots/")?;
+                let (plot, tail) = rest.split_once('/')?;
+                let tail = tail.strip_prefix(prefix)?;
+                (c.num_rows() > 1).then(|| (format!("{plot}/{tail}"), c.num_rows()))
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let newest = series(&bytes, "g1/");
+    assert!(!newest.is_empty());
+    assert_eq!(newest, series(&expected, ""));
+    // The active layout (the last one sent) plots generation 1's series only.
+    let origins: Vec<String> = messages(&bytes)
+        .iter()
+        .filter_map(|m| match m {
+            LogMsg::ArrowMsg(store, arrow) if store.kind() == StoreKind::Blueprint => {
+                rerun::log::Chunk::from_arrow_msg(arrow).ok()
+            }
+            _ => None,
+        })
+        .filter_map(|c| {
+            let origin = ViewBlueprint::descriptor_space_origin().component;
+            let array = c.component_batch_raw(origin, 0)?.ok()?;
+            let text = array
+                .as_any()
+                .downcast_ref::<StringArray>()?
+                .value(0)
+                .to_owned();
+            text.trim_start_matches('/')
+                .strip_prefix("plots/")
+                .map(str::to_owned)
+        })
+        .collect();
+    let last = origins.last().expect("a plot view");
+    assert!(last.ends_with("/g1"), "{origins:?}");
 }

@@ -10,9 +10,11 @@
 //!   the entity only at an *earlier* step, its latest item is logged again at the cleared
 //!   step, so the step slider shows exactly what a fresh recording would. Clears are
 //!   per entity (not recursive) and cost one small chunk each.
-//! - **Plots** (range queries, which Rerun does not clear): each generation's series go under
-//!   `plots/<plot>/g<N>/…`, and the time-series views are told (a blueprint update of their
-//!   contents, nothing else) to show generation `N` only.
+//! - **Plots** (range queries, which Rerun does not clear: a cleared point still plots):
+//!   each generation's series go under `plots/<plot>/g<N>/…`, and the layout is sent again
+//!   with each plot view's origin there. For scenes with plots this resets the camera to the
+//!   layout's; scenes without plots keep the camera the user set. (An update of the views'
+//!   contents alone would keep it, but the 0.36 viewer does not apply one.)
 //!
 //! Rerun lets static data shadow temporal data on the same entity forever, so an entity that
 //! was ever logged static and is later logged at steps is logged static (its last step):
@@ -23,6 +25,7 @@ use std::sync::atomic::AtomicBool;
 
 use ::rerun as rr;
 
+use super::blueprint_for;
 use super::rerun::send;
 use super::{LogOutcome, SinkError, log_part_cancellable, log_scene_cancellable};
 use crate::scene::{self, Scene, SceneItem, Timing};
@@ -84,7 +87,28 @@ impl Restream {
         let generation = self.generation;
         self.generation += 1;
         self.clear_and_carry(rec, &scene)?;
-        let _ = generation;
+        if !scene.series.is_empty() {
+            for series in &mut scene.series {
+                series.path = generation_path(&series.path, generation);
+            }
+            // The plot views show this generation's series only (a new layout: Rerun's
+            // plots do not honour clears).
+            let ids: Vec<String> = scene.plots.iter().map(|p| p.id.clone()).collect();
+            for plot in &mut scene.plots {
+                plot.id = format!("{}/g{generation}", plot.id);
+            }
+            let layout = blueprint_for(&scene);
+            for (plot, id) in scene.plots.iter_mut().zip(ids) {
+                plot.id = id;
+            }
+            layout.send(
+                rec,
+                rr::blueprint::BlueprintActivation {
+                    make_active: true,
+                    make_default: true,
+                },
+            )?;
+        }
         let outcome = log_scene_cancellable(rec, &scene, cancel)?;
         self.touch(&scene);
         Ok(outcome)
