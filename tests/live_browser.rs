@@ -81,14 +81,9 @@ fn read_stream(url: &str) -> Arc<Mutex<Vec<LogMsg>>> {
             .unwrap();
         let handle = re_async::AsyncRuntimeHandle::new_native(runtime.handle().clone());
         let rx = re_grpc_client::read::stream(&handle, uri);
-        loop {
-            match rx.recv_timeout(Duration::from_secs(300)) {
-                Ok(msg) => {
-                    if let Some(re_log_channel::DataSourceMessage::LogMsg(m)) = msg.into_data() {
-                        sink.lock().unwrap().push(m);
-                    }
-                }
-                Err(_) => break,
+        while let Ok(msg) = rx.recv_timeout(Duration::from_secs(300)) {
+            if let Some(re_log_channel::DataSourceMessage::LogMsg(m)) = msg.into_data() {
+                sink.lock().unwrap().push(m);
             }
         }
         drop(runtime);
@@ -130,6 +125,9 @@ fn dragging_a_slider_in_chromium_re_streams_the_viewer() {
         return;
     }
     let grpc_port = free_port();
+    let dir = std::env::temp_dir().join(format!("posecov-live-browser-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let saved = dir.join("saved.toml");
     let child = Command::new(env!("CARGO_BIN_EXE_posecov"))
         .args([
             "live",
@@ -140,7 +138,14 @@ fn dragging_a_slider_in_chromium_re_streams_the_viewer() {
             "--grpc-port",
         ])
         .arg(grpc_port.to_string())
-        .args(["--bind", "127.0.0.1:0", "--serve-seconds", "300"])
+        .args([
+            "--bind",
+            "127.0.0.1:0",
+            "--serve-seconds",
+            "300",
+            "--save-scenario",
+        ])
+        .arg(&saved)
         .env("POSECOV_RERUN", "/nonexistent")
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -171,6 +176,12 @@ fn dragging_a_slider_in_chromium_re_streams_the_viewer() {
         serde_json::from_slice(output.stdout.trim_ascii()).expect("one JSON line");
     let value = report["value"].as_f64().unwrap();
     assert!(value > 20.0, "{report}");
+    // "Save" wrote a scenario that `posecov check` accepts, with the new σ and the file's
+    // comments.
+    assert_eq!(report["saved"].as_str(), saved.to_str(), "{report}");
+    let text = std::fs::read_to_string(&saved).unwrap();
+    assert!(text.contains("# x, y in metres; θ in degrees"), "{text}");
+    posecov::app::commands::check(saved.to_str().unwrap(), &Overrides::default()).unwrap();
 
     // What a fresh recording of the edited scenario shows.
     let mut doc = LiveDocument::open("camera_on_robot").unwrap();
@@ -179,6 +190,7 @@ fn dragging_a_slider_in_chromium_re_streams_the_viewer() {
         value: EditValue::Number(value),
     })
     .unwrap();
+    assert_eq!(doc.text(), text, "the saved file is the edited scenario");
     let loaded = load_text(&doc.text(), "edited.toml").unwrap();
     let (_, scene) = pipeline(&loaded, &Overrides::default(), None).unwrap();
     let fresh = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("fresh", 0)).unwrap();
@@ -197,6 +209,7 @@ fn dragging_a_slider_in_chromium_re_streams_the_viewer() {
                 .map(|m| format!("{:?}", m.store_id()))
                 .collect();
             assert_eq!(recordings.len(), 1, "one recording");
+            std::fs::remove_dir_all(&dir).ok();
             break;
         }
         assert!(

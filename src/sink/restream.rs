@@ -27,7 +27,7 @@ use ::rerun as rr;
 
 use super::blueprint_for;
 use super::rerun::send;
-use super::{LogOutcome, SinkError, log_part_cancellable, log_scene_cancellable};
+use super::{LogOutcome, STEP_TIMELINE, SinkError, log_part_cancellable, log_scene_cancellable};
 use crate::scene::{self, Scene, SceneItem, Timing};
 
 /// The state of a recording that generations are re-streamed into.
@@ -176,8 +176,8 @@ impl Restream {
         }
         let mut carried = Scene::new(String::new(), String::new());
         for (path, times) in &self.touched {
+            clear_all(rec, path, times, &clear)?;
             for &t in times {
-                send(rec, path.as_str(), timing_of(t), &[&clear])?;
                 let (Some(step), Some(new)) = (t, at.get(path.as_str())) else {
                     continue;
                 };
@@ -207,15 +207,39 @@ impl Restream {
     }
 }
 
+/// One chunk of clears per entity: a static row if it was static, one row per step it was
+/// logged at.
+fn clear_all(
+    rec: &rr::RecordingStream,
+    path: &str,
+    times: &BTreeSet<Option<i64>>,
+    clear: &rr::Clear,
+) -> Result<(), SinkError> {
+    if times.contains(&None) {
+        send(rec, path, Timing::Static, &[clear])?;
+    }
+    let steps: Vec<i64> = times.iter().flatten().copied().collect();
+    if steps.is_empty() {
+        return Ok(());
+    }
+    let mut builder = rr::log::Chunk::builder(rr::EntityPath::from(path));
+    for step in steps {
+        let at = rr::TimePoint::default().with(rr::Timeline::new_sequence(STEP_TIMELINE), step);
+        builder = builder.with_archetype(rr::log::RowId::new(), at, clear);
+    }
+    let chunk = builder.build().map_err(|err| SinkError::Chunk {
+        path: path.to_owned(),
+        message: err.to_string(),
+    })?;
+    rec.send_chunk(chunk);
+    Ok(())
+}
+
 fn timing_key(t: Timing) -> Option<i64> {
     match t {
         Timing::Static => None,
         Timing::Step(k) => Some(k),
     }
-}
-
-fn timing_of(t: Option<i64>) -> Timing {
-    t.map_or(Timing::Static, Timing::Step)
 }
 
 /// `plots/<plot>/<rest>` → `plots/<plot>/g<N>/<rest>`.

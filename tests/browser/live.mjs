@@ -2,8 +2,9 @@
 // playwright-core. Usage: node live.mjs CONTROL_PAGE_URL [SCREENSHOT.png]
 //
 // Opens the control page, drags the heading σ slider of camera_on_robot with the mouse,
-// waits until the page reports the new generation's final picture as sent, and prints one
-// JSON line {"id", "value", "generation"} for the Rust side (tests/live_browser.rs), which
+// waits until the page reports the new generation's final picture as sent, clicks Save when
+// the page offers it, and prints one JSON line {"id", "value", "generation", "saved"} for the
+// Rust side (tests/live_browser.rs), which
 // checks on the viewer's gRPC stream that the new data arrived.
 import { chromium } from "playwright-core";
 import { mkdtempSync, rmSync } from "node:fs";
@@ -57,11 +58,21 @@ try {
   const typed = Number(await page.locator(`input[type=number][data-id="${ID}"]`).inputValue());
   if (Math.abs(typed - after) > 1e-9) throw new Error(`typed value ${typed} does not follow the slider ${after}`);
   const generation = Number(await status.getAttribute("data-generation"));
+  // "Save" (shown with --save-scenario) writes the current scenario to that file.
+  let saved = null;
+  if (await page.locator("#save").isVisible()) {
+    const [response] = await Promise.all([
+      page.waitForResponse((r) => r.url().endsWith("/api/save")),
+      page.click("#save"),
+    ]);
+    if (!response.ok()) throw new Error(`save failed: ${await response.text()}`);
+    saved = (await response.json()).saved;
+  }
   if (screenshot) {
     await page.waitForTimeout(3000);
     await page.screenshot({ path: screenshot });
   }
-  console.log(JSON.stringify({ id: ID, value: after, generation }));
+  console.log(JSON.stringify({ id: ID, value: after, generation, saved }));
   code = 0;
 } catch (e) {
   console.error(String(e && e.stack || e));

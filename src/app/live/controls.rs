@@ -466,7 +466,7 @@ fn range(x: f64, integer: bool, spread: bool, angle: Option<Angle>) -> (f64, f64
 
 /// The largest 1, 2 or 5 × 10ᵏ not above `raw`.
 fn nice_step(raw: f64) -> f64 {
-    if !(raw > 0.0) || !raw.is_finite() {
+    if raw.is_nan() || raw <= 0.0 || raw.is_infinite() {
         return 0.001;
     }
     let p = 10f64.powf(raw.log10().floor());

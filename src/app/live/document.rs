@@ -2,7 +2,7 @@
 //! document, so comments and layout survive every edit), and the input lowered from it.
 //!
 //! Every edit is applied to a copy of the document, printed, and loaded by the same path as a
-//! file ([`load_text`](crate::app::load_text)); only when that succeeds does the copy become
+//! file ([`load_text`]); only when that succeeds does the copy become
 //! current. A bad value is refused with the file's field and message, and nothing changes.
 
 use std::path::Path;
@@ -244,6 +244,10 @@ fn write(doc: &mut DocumentMut, slot: &Slot, value: EditValue) -> Result<(), Edi
                 Place::Leaf(path) => {
                     let old =
                         leaf_mut(doc, path).ok_or_else(|| wrong("is no longer in the file"))?;
+                    if controls::number(old) == Some(x) {
+                        // Unchanged: keep the file's spelling (`0.062110`, `1e-3`).
+                        return Ok(());
+                    }
                     // A whole number written as an integer stays one (TOML floats accept it).
                     let new = if old.is_integer() && x.fract() == 0.0 && x.abs() < 1e15 {
                         Value::from(x as i64)

@@ -37,6 +37,21 @@ pub struct LiveOptions {
 
 /// Runs live mode until Ctrl-C (or the serve limit). Returns the exit code.
 ///
+/// ```no_run
+/// use std::sync::{Arc, atomic::AtomicBool};
+/// use posecov::app::live::{LiveOptions, live};
+/// use posecov::app::session::ServeOptions;
+/// let options = LiveOptions {
+///     scenario: "camera_on_robot".into(),
+///     overrides: Default::default(),
+///     sink: None,
+///     serve: ServeOptions { web_port: 9090, grpc_port: 9876, seconds: Some(60), open_browser: false },
+///     bind: "127.0.0.1:9091".parse().unwrap(),
+///     save_scenario: None,
+/// };
+/// live(&options, &Arc::new(AtomicBool::new(false))).unwrap();
+/// ```
+///
 /// # Errors
 /// The scenario's error; a sink live mode cannot stream to; the page server's.
 pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppError> {
@@ -113,6 +128,19 @@ fn start(doc: LiveDocument, view: &ViewOptions) -> Result<(Arc<Live>, Option<Str
 ///
 /// # Errors
 /// The first load's error; the sink's.
+///
+/// ```no_run
+/// use posecov::app::session::{ServeOptions, ViewOptions};
+/// let options = ViewOptions {
+///     scenario: "my_scenario.toml".into(),
+///     overrides: Default::default(),
+///     sink: None,
+///     serve: ServeOptions { web_port: 9090, grpc_port: 9876, seconds: None, open_browser: false },
+///     watch: true,
+///     png: None,
+/// };
+/// posecov::app::live::watch_in_place(&options, &Default::default()).unwrap();
+/// ```
 pub fn watch_in_place(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, AppError> {
     let path = PathBuf::from(&options.scenario);
     let doc = LiveDocument::open(&options.scenario)?;

@@ -62,6 +62,18 @@ struct App {
 ///
 /// # Errors
 /// [`AppError::Live`] when the address cannot be bound.
+///
+/// ```no_run
+/// # use std::sync::{Arc, atomic::AtomicBool};
+/// # use posecov::app::live::{Live, LiveDocument, PageOptions, serve_page};
+/// # use posecov::sink::{RecordingIds, Sink, open_stream};
+/// let doc = LiveDocument::open("camera_on_robot").unwrap();
+/// let layout = posecov::scene::Scene::new("camera", "");
+/// let (rec, guard) = open_stream(&Sink::Spawn, &RecordingIds::for_scenario("camera", 7), &layout).unwrap();
+/// let live = Live::start(doc, rec, guard, Default::default());
+/// let page = PageOptions { bind: "127.0.0.1:9091".parse().unwrap(), viewer_url: None, save_to: None };
+/// serve_page(live, page, Arc::new(AtomicBool::new(false)), None, |url| println!("Controls: {url}")).unwrap();
+/// ```
 pub fn serve_page(
     live: Arc<Live>,
     options: PageOptions,
@@ -123,19 +135,23 @@ fn hosts_of(addr: SocketAddr) -> Vec<String> {
     hosts
 }
 
-/// Whether the request comes from this server's own page (see the module docs).
-fn allowed(app: &App, method: &Method, headers: &HeaderMap) -> Result<(), &'static str> {
+/// Whether the request comes from this server's own page (see the module docs). `hosts`:
+/// the `host:port` values naming this server; `open`: bound to every interface (`--bind
+/// 0.0.0.0:…`), where any host name with this port is accepted.
+fn allowed(
+    hosts: &[String],
+    open: bool,
+    method: &Method,
+    headers: &HeaderMap,
+) -> Result<(), &'static str> {
     let host = headers
         .get(header::HOST)
         .and_then(|h| h.to_str().ok())
         .ok_or("a Host header is required")?;
-    let own = |h: &str| {
-        app.hosts.iter().any(|o| o.eq_ignore_ascii_case(h))
-            // `--bind 0.0.0.0`: the user opened it to the network; any host name may reach it.
-            || app.options.bind.ip().is_unspecified()
-                && h.rsplit_once(':').is_some_and(|(_, p)| p == app.hosts[0].rsplit_once(':').map_or("", |x| x.1))
-    };
-    if !own(host) {
+    let port = hosts[0].rsplit_once(':').map_or("", |x| x.1);
+    let own = hosts.iter().any(|o| o.eq_ignore_ascii_case(host))
+        || open && host.rsplit_once(':').is_some_and(|(_, p)| p == port);
+    if !own {
         return Err("Host is not this server");
     }
     if let Some(origin) = headers.get(header::ORIGIN) {
@@ -166,7 +182,8 @@ async fn handle(
     headers: HeaderMap,
     body: Bytes,
 ) -> Response {
-    if let Err(why) = allowed(&app, &method, &headers) {
+    let open = app.options.bind.ip().is_unspecified();
+    if let Err(why) = allowed(&app.hosts, open, &method, &headers) {
         return reply(StatusCode::FORBIDDEN, &json!({ "error": why }));
     }
     if body.len() > MAX_BODY {
@@ -332,6 +349,76 @@ fn reply(status: StatusCode, body: &Json) -> Response {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn headers(pairs: &[(header::HeaderName, &str)]) -> HeaderMap {
+        let mut h = HeaderMap::new();
+        for (k, v) in pairs {
+            h.insert(k.clone(), HeaderValue::from_str(v).unwrap());
+        }
+        h
+    }
+
+    #[test]
+    fn only_this_servers_own_page_may_drive_it() {
+        let hosts = hosts_of("127.0.0.1:8123".parse().unwrap());
+        let json = (header::CONTENT_TYPE, "application/json");
+        let get = |pairs: &[(header::HeaderName, &str)]| {
+            allowed(&hosts, false, &Method::GET, &headers(pairs))
+        };
+        let post = |pairs: &[(header::HeaderName, &str)]| {
+            allowed(&hosts, false, &Method::POST, &headers(pairs))
+        };
+        assert!(get(&[(header::HOST, "127.0.0.1:8123")]).is_ok());
+        assert!(get(&[(header::HOST, "localhost:8123")]).is_ok());
+        assert!(get(&[]).is_err(), "no Host");
+        // DNS rebinding: a foreign name that resolves to 127.0.0.1.
+        assert!(get(&[(header::HOST, "evil.example:8123")]).is_err());
+        assert!(
+            post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::ORIGIN, "http://127.0.0.1:8123"),
+                json.clone()
+            ])
+            .is_ok()
+        );
+        // Another page in the browser.
+        assert!(
+            post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::ORIGIN, "http://evil.example"),
+                json.clone()
+            ])
+            .is_err()
+        );
+        assert!(
+            post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::ORIGIN, "null"),
+                json.clone()
+            ])
+            .is_err()
+        );
+        // A cross-site form cannot send JSON.
+        assert!(
+            post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::CONTENT_TYPE, "text/plain")
+            ])
+            .is_err()
+        );
+        // Opened to the network on purpose: any name with this port, still same-origin only.
+        let open = |pairs: &[(header::HeaderName, &str)]| {
+            allowed(&hosts, true, &Method::GET, &headers(pairs))
+        };
+        assert!(open(&[(header::HOST, "lab-pc.local:8123")]).is_ok());
+        assert!(
+            open(&[
+                (header::HOST, "lab-pc.local:8123"),
+                (header::ORIGIN, "http://evil.example")
+            ])
+            .is_err()
+        );
+    }
 
     #[test]
     fn loopback_hosts_include_localhost() {

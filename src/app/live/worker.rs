@@ -58,18 +58,35 @@ struct Job {
     since: Instant,
 }
 
+/// The evaluation thread; it returns the bytes of a memory sink when it ends.
+type Worker = JoinHandle<Result<Option<Vec<u8>>, AppError>>;
+
 struct Shared {
     status: Mutex<Status>,
     changed: Condvar,
 }
 
 /// A live session: the document being edited and the thread that evaluates and streams it.
+///
+/// ```
+/// use std::time::Duration;
+/// use posecov::app::live::{Edit, EditValue, Live, LiveDocument};
+/// use posecov::sink::{RecordingIds, Sink, open_stream};
+/// let doc = LiveDocument::open("camera_on_robot").unwrap();
+/// let layout = posecov::scene::Scene::new("camera", "");
+/// let (rec, guard) = open_stream(&Sink::Memory, &RecordingIds::for_scenario("doc", 0), &layout).unwrap();
+/// let live = Live::start(doc, rec, guard, Default::default());
+/// let edit = Edit { id: "pose[0].cov.std_deg[2]".into(), value: EditValue::Number(40.0) };
+/// let generation = live.apply(&edit).unwrap();
+/// assert_eq!(live.wait_done(generation, Duration::from_secs(120)).shown, Some(generation));
+/// assert!(live.finish().unwrap().is_some_and(|bytes| !bytes.is_empty()));
+/// ```
 pub struct Live {
     doc: Mutex<LiveDocument>,
     jobs: Mutex<Option<Sender<Job>>>,
     in_flight: Mutex<Arc<AtomicBool>>,
     shared: Arc<Shared>,
-    thread: Mutex<Option<JoinHandle<Result<Option<Vec<u8>>, AppError>>>>,
+    thread: Mutex<Option<Worker>>,
     generation: Mutex<u64>,
 }
 
