@@ -6,6 +6,8 @@
 //!
 //! Needs `chromium` (Debian's, at /usr/bin/chromium), `node` and `npm ci` in tests/browser
 //! (`.ci/run` installs them). Without them the test is skipped, except under CI.
+//!
+//! The same stream check covers `--watch` on a served viewer (no browser needed).
 
 use std::io::{BufRead as _, BufReader};
 use std::net::TcpListener;
@@ -235,4 +237,71 @@ impl FromBytes for EntityDb {
                 .collect();
         db_from(&msgs)
     }
+}
+
+/// `--watch` on a served viewer: one recording, re-streamed in place when the file changes;
+/// a broken save is reported and the picture stays until the next good one.
+#[test]
+fn watch_re_streams_in_place_on_the_served_viewer() {
+    let dir = std::env::temp_dir().join(format!("posecov-watch-live-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("camera.toml");
+    let original = posecov::input::scenario::bundled::find("camera_on_robot")
+        .unwrap()
+        .text;
+    std::fs::write(&file, original).unwrap();
+    let grpc_port = free_port();
+    let child = Command::new(env!("CARGO_BIN_EXE_posecov"))
+        .arg(&file)
+        .args(["--watch", "--serve", "--web-port", "0", "--grpc-port"])
+        .arg(grpc_port.to_string())
+        .args(["--serve-seconds", "120"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut child = Running(child);
+    let mut errors = BufReader::new(child.0.stderr.take().unwrap()).lines();
+    let mut wait_for = |needle: &str| loop {
+        let line = errors.next().expect("posecov --watch is running").unwrap();
+        if line.contains(needle) {
+            break;
+        }
+    };
+    wait_for("[0] streamed");
+    let received = read_stream(&format!("rerun+http://127.0.0.1:{grpc_port}/proxy"));
+    let expected_for = |text: &str| {
+        let loaded = load_text(text, "edited.toml").unwrap();
+        let (_, scene) = pipeline(&loaded, &Overrides::default(), None).unwrap();
+        let bytes = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("fresh", 0)).unwrap();
+        cloud(&EntityDb::from_bytes_for_test(&bytes)).unwrap()
+    };
+    let broken = original.replace("[0.05, 0.05, 20.0]", "[0.05, 0.05, -1.0]");
+    std::fs::write(&file, &broken).unwrap();
+    wait_for("is negative");
+    let edited = original.replace("[0.05, 0.05, 20.0]", "[0.05, 0.05, 35.0]");
+    std::fs::write(&file, &edited).unwrap();
+    wait_for("[1] streamed");
+    let expected = expected_for(&edited);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        let msgs = received.lock().unwrap().clone();
+        let seen = (!msgs.is_empty()).then(|| cloud(&db_from(&msgs))).flatten();
+        if seen.as_ref().map(|a| a.as_ref()) == Some(expected.as_ref()) {
+            let recordings: std::collections::BTreeSet<_> = msgs
+                .iter()
+                .filter(|m| m.store_id().kind() == StoreKind::Recording)
+                .map(|m| format!("{:?}", m.store_id()))
+                .collect();
+            assert_eq!(recordings.len(), 1, "one recording");
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the stream never showed the edited cloud"
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

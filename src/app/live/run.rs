@@ -155,8 +155,10 @@ pub fn watch_in_place(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, 
         println!("Web viewer: {url}");
     }
     eprintln!("Watching {} for changes (Ctrl-C stops).", path.display());
+    let limit = serve_limit(&options.serve)?;
+    let start = std::time::Instant::now();
     let mut reported = 0;
-    while !cancel.load(Ordering::Relaxed) {
+    while !cancel.load(Ordering::Relaxed) && limit.is_none_or(|l| start.elapsed() < l) {
         std::thread::sleep(WATCH_POLL);
         let status = live.status();
         if let (Some(shown), true) = (status.shown, status.done)
