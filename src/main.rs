@@ -222,22 +222,29 @@ impl ServeArgs {
     }
 }
 
+/// The viewer sink the flags ask for (at most one is set; clap checks), or `None` for the
+/// default.
+fn viewer_sink(connect: Option<&str>, spawn: bool, serve: bool, o: &ServeOptions) -> Option<Sink> {
+    if let Some(url) = connect {
+        Some(Sink::Connect(url.to_owned()))
+    } else if spawn {
+        Some(Sink::Spawn)
+    } else if serve {
+        Some(Sink::Serve {
+            web_port: o.web_port,
+            grpc_port: o.grpc_port,
+            open_browser: o.open_browser,
+        })
+    } else {
+        None
+    }
+}
+
 impl LiveArgs {
     fn options(&self) -> LiveOptions {
         let serve = self.serve.options();
-        let sink = if let Some(url) = &self.sink.connect {
-            Some(Sink::Connect(url.clone()))
-        } else if self.sink.spawn {
-            Some(Sink::Spawn)
-        } else if self.sink.serve {
-            Some(Sink::Serve {
-                web_port: serve.web_port,
-                grpc_port: serve.grpc_port,
-                open_browser: serve.open_browser,
-            })
-        } else {
-            None
-        };
+        let s = &self.sink;
+        let sink = viewer_sink(s.connect.as_deref(), s.spawn, s.serve, &serve);
         LiveOptions {
             scenario: self.scenario.scenario().to_owned(),
             overrides: self.scenario.overrides(),
@@ -255,20 +262,10 @@ impl ViewArgs {
         let serve = self.serve.options();
         let chosen = if let Some(path) = &sink.save {
             Some(Sink::Save(path.clone()))
-        } else if let Some(url) = &sink.connect {
-            Some(Sink::Connect(url.clone()))
         } else if sink.stdout {
             Some(Sink::Stdout)
-        } else if sink.spawn {
-            Some(Sink::Spawn)
-        } else if sink.serve {
-            Some(Sink::Serve {
-                web_port: serve.web_port,
-                grpc_port: serve.grpc_port,
-                open_browser: serve.open_browser,
-            })
         } else {
-            None
+            viewer_sink(sink.connect.as_deref(), sink.spawn, sink.serve, &serve)
         };
         ViewOptions {
             scenario: self.scenario.scenario().to_owned(),

@@ -200,19 +200,28 @@ fn dragging_a_slider_in_chromium_re_streams_the_viewer() {
     assert!(expected.is_some());
 
     // The viewer's stream reaches it (it may still be arriving).
+    wait_until_stream_shows(&received, expected.as_ref().unwrap());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Waits (up to a minute) until the stream received so far shows `expected` as the camera's
+/// cloud, then checks it holds one recording.
+fn wait_until_stream_shows(
+    received: &Mutex<Vec<LogMsg>>,
+    expected: &rerun::external::arrow::array::ArrayRef,
+) {
     let deadline = Instant::now() + Duration::from_secs(60);
     loop {
         let msgs = received.lock().unwrap().clone();
         let seen = (!msgs.is_empty()).then(|| cloud(&db_from(&msgs))).flatten();
-        if seen.as_ref().map(|a| a.as_ref()) == expected.as_ref().map(|a| a.as_ref()) {
+        if seen.as_ref().map(|a| a.as_ref()) == Some(expected.as_ref()) {
             let recordings: std::collections::BTreeSet<_> = msgs
                 .iter()
                 .filter(|m| m.store_id().kind() == StoreKind::Recording)
                 .map(|m| format!("{:?}", m.store_id()))
                 .collect();
             assert_eq!(recordings.len(), 1, "one recording");
-            std::fs::remove_dir_all(&dir).ok();
-            break;
+            return;
         }
         assert!(
             Instant::now() < deadline,
@@ -283,25 +292,6 @@ fn watch_re_streams_in_place_on_the_served_viewer() {
     let edited = original.replace("[0.05, 0.05, 20.0]", "[0.05, 0.05, 35.0]");
     std::fs::write(&file, &edited).unwrap();
     wait_for("[1] streamed");
-    let expected = expected_for(&edited);
-    let deadline = Instant::now() + Duration::from_secs(60);
-    loop {
-        let msgs = received.lock().unwrap().clone();
-        let seen = (!msgs.is_empty()).then(|| cloud(&db_from(&msgs))).flatten();
-        if seen.as_ref().map(|a| a.as_ref()) == Some(expected.as_ref()) {
-            let recordings: std::collections::BTreeSet<_> = msgs
-                .iter()
-                .filter(|m| m.store_id().kind() == StoreKind::Recording)
-                .map(|m| format!("{:?}", m.store_id()))
-                .collect();
-            assert_eq!(recordings.len(), 1, "one recording");
-            break;
-        }
-        assert!(
-            Instant::now() < deadline,
-            "the stream never showed the edited cloud"
-        );
-        std::thread::sleep(Duration::from_millis(200));
-    }
+    wait_until_stream_shows(&received, &expected_for(&edited));
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -97,15 +97,7 @@ pub(super) fn slots(doc: &DocumentMut, group: GroupKind) -> Vec<Slot> {
             place: Place::Setting(key),
         });
     }
-    let methods: Vec<String> = header
-        .and_then(|h| h.get("methods"))
-        .and_then(Item::as_array)
-        .map(|a| {
-            a.iter()
-                .filter_map(|v| v.as_str().map(str::to_owned))
-                .collect()
-        })
-        .unwrap_or_default();
+    let methods = header.map(methods_of).unwrap_or_default();
     for method in Method::ALL.into_iter().filter(|m| *m != Method::Exact) {
         let slug = method.slug();
         out.push(Slot {
@@ -141,6 +133,19 @@ pub(super) fn slots(doc: &DocumentMut, group: GroupKind) -> Vec<Slot> {
     poses(doc, group, &mut out);
     operations(doc, group, &mut out);
     out
+}
+
+/// The method names in a `[scenario]` table's `methods` array, in file order.
+pub(super) fn methods_of(header: &dyn toml_edit::TableLike) -> Vec<String> {
+    header
+        .get("methods")
+        .and_then(Item::as_array)
+        .map(|a| {
+            a.iter()
+                .filter_map(|v| v.as_str().map(str::to_owned))
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 fn setting_control(key: &'static str, value: Option<f64>) -> Control {

@@ -308,15 +308,7 @@ fn set_method(doc: &mut DocumentMut, method: Method, on: bool) {
     let Some(h) = header.as_table_like_mut() else {
         return;
     };
-    let mut names: Vec<String> = h
-        .get("methods")
-        .and_then(Item::as_array)
-        .map(|a| {
-            a.iter()
-                .filter_map(|v| v.as_str().map(str::to_owned))
-                .collect()
-        })
-        .unwrap_or_default();
+    let mut names = controls::methods_of(h);
     names.retain(|n| n != slug);
     if on {
         names.push(slug.to_owned());
