@@ -87,6 +87,12 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
         viewer_url: viewer_url.clone(),
         save_to: options.save_scenario.clone(),
     };
+    if !options.bind.ip().is_loopback() {
+        eprintln!(
+            "warning: --bind {}: the control page is reachable from other machines; anyone who can reach it can change the scenario shown (not the files on disk)",
+            options.bind
+        );
+    }
     let limit = serve_limit(&options.serve)?;
     let served = serve_page(Arc::clone(&live), page, Arc::clone(cancel), limit, |url| {
         if let Some(v) = &viewer_url {
