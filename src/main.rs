@@ -15,6 +15,7 @@ use anyhow::Context as _;
 use clap::{Args, Parser, Subcommand};
 use posecov::app::Overrides;
 use posecov::app::commands;
+use posecov::app::live::{self, LiveOptions};
 use posecov::app::session::{self, EXIT_INTERRUPTED, ServeOptions, ViewOptions};
 use posecov::sink::Sink;
 
@@ -53,6 +54,42 @@ enum Command {
         #[command(flatten)]
         scenario: ScenarioArgs,
     },
+    /// Show a scenario with a control page beside the viewer: every pose, noise and setting
+    /// as a slider; each change re-evaluates and re-streams in place.
+    Live(LiveArgs),
+}
+
+/// Options of `posecov live`.
+#[derive(Debug, Args)]
+struct LiveArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    #[command(flatten)]
+    sink: LiveSinkArgs,
+    #[command(flatten)]
+    serve: ServeArgs,
+    /// Address of the control page [default: 127.0.0.1:9091; port 0: any free port]. Only
+    /// loopback unless you give another address here.
+    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:9091")]
+    bind: std::net::SocketAddr,
+    /// File that the page's "Save" writes the current scenario to (comments and layout kept).
+    #[arg(long, value_name = "FILE.toml")]
+    save_scenario: Option<PathBuf>,
+}
+
+/// The viewer live mode streams to (default: spawn a viewer, else serve the web viewer).
+#[derive(Debug, Args)]
+#[group(id = "live_sink", multiple = false)]
+struct LiveSinkArgs {
+    /// Spawn a native `rerun` 0.36 viewer and stream to it.
+    #[arg(long)]
+    spawn: bool,
+    /// Stream to a running viewer [default URL: rerun+http://127.0.0.1:9876/proxy].
+    #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = rerun::DEFAULT_CONNECT_URL)]
+    connect: Option<String>,
+    /// Serve the embedded web viewer on 127.0.0.1 and show it beside the controls.
+    #[arg(long)]
+    serve: bool,
 }
 
 /// Which scenario, evaluated how.
@@ -183,31 +220,61 @@ impl ScenarioArgs {
     }
 }
 
+impl ServeArgs {
+    fn options(&self) -> ServeOptions {
+        ServeOptions {
+            web_port: self.web_port,
+            grpc_port: self.grpc_port,
+            seconds: self.serve_seconds,
+            open_browser: self.open_browser,
+        }
+    }
+}
+
+/// The viewer sink the flags ask for (at most one is set; clap checks), or `None` for the
+/// default.
+fn viewer_sink(connect: Option<&str>, spawn: bool, serve: bool, o: &ServeOptions) -> Option<Sink> {
+    if let Some(url) = connect {
+        Some(Sink::Connect(url.to_owned()))
+    } else if spawn {
+        Some(Sink::Spawn)
+    } else if serve {
+        Some(Sink::Serve {
+            web_port: o.web_port,
+            grpc_port: o.grpc_port,
+            open_browser: o.open_browser,
+        })
+    } else {
+        None
+    }
+}
+
+impl LiveArgs {
+    fn options(&self) -> LiveOptions {
+        let serve = self.serve.options();
+        let s = &self.sink;
+        let sink = viewer_sink(s.connect.as_deref(), s.spawn, s.serve, &serve);
+        LiveOptions {
+            scenario: self.scenario.scenario().to_owned(),
+            overrides: self.scenario.overrides(),
+            sink,
+            serve,
+            bind: self.bind,
+            save_scenario: self.save_scenario.clone(),
+        }
+    }
+}
+
 impl ViewArgs {
     fn options(&self) -> ViewOptions {
         let sink = &self.sink;
-        let serve = ServeOptions {
-            web_port: self.serve.web_port,
-            grpc_port: self.serve.grpc_port,
-            seconds: self.serve.serve_seconds,
-            open_browser: self.serve.open_browser,
-        };
+        let serve = self.serve.options();
         let chosen = if let Some(path) = &sink.save {
             Some(Sink::Save(path.clone()))
-        } else if let Some(url) = &sink.connect {
-            Some(Sink::Connect(url.clone()))
         } else if sink.stdout {
             Some(Sink::Stdout)
-        } else if sink.spawn {
-            Some(Sink::Spawn)
-        } else if sink.serve {
-            Some(Sink::Serve {
-                web_port: serve.web_port,
-                grpc_port: serve.grpc_port,
-                open_browser: serve.open_browser,
-            })
         } else {
-            None
+            viewer_sink(sink.connect.as_deref(), sink.spawn, sink.serve, &serve)
         };
         ViewOptions {
             scenario: self.scenario.scenario().to_owned(),
@@ -249,6 +316,10 @@ fn try_main() -> anyhow::Result<ExitCode> {
         )?),
         Some(Command::Check { scenario }) => {
             emit(&(commands::check(scenario.scenario(), &scenario.overrides())? + "\n"))
+        }
+        Some(Command::Live(args)) => {
+            let cancel = install_ctrl_c()?;
+            Ok(ExitCode::from(live::live(&args.options(), &cancel)?))
         }
         None => {
             let cancel = install_ctrl_c()?;

@@ -1,7 +1,8 @@
 //! The application: load an input, resolve its settings once (command line over file over
 //! defaults), evaluate, draw — the pure path every command shares — and, with the `viewer`
 //! feature, one `session` that logs the scene and any later Monte Carlo blocks to a sink,
-//! used by the viewer, `--watch` and `--save` alike.
+//! used by the viewer, `--watch` and `--save` alike; and [`live`] mode, which re-evaluates and
+//! re-streams in place as controls change.
 //!
 //! ```
 //! use posecov::app::{Overrides, load, pipeline};
@@ -22,6 +23,7 @@ use crate::scene::{Scene, SceneError};
 
 pub mod bag;
 pub mod commands;
+pub mod live;
 #[cfg(feature = "viewer")]
 pub mod session;
 mod settings;
@@ -51,6 +53,9 @@ pub enum AppError {
     /// `--watch` was given something it cannot watch or a sink it cannot rewrite.
     #[error("--watch {0}")]
     Watch(String),
+    /// Live mode: an input it cannot edit, a sink it cannot stream to, the page server.
+    #[error("live: {0}")]
+    Live(String),
 }
 
 /// An input and the file it came from (to locate evaluation errors in it), of any format.

@@ -87,10 +87,26 @@ impl Session {
         cancel: Option<Arc<AtomicBool>>,
     ) -> Result<Self, AppError> {
         let loaded = load(scenario)?;
+        with_spinner(&format!("evaluating {scenario}"), || {
+            Self::from_loaded(loaded, overrides, cancel)
+        })
+    }
+
+    /// Resolves, evaluates and draws an input already loaded (live mode: no spinner).
+    ///
+    /// ```
+    /// use posecov::app::{Overrides, load, session::Session};
+    /// let loaded = load("camera_on_robot").unwrap();
+    /// let s = Session::from_loaded(loaded, &Overrides { samples: Some(64), ..Default::default() }, None).unwrap();
+    /// assert!(!s.scene.items.is_empty());
+    /// ```
+    pub fn from_loaded(
+        loaded: Loaded,
+        overrides: &Overrides,
+        cancel: Option<Arc<AtomicBool>>,
+    ) -> Result<Self, AppError> {
         let settings = resolve(&loaded.input, overrides, cancel)?;
-        let evaluation = with_spinner(&format!("evaluating {scenario}"), || {
-            super::evaluate(&loaded, &settings.eval)
-        })?;
+        let evaluation = super::evaluate(&loaded, &settings.eval)?;
         let scene = draw::scene(&evaluation, &settings.draw);
         scene.validate()?;
         Ok(Self {
@@ -115,9 +131,28 @@ impl Session {
         rec: &rerun::RecordingStream,
         cancel: &AtomicBool,
     ) -> Result<LogOutcome, AppError> {
-        let mut outcome = sink::log_scene_cancellable(rec, &self.scene, cancel)?;
+        let outcome = sink::log_scene_cancellable(rec, &self.scene, cancel)?;
+        if outcome != LogOutcome::Complete {
+            report_interrupted(outcome);
+            return Ok(outcome);
+        }
+        self.log_blocks(rec, cancel, |part| {
+            Ok(sink::log_part_cancellable(rec, &part, cancel)?)
+        })
+    }
+
+    /// Logs the clouds of the later Monte Carlo blocks (after the scene) with `log_part`,
+    /// one block at a time, each re-simulated, drawn, logged, flushed and dropped (memory
+    /// stays bounded); reports how far it got if `cancel` interrupted it.
+    pub fn log_blocks(
+        &self,
+        rec: &rerun::RecordingStream,
+        cancel: &AtomicBool,
+        mut log_part: impl FnMut(Scene) -> Result<LogOutcome, AppError>,
+    ) -> Result<LogOutcome, AppError> {
+        let mut outcome = LogOutcome::Complete;
         let later = self.later_blocks();
-        if outcome == LogOutcome::Complete && later > 0 {
+        if later > 0 {
             let bar = ProgressBar::new(later).with_message("logging Monte Carlo blocks");
             bar.set_style(
                 ProgressStyle::with_template("{msg} {pos}/{len} ({elapsed}, eta {eta})")
@@ -137,8 +172,7 @@ impl Session {
                 };
                 let part = draw::particle_part(&self.evaluation, &block, k, &self.settings.draw);
                 drop(block);
-                outcome = sink::log_part_cancellable(rec, &part, cancel)?;
-                drop(part);
+                outcome = log_part(part)?;
                 flush(rec)?;
                 bar.inc(1);
                 if outcome != LogOutcome::Complete {
@@ -152,15 +186,6 @@ impl Session {
                     bar.position() + 1,
                     later + 1
                 );
-                return Ok(outcome);
-            }
-        }
-        if let LogOutcome::Cancelled { next_step } = outcome {
-            match next_step {
-                Some(k) => {
-                    eprintln!("Interrupted: recorded the static items and steps before {k}.")
-                }
-                None => eprintln!("Interrupted: recorded part of the static items."),
             }
         }
         Ok(outcome)
@@ -169,6 +194,15 @@ impl Session {
     /// The recording id: the scenario's name (a file by its stem) and the seed in effect.
     fn ids(&self, scenario: &str) -> RecordingIds {
         RecordingIds::for_scenario(&scenario_name(scenario), self.settings.eval.seed)
+    }
+}
+
+fn report_interrupted(outcome: LogOutcome) {
+    if let LogOutcome::Cancelled { next_step } = outcome {
+        match next_step {
+            Some(k) => eprintln!("Interrupted: recorded the static items and steps before {k}."),
+            None => eprintln!("Interrupted: recorded part of the static items."),
+        }
     }
 }
 
@@ -201,7 +235,7 @@ fn with_spinner<T>(message: &str, work: impl FnOnce() -> T) -> T {
 }
 
 /// Name used in the recording id: a bundled name as is, a file by its stem.
-fn scenario_name(scenario: &str) -> String {
+pub(crate) fn scenario_name(scenario: &str) -> String {
     Path::new(scenario)
         .file_stem()
         .map_or_else(|| scenario.to_owned(), |s| s.to_string_lossy().into_owned())
@@ -251,9 +285,10 @@ pub(crate) fn serve(
     Ok(())
 }
 
-/// `--watch`: evaluate, stream, and again whenever the file changes. Each generation is a new
-/// recording (id suffix `/gen-N`) sent to the same viewer, so nothing stale survives an edit;
-/// errors in the file are printed and the previous picture stays up.
+/// `--watch`: evaluate, stream, and again whenever the file changes. A viewer gets one
+/// recording re-streamed in place ([`super::live::watch_in_place`]); a `--save` file is
+/// rewritten whole on every change. Errors in the file are printed and the previous picture
+/// stays up.
 fn watch(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, AppError> {
     let path = PathBuf::from(&options.scenario);
     if !path.is_file() {
@@ -266,6 +301,10 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, AppError> {
             "streams to a viewer or rewrites a --save file; it does not combine with --stdout or --png"
                 .to_owned(),
         ));
+    }
+    if !matches!(options.sink, Some(Sink::Save(_))) {
+        // A viewer: one recording, re-streamed in place (see `sink::restream`).
+        return super::live::watch_in_place(options, cancel);
     }
     let first_sink = choose_sink(options)?;
     // Later generations connect to the viewer the first one reached.
@@ -364,7 +403,7 @@ pub(crate) fn choose_sink(options: &ViewOptions) -> Result<Sink, AppError> {
     })
 }
 
-fn serve_limit(options: &ServeOptions) -> Result<Option<Duration>, AppError> {
+pub(crate) fn serve_limit(options: &ServeOptions) -> Result<Option<Duration>, AppError> {
     if let Some(s) = options.seconds {
         return Ok(Some(Duration::from_secs(s)));
     }

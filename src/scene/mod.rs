@@ -92,8 +92,8 @@ impl Color {
     }
 }
 
-/// When an item is shown.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// When an item is shown. Ordered: static first, then steps, then stamps, each by value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Timing {
     /// Always, on every timeline (fixed context: frames, descriptions, nominal paths).
     Static,

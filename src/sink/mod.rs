@@ -5,6 +5,8 @@
 //!   ([`send_layout`]).
 //! - [`stream`]: opening a [`Sink`] (viewer, file, stdout, web viewer, memory) with
 //!   deterministic content, and finishing it cleanly ([`SinkGuard::finish`]).
+//! - [`restream`]: logging a new scene in place of the last one in the same recording (live
+//!   mode, `--watch`), leaving nothing stale.
 //! - [`viewer`]: finding a native `rerun` 0.36 viewer and rendering PNGs with it.
 //!
 //! # Deterministic content
@@ -28,6 +30,7 @@
 
 pub mod blueprint;
 pub mod rerun;
+pub mod restream;
 pub mod stream;
 pub mod viewer;
 
@@ -37,6 +40,7 @@ pub use self::blueprint::send_layout;
 pub use self::rerun::{
     LogOutcome, STEP_TIMELINE, log_part_cancellable, log_scene, log_scene_cancellable,
 };
+pub use self::restream::Restream;
 pub use self::stream::{SinkGuard, open_stream, scene_to_rrd_bytes};
 pub use self::viewer::{NativeViewer, find_native_viewer, render_png};
 

@@ -133,7 +133,7 @@ fn log_items(
 }
 
 /// Sends one row with all `parts` as one chunk: no log time, no batcher, fixed order.
-fn send(
+pub(super) fn send(
     rec: &rr::RecordingStream,
     path: impl Into<rr::EntityPath>,
     timing: Timing,

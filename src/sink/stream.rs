@@ -34,7 +34,7 @@ enum GuardKind {
         done: bool,
     },
     Serve {
-        _web: Box<dyn Any>,
+        _web: Box<dyn Any + Send>,
         url: String,
     },
     Memory(rr::sink::MemorySinkStorage),

@@ -324,6 +324,19 @@ pub enum View {
     Perspective,
 }
 
+impl DrawSpec {
+    /// The on/off switches of `[draw]`, as the file spells them (live mode offers each).
+    pub const SWITCHES: [&'static str; 7] = [
+        "axes",
+        "clouds",
+        "sample_axes",
+        "ellipsoids",
+        "bananas",
+        "orientation",
+        "trajectories",
+    ];
+}
+
 impl Default for DrawSpec {
     /// Every switch on, no axis length, no view: the values of an empty `[draw]` table.
     fn default() -> Self {

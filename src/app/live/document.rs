@@ -1,0 +1,353 @@
+//! The scenario being edited live: the file's text, the current document (a `toml_edit`
+//! document, so comments and layout survive every edit), and the input lowered from it.
+//!
+//! Every edit is applied to a copy of the document, printed, and loaded by the same path as a
+//! file ([`load_text`]); only when that succeeds does the copy become
+//! current. A bad value is refused with the file's field and message, and nothing changes.
+
+use std::path::Path;
+
+use toml_edit::{Array, DocumentMut, Item, Value};
+
+use super::controls::{self, Control, ControlKind, Place, Seg, Slot};
+use crate::app::{AppError, Loaded, load_text};
+use crate::input::scenario::bundled;
+use crate::uncertain::Method;
+
+/// A change asked for by the page (or a test): a control's id and its new value.
+#[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+pub struct Edit {
+    /// The control's id, e.g. `pose[0].cov.std_deg[2]`.
+    pub id: String,
+    /// The new value.
+    pub value: EditValue,
+}
+
+/// A number or a switch.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(untagged)]
+pub enum EditValue {
+    /// For a number control.
+    Number(f64),
+    /// For a toggle.
+    Toggle(bool),
+}
+
+/// Why an edit was refused. The document is unchanged.
+#[derive(Debug, thiserror::Error)]
+pub enum EditError {
+    /// No control has this id.
+    #[error("{id}: no such control (the page offers only the scenario's values)")]
+    Unknown {
+        /// The id asked for.
+        id: String,
+    },
+    /// A number for a switch, or the reverse; a fraction or out-of-range integer where the
+    /// file needs a whole number.
+    #[error("{id}: {message}")]
+    Value {
+        /// The control.
+        id: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The edited file does not load: the lowering's message, with its field.
+    #[error(transparent)]
+    Invalid(#[from] AppError),
+}
+
+impl EditError {
+    /// The field the error is about (the control id, or the file's key named by the
+    /// lowering, e.g. `pose[0].cov`), when known.
+    pub fn field(&self) -> Option<String> {
+        match self {
+            EditError::Unknown { id } | EditError::Value { id, .. } => Some(id.clone()),
+            EditError::Invalid(AppError::Input(crate::input::scenario::ScenarioError::At {
+                field,
+                ..
+            })) => Some(field.clone()),
+            EditError::Invalid(_) => None,
+        }
+    }
+}
+
+/// A scenario file open for live editing.
+pub struct LiveDocument {
+    origin: String,
+    source: String,
+    doc: DocumentMut,
+    loaded: Loaded,
+}
+
+impl LiveDocument {
+    /// Parses and loads scenario `text` (`origin` names it in messages).
+    ///
+    /// # Errors
+    /// The file's error, as `posecov check` reports it.
+    ///
+    /// ```
+    /// use posecov::app::live::LiveDocument;
+    /// let text = posecov::input::scenario::bundled::find("camera_on_robot").unwrap().text;
+    /// let live = LiveDocument::new(text, "camera_on_robot.toml").unwrap();
+    /// assert!(live.controls().iter().any(|c| c.id == "pose[0].cov.std_deg[2]"));
+    /// ```
+    pub fn new(text: &str, origin: &str) -> Result<Self, AppError> {
+        let loaded = load_text(text, origin)?;
+        let doc = parse(text, origin)?;
+        Ok(Self {
+            origin: origin.to_owned(),
+            source: text.to_owned(),
+            doc,
+            loaded,
+        })
+    }
+
+    /// Opens a bundled scenario by name or a scenario file (`.toml`); other inputs are
+    /// refused with a message saying live mode edits scenario files only.
+    ///
+    /// # Errors
+    /// [`AppError::Live`] for an input that is not a scenario file; the file's error.
+    pub fn open(name_or_path: &str) -> Result<Self, AppError> {
+        let path = Path::new(name_or_path);
+        if path.exists() {
+            if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+                return Err(AppError::Live(format!(
+                    "{name_or_path}: live mode edits scenario files (.toml) only; \
+                     show other inputs with `posecov {name_or_path}`"
+                )));
+            }
+            let text = std::fs::read_to_string(path).map_err(|e| {
+                crate::input::scenario::ScenarioError::Read {
+                    path: name_or_path.to_owned(),
+                    reason: e.to_string(),
+                }
+            })?;
+            return Self::new(&text, name_or_path);
+        }
+        match bundled::find(name_or_path) {
+            Some(b) => Self::new(b.text, &format!("{}.toml (bundled)", b.name)),
+            // The loader's message lists the bundled names.
+            None => Err(crate::app::load(name_or_path)
+                .err()
+                .unwrap_or_else(|| AppError::Live(format!("{name_or_path}: not a scenario")))),
+        }
+    }
+
+    /// The controls for the current document.
+    pub fn controls(&self) -> Vec<Control> {
+        self.slots().into_iter().map(|s| s.control).collect()
+    }
+
+    fn slots(&self) -> Vec<Slot> {
+        use crate::lie::GroupKind;
+        use crate::plan::AnyPlan;
+        let group = match &self.loaded.input.plan {
+            AnyPlan::So2(_) => GroupKind::So2,
+            AnyPlan::Se2(_) => GroupKind::Se2,
+            AnyPlan::So3(_) => GroupKind::So3,
+            AnyPlan::Se3(_) => GroupKind::Se3,
+        };
+        controls::slots(&self.doc, group)
+    }
+
+    /// The current input (always valid).
+    pub fn loaded(&self) -> &Loaded {
+        &self.loaded
+    }
+
+    /// The current text: the file with every edit applied, its comments and layout kept.
+    pub fn text(&self) -> String {
+        self.doc.to_string()
+    }
+
+    /// The name used in messages (the file, or `name.toml (bundled)`).
+    pub fn origin(&self) -> &str {
+        &self.origin
+    }
+
+    /// Applies `edit` if the edited file loads; else returns why and changes nothing.
+    ///
+    /// # Errors
+    /// [`EditError`], naming the control or the file's field.
+    ///
+    /// ```
+    /// use posecov::app::live::{Edit, EditValue, LiveDocument};
+    /// let mut live = LiveDocument::open("camera_on_robot").unwrap();
+    /// let bad = Edit { id: "pose[0].cov.std_deg[2]".into(), value: EditValue::Number(-1.0) };
+    /// let e = live.apply(&bad).unwrap_err();
+    /// assert_eq!(e.field().as_deref(), Some("pose[0].cov"), "{e}");
+    /// let good = Edit { id: "pose[0].cov.std_deg[2]".into(), value: EditValue::Number(40.0) };
+    /// live.apply(&good).unwrap();
+    /// assert!(live.text().contains("std_deg = [0.05, 0.05, 40.0] }   # x, y in metres"));
+    /// ```
+    pub fn apply(&mut self, edit: &Edit) -> Result<(), EditError> {
+        let slot = self
+            .slots()
+            .into_iter()
+            .find(|s| s.control.id == edit.id)
+            .ok_or_else(|| EditError::Unknown {
+                id: edit.id.clone(),
+            })?;
+        let mut doc = self.doc.clone();
+        write(&mut doc, &slot, edit.value)?;
+        let text = doc.to_string();
+        let loaded = load_text(&text, &self.origin)?;
+        self.doc = doc;
+        self.loaded = loaded;
+        Ok(())
+    }
+
+    /// Returns to the file's values.
+    pub fn reset(&mut self) -> Result<(), AppError> {
+        let text = self.source.clone();
+        self.replace_source(&text)
+    }
+
+    /// Replaces the file's text (the file changed on disk, `--watch`): the new text becomes
+    /// both the current document and what [`reset`](Self::reset) returns to.
+    ///
+    /// # Errors
+    /// The new text's error; nothing changes then.
+    pub fn replace_source(&mut self, text: &str) -> Result<(), AppError> {
+        let next = Self::new(text, &self.origin)?;
+        *self = next;
+        Ok(())
+    }
+}
+
+fn parse(text: &str, origin: &str) -> Result<DocumentMut, AppError> {
+    // The text already loaded, so this only fails on a bug; report it like a file error.
+    text.parse::<DocumentMut>()
+        .map_err(|e| AppError::Live(format!("{origin}: {e}")))
+}
+
+/// Writes `value` into `doc` where `slot` lives, keeping the old value's decoration
+/// (spacing and trailing comment).
+fn write(doc: &mut DocumentMut, slot: &Slot, value: EditValue) -> Result<(), EditError> {
+    let id = &slot.control.id;
+    let wrong = |message: &str| EditError::Value {
+        id: id.clone(),
+        message: message.to_owned(),
+    };
+    match (&slot.control.kind, value) {
+        (ControlKind::Number { integer, .. }, EditValue::Number(x)) => {
+            let new = if *integer {
+                if x.fract() != 0.0 || !x.is_finite() || x < 0.0 || x > i64::MAX as f64 {
+                    return Err(wrong(&format!("{x} is not a whole number ≥ 0")));
+                }
+                Value::from(x as i64)
+            } else {
+                // TOML has nan and inf; the lowering refuses them with the field named.
+                Value::from(x)
+            };
+            match &slot.place {
+                Place::Leaf(path) => {
+                    let old =
+                        leaf_mut(doc, path).ok_or_else(|| wrong("is no longer in the file"))?;
+                    if controls::number(old) == Some(x) {
+                        // Unchanged: keep the file's spelling (`0.062110`, `1e-3`).
+                        return Ok(());
+                    }
+                    // A whole number written as an integer stays one (TOML floats accept it).
+                    let new = if old.is_integer() && x.fract() == 0.0 && x.abs() < 1e15 {
+                        Value::from(x as i64)
+                    } else {
+                        new
+                    };
+                    replace(old, new);
+                }
+                Place::Setting(key) => set_key(doc, "scenario", key, new),
+                _ => return Err(wrong("is a switch; send true or false")),
+            }
+        }
+        (ControlKind::Toggle { .. }, EditValue::Toggle(on)) => match &slot.place {
+            Place::Switch(key) => set_key(doc, "draw", key, Value::from(on)),
+            Place::Method(method) => set_method(doc, *method, on),
+            _ => return Err(wrong("is a number")),
+        },
+        (ControlKind::Number { .. }, EditValue::Toggle(_)) => {
+            return Err(wrong("is a number; send a number"));
+        }
+        (ControlKind::Toggle { .. }, EditValue::Number(_)) => {
+            return Err(wrong("is a switch; send true or false"));
+        }
+    }
+    Ok(())
+}
+
+/// Replaces `old` by `new`, keeping `old`'s spacing and comment.
+fn replace(old: &mut Value, mut new: Value) {
+    *new.decor_mut() = old.decor().clone();
+    *old = new;
+}
+
+/// Sets `[table] key = value`, creating the table or key when the file has none.
+fn set_key(doc: &mut DocumentMut, table: &str, key: &str, value: Value) {
+    let item = doc
+        .as_table_mut()
+        .entry(table)
+        .or_insert_with(|| Item::Table(toml_edit::Table::new()));
+    let Some(t) = item.as_table_like_mut() else {
+        return;
+    };
+    match t.get_mut(key).and_then(Item::as_value_mut) {
+        Some(old) => replace(old, value),
+        None => {
+            t.insert(key, Item::Value(value));
+        }
+    }
+}
+
+/// Adds `method` to `[scenario] methods` or removes it, keeping the others' order.
+fn set_method(doc: &mut DocumentMut, method: Method, on: bool) {
+    let slug = method.slug();
+    let header = doc
+        .as_table_mut()
+        .entry("scenario")
+        .or_insert_with(|| Item::Table(toml_edit::Table::new()));
+    let Some(h) = header.as_table_like_mut() else {
+        return;
+    };
+    let mut names = controls::methods_of(h);
+    names.retain(|n| n != slug);
+    if on {
+        names.push(slug.to_owned());
+    }
+    let array: Array = names.iter().map(String::as_str).collect();
+    match h.get_mut("methods").and_then(Item::as_value_mut) {
+        Some(old) => replace(old, Value::Array(array)),
+        None => {
+            h.insert("methods", Item::Value(Value::Array(array)));
+        }
+    }
+}
+
+/// The number at `path` (keys and indices from the root).
+fn leaf_mut<'a>(doc: &'a mut DocumentMut, path: &[Seg]) -> Option<&'a mut Value> {
+    let (Seg::Key(first), rest) = path.split_first()? else {
+        return None;
+    };
+    let value = item_leaf(doc.as_table_mut().get_mut(first)?, rest)?;
+    controls::number(value).is_some().then_some(value)
+}
+
+/// Tables and arrays of tables first, then values.
+fn item_leaf<'a>(item: &'a mut Item, rest: &[Seg]) -> Option<&'a mut Value> {
+    match (item, rest) {
+        (Item::ArrayOfTables(a), [Seg::Index(i), Seg::Key(k), tail @ ..]) => {
+            item_leaf(a.get_mut(*i)?.get_mut(k)?, tail)
+        }
+        (Item::Table(t), [Seg::Key(k), tail @ ..]) => item_leaf(t.get_mut(k)?, tail),
+        (Item::Value(v), tail) => value_leaf(v, tail),
+        _ => None,
+    }
+}
+
+fn value_leaf<'a>(value: &'a mut Value, rest: &[Seg]) -> Option<&'a mut Value> {
+    match (value, rest) {
+        (v, []) => Some(v),
+        (Value::InlineTable(t), [Seg::Key(k), tail @ ..]) => value_leaf(t.get_mut(k)?, tail),
+        (Value::Array(a), [Seg::Index(i), tail @ ..]) => value_leaf(a.get_mut(*i)?, tail),
+        _ => None,
+    }
+}

@@ -1,0 +1,430 @@
+//! The control page and its JSON API, served on loopback unless `--bind` says otherwise.
+//!
+//! | request | answer |
+//! |---|---|
+//! | `GET /` | the page (controls; beside them the web viewer when one is served) |
+//! | `GET /api/state` | title, controls, status, viewer URL, whether saving to disk is possible |
+//! | `GET /api/status` | the evaluation status (generation shown, progress, timings, error) |
+//! | `POST /api/edit` `{"id", "value"}` | 200 with the new state, or 422 `{"error", "field"}` |
+//! | `POST /api/reset` | back to the file's values |
+//! | `POST /api/save` | writes the current scenario to the `--save-scenario` file |
+//! | `GET /api/scenario.toml` | the current scenario as a download |
+//!
+//! Every request must name this server in `Host` (and in `Origin` when a browser sends one),
+//! so a page elsewhere cannot drive it (nor a DNS-rebinding name); `POST`s must carry JSON,
+//! which a cross-site form cannot send. The page never names a path: saving goes to the
+//! file given on the command line.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use axum::Router;
+use axum::body::{Body, Bytes};
+use axum::extract::State;
+use axum::http::{HeaderMap, HeaderValue, Method, StatusCode, Uri, header};
+use axum::response::Response;
+use serde_json::{Value as Json, json};
+
+use super::document::{Edit, EditError};
+use super::worker::Live;
+use crate::app::AppError;
+
+const PAGE: &str = include_str!("../../../assets/live/index.html");
+const SCRIPT: &str = include_str!("../../../assets/live/live.js");
+const STYLE: &str = include_str!("../../../assets/live/live.css");
+
+/// Largest request body accepted (an edit is a few dozen bytes).
+const MAX_BODY: usize = 64 * 1024;
+
+/// How the page is served.
+#[derive(Clone, Debug)]
+pub struct PageOptions {
+    /// Address to listen on (port 0: any free port).
+    pub bind: SocketAddr,
+    /// The web viewer to show beside the controls, if one is served.
+    pub viewer_url: Option<String>,
+    /// Where "save" writes (`--save-scenario`); `None`: download only.
+    pub save_to: Option<PathBuf>,
+}
+
+struct App {
+    live: Arc<Live>,
+    options: PageOptions,
+    /// `host:port` values that name this server.
+    hosts: Vec<String>,
+}
+
+/// Serves the page until `cancel` is raised or `limit` has passed; calls `ready` with the
+/// page's URL once listening.
+///
+/// # Errors
+/// [`AppError::Live`] when the address cannot be bound.
+///
+/// ```no_run
+/// # use std::sync::{Arc, atomic::AtomicBool};
+/// # use posecov::app::live::{Live, LiveDocument, PageOptions, serve_page};
+/// # use posecov::sink::{RecordingIds, Sink, open_stream};
+/// let doc = LiveDocument::open("camera_on_robot").unwrap();
+/// let layout = posecov::scene::Scene::new("camera", "");
+/// let (rec, guard) = open_stream(&Sink::Spawn, &RecordingIds::for_scenario("camera", 7), &layout).unwrap();
+/// let live = Live::start(doc, rec, guard, Default::default());
+/// let page = PageOptions { bind: "127.0.0.1:9091".parse().unwrap(), viewer_url: None, save_to: None };
+/// serve_page(live, page, Arc::new(AtomicBool::new(false)), None, |url| println!("Controls: {url}")).unwrap();
+/// ```
+pub fn serve_page(
+    live: Arc<Live>,
+    options: PageOptions,
+    cancel: Arc<AtomicBool>,
+    limit: Option<Duration>,
+    ready: impl FnOnce(&str),
+) -> Result<(), AppError> {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .map_err(|e| AppError::Live(format!("starting the page server: {e}")))?;
+    let listener = std::net::TcpListener::bind(options.bind)
+        .map_err(|e| AppError::Live(format!("--bind {}: {e}", options.bind)))?;
+    listener
+        .set_nonblocking(true)
+        .map_err(|e| AppError::Live(e.to_string()))?;
+    let addr = listener
+        .local_addr()
+        .map_err(|e| AppError::Live(e.to_string()))?;
+    let hosts = hosts_of(addr);
+    let url = format!("http://{}/", hosts[0]);
+    let app = Arc::new(App {
+        live,
+        options,
+        hosts,
+    });
+    let router = Router::new().fallback(handle).with_state(app);
+    ready(&url);
+    let start = Instant::now();
+    runtime.block_on(async move {
+        let listener = tokio::net::TcpListener::from_std(listener)
+            .map_err(|e| AppError::Live(e.to_string()))?;
+        axum::serve(listener, router)
+            .with_graceful_shutdown(async move {
+                while !cancel.load(Ordering::Relaxed) && limit.is_none_or(|l| start.elapsed() < l) {
+                    tokio::time::sleep(Duration::from_millis(50)).await;
+                }
+            })
+            .await
+            .map_err(|e| AppError::Live(format!("serving the page: {e}")))
+    })
+}
+
+/// The `Host` values that name a server listening on `addr`: the address itself, and for
+/// loopback `localhost` too.
+fn hosts_of(addr: SocketAddr) -> Vec<String> {
+    let port = addr.port();
+    let mut hosts = vec![match addr {
+        SocketAddr::V4(a) if a.ip().is_unspecified() => format!("127.0.0.1:{port}"),
+        SocketAddr::V6(a) if a.ip().is_unspecified() => format!("[::1]:{port}"),
+        a => a.to_string(),
+    }];
+    if addr.ip().is_loopback() || addr.ip().is_unspecified() {
+        hosts.push(format!("localhost:{port}"));
+        hosts.push(format!("127.0.0.1:{port}"));
+        hosts.push(format!("[::1]:{port}"));
+    }
+    hosts.dedup();
+    hosts
+}
+
+/// Whether the request comes from this server's own page (see the module docs). `hosts`:
+/// the `host:port` values naming this server; `open`: bound to every interface (`--bind
+/// 0.0.0.0:…`), where any host name with this port is accepted.
+fn allowed(
+    hosts: &[String],
+    open: bool,
+    method: &Method,
+    headers: &HeaderMap,
+) -> Result<(), &'static str> {
+    let host = headers
+        .get(header::HOST)
+        .and_then(|h| h.to_str().ok())
+        .ok_or("a Host header is required")?;
+    let port = hosts[0].rsplit_once(':').map_or("", |x| x.1);
+    let own = hosts.iter().any(|o| o.eq_ignore_ascii_case(host))
+        || open && host.rsplit_once(':').is_some_and(|(_, p)| p == port);
+    if !own {
+        return Err("Host is not this server");
+    }
+    if let Some(origin) = headers.get(header::ORIGIN) {
+        let origin = origin.to_str().map_err(|_| "bad Origin")?;
+        let Some(rest) = origin.strip_prefix("http://") else {
+            return Err("Origin is not this server");
+        };
+        if !rest.eq_ignore_ascii_case(host) {
+            return Err("Origin is not this server");
+        }
+    }
+    if method == Method::POST {
+        let json = headers
+            .get(header::CONTENT_TYPE)
+            .and_then(|v| v.to_str().ok())
+            .is_some_and(|v| v.starts_with("application/json"));
+        if !json {
+            return Err("POST bodies must be application/json");
+        }
+    }
+    Ok(())
+}
+
+async fn handle(
+    State(app): State<Arc<App>>,
+    method: Method,
+    uri: Uri,
+    headers: HeaderMap,
+    body: Bytes,
+) -> Response {
+    let open = app.options.bind.ip().is_unspecified();
+    if let Err(why) = allowed(&app.hosts, open, &method, &headers) {
+        return reply(StatusCode::FORBIDDEN, &json!({ "error": why }));
+    }
+    if body.len() > MAX_BODY {
+        return reply(
+            StatusCode::PAYLOAD_TOO_LARGE,
+            &json!({ "error": "body too large" }),
+        );
+    }
+    let app2 = Arc::clone(&app);
+    let path = uri.path().to_owned();
+    // The document and the evaluation thread use blocking locks: keep them off the runtime.
+    tokio::task::spawn_blocking(move || route(&app2, &method, &path, &body))
+        .await
+        .unwrap_or_else(|_| {
+            reply(
+                StatusCode::INTERNAL_SERVER_ERROR,
+                &json!({ "error": "panic" }),
+            )
+        })
+}
+
+fn route(app: &App, method: &Method, path: &str, body: &[u8]) -> Response {
+    match (method.as_str(), path) {
+        ("GET", "/") => asset(PAGE, "text/html; charset=utf-8"),
+        ("GET", "/live.js") => asset(SCRIPT, "text/javascript; charset=utf-8"),
+        ("GET", "/live.css") => asset(STYLE, "text/css; charset=utf-8"),
+        ("GET", "/api/state") => reply(StatusCode::OK, &state(app)),
+        ("GET", "/api/status") => reply(StatusCode::OK, &json!(app.live.status())),
+        ("GET", "/api/scenario.toml") => download(app),
+        ("POST", "/api/edit") => match serde_json::from_slice::<Edit>(body) {
+            Err(e) => reply(
+                StatusCode::BAD_REQUEST,
+                &json!({ "error": format!("expected {{\"id\": …, \"value\": number or true/false}}: {e}") }),
+            ),
+            Ok(edit) => match app.live.apply(&edit) {
+                Ok(_) => reply(StatusCode::OK, &state(app)),
+                Err(e) => refused(&e),
+            },
+        },
+        ("POST", "/api/reset") => match app.live.reset() {
+            Ok(_) => reply(StatusCode::OK, &state(app)),
+            Err(e) => reply(
+                StatusCode::INTERNAL_SERVER_ERROR,
+                &json!({ "error": e.to_string() }),
+            ),
+        },
+        ("POST", "/api/save") => save(app),
+        (
+            _,
+            "/" | "/live.js" | "/live.css" | "/api/state" | "/api/status" | "/api/scenario.toml",
+        )
+        | (_, "/api/edit" | "/api/reset" | "/api/save") => reply(
+            StatusCode::METHOD_NOT_ALLOWED,
+            &json!({ "error": "method not allowed" }),
+        ),
+        _ => reply(StatusCode::NOT_FOUND, &json!({ "error": "not found" })),
+    }
+}
+
+fn state(app: &App) -> Json {
+    let (title, origin, controls) = app.live.with_doc(|d| {
+        (
+            d.loaded().input.about.title.clone(),
+            d.origin().to_owned(),
+            d.controls(),
+        )
+    });
+    json!({
+        "title": title,
+        "origin": origin,
+        "controls": controls,
+        "status": app.live.status(),
+        "viewer_url": app.options.viewer_url,
+        "save_to": app.options.save_to.as_ref().map(|p| p.display().to_string()),
+    })
+}
+
+fn refused(e: &EditError) -> Response {
+    reply(
+        StatusCode::UNPROCESSABLE_ENTITY,
+        &json!({ "error": e.to_string(), "field": e.field() }),
+    )
+}
+
+fn save(app: &App) -> Response {
+    let Some(path) = &app.options.save_to else {
+        return reply(
+            StatusCode::CONFLICT,
+            &json!({ "error": "no file to save to: start with --save-scenario FILE, or use Download" }),
+        );
+    };
+    let text = app.live.with_doc(|d| d.text());
+    match write_atomically(path, &text) {
+        Ok(()) => reply(
+            StatusCode::OK,
+            &json!({ "saved": path.display().to_string() }),
+        ),
+        Err(e) => reply(
+            StatusCode::INTERNAL_SERVER_ERROR,
+            &json!({ "error": format!("writing {}: {e}", path.display()) }),
+        ),
+    }
+}
+
+/// Writes `text` to a temporary sibling and renames it over `path`: never half a file.
+pub(super) fn write_atomically(path: &std::path::Path, text: &str) -> std::io::Result<()> {
+    let name = path.file_name().map_or_else(
+        || "scenario.toml".into(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let tmp = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path).inspect_err(|_| {
+        std::fs::remove_file(&tmp).ok();
+    })
+}
+
+fn download(app: &App) -> Response {
+    let (text, origin) = app.live.with_doc(|d| (d.text(), d.origin().to_owned()));
+    let stem: String = std::path::Path::new(origin.split(' ').next().unwrap_or("scenario"))
+        .file_stem()
+        .map_or_else(|| "scenario".into(), |s| s.to_string_lossy().into_owned())
+        .chars()
+        .filter(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+        .collect();
+    let mut response = asset_owned(text, "application/toml; charset=utf-8");
+    if let Ok(v) = HeaderValue::from_str(&format!("attachment; filename=\"{stem}_live.toml\"")) {
+        response
+            .headers_mut()
+            .insert(header::CONTENT_DISPOSITION, v);
+    }
+    response
+}
+
+fn asset(text: &'static str, content_type: &'static str) -> Response {
+    let mut r = Response::new(Body::from(text));
+    r.headers_mut()
+        .insert(header::CONTENT_TYPE, HeaderValue::from_static(content_type));
+    r.headers_mut()
+        .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    r
+}
+
+fn asset_owned(text: String, content_type: &'static str) -> Response {
+    let mut r = Response::new(Body::from(text));
+    r.headers_mut()
+        .insert(header::CONTENT_TYPE, HeaderValue::from_static(content_type));
+    r
+}
+
+fn reply(status: StatusCode, body: &Json) -> Response {
+    let mut r = Response::new(Body::from(body.to_string()));
+    *r.status_mut() = status;
+    r.headers_mut().insert(
+        header::CONTENT_TYPE,
+        HeaderValue::from_static("application/json"),
+    );
+    r.headers_mut()
+        .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn headers(pairs: &[(header::HeaderName, &str)]) -> HeaderMap {
+        let mut h = HeaderMap::new();
+        for (k, v) in pairs {
+            h.insert(k.clone(), HeaderValue::from_str(v).unwrap());
+        }
+        h
+    }
+
+    #[test]
+    fn only_this_servers_own_page_may_drive_it() {
+        let hosts = hosts_of("127.0.0.1:8123".parse().unwrap());
+        let json = (header::CONTENT_TYPE, "application/json");
+        let get = |pairs: &[(header::HeaderName, &str)]| {
+            allowed(&hosts, false, &Method::GET, &headers(pairs))
+        };
+        let post = |pairs: &[(header::HeaderName, &str)]| {
+            allowed(&hosts, false, &Method::POST, &headers(pairs))
+        };
+        assert!(get(&[(header::HOST, "127.0.0.1:8123")]).is_ok());
+        assert!(get(&[(header::HOST, "localhost:8123")]).is_ok());
+        assert!(get(&[]).is_err(), "no Host");
+        // DNS rebinding: a foreign name that resolves to 127.0.0.1.
+        assert!(get(&[(header::HOST, "evil.example:8123")]).is_err());
+        assert!(
+            post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::ORIGIN, "http://127.0.0.1:8123"),
+                json.clone()
+            ])
+            .is_ok()
+        );
+        // Another page in the browser.
+        assert!(
+            post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::ORIGIN, "http://evil.example"),
+                json.clone()
+            ])
+            .is_err()
+        );
+        assert!(
+            post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::ORIGIN, "null"),
+                json.clone()
+            ])
+            .is_err()
+        );
+        // A cross-site form cannot send JSON.
+        assert!(
+            post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::CONTENT_TYPE, "text/plain")
+            ])
+            .is_err()
+        );
+        // Opened to the network on purpose: any name with this port, still same-origin only.
+        let open = |pairs: &[(header::HeaderName, &str)]| {
+            allowed(&hosts, true, &Method::GET, &headers(pairs))
+        };
+        assert!(open(&[(header::HOST, "lab-pc.local:8123")]).is_ok());
+        assert!(
+            open(&[
+                (header::HOST, "lab-pc.local:8123"),
+                (header::ORIGIN, "http://evil.example")
+            ])
+            .is_err()
+        );
+    }
+
+    #[test]
+    fn loopback_hosts_include_localhost() {
+        let hosts = hosts_of("127.0.0.1:8123".parse().unwrap());
+        assert!(hosts.contains(&"127.0.0.1:8123".to_owned()));
+        assert!(hosts.contains(&"localhost:8123".to_owned()));
+        assert!(!hosts.iter().any(|h| h.starts_with("evil")));
+    }
+}

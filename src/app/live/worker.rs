@@ -1,0 +1,333 @@
+//! The evaluation thread of live mode: it owns the recording stream, takes the newest
+//! change, shows a quick preview (fewer samples from the same random streams), then the
+//! full picture, each re-streamed in place ([`Restream`]). A newer change cancels the
+//! evaluation in flight through the evaluation's own cancel flag.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Condvar, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+
+use super::document::{Edit, EditError, LiveDocument};
+use crate::app::session::Session;
+use crate::app::{AppError, Loaded, Overrides, resolve};
+use crate::sample::CHUNK_SIZE;
+use crate::sink::{LogOutcome, Restream, SinkError, SinkGuard};
+use crate::uncertain::Method;
+
+/// Samples of the quick preview shown before a larger full sample: one random chunk, so
+/// the preview's draws are the first draws of the full run.
+pub const PREVIEW_SAMPLES: u64 = CHUNK_SIZE as u64;
+
+/// How long a remote viewer may take to receive a generation before we move on.
+const FLUSH_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// What the page shows about the evaluation.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Status {
+    /// The newest accepted change (0: the file as loaded).
+    pub generation: u64,
+    /// The generation whose picture was sent last (`None` before the first).
+    pub shown: Option<u64>,
+    /// Monte Carlo samples of the picture sent last (0 without Monte Carlo).
+    pub shown_samples: u64,
+    /// Whether the picture sent last is final for its generation (not a preview).
+    pub done: bool,
+    /// What the thread is doing: `idle`, `preview`, `full`.
+    pub phase: &'static str,
+    /// Samples being evaluated now.
+    pub samples: u64,
+    /// Milliseconds from the change to its first picture sent.
+    pub first_picture_ms: Option<f64>,
+    /// Milliseconds from the change to its final picture sent.
+    pub final_picture_ms: Option<f64>,
+    /// Entity items in the picture sent last.
+    pub items: usize,
+    /// Why the newest generation could not be drawn (the last good picture stays).
+    pub error: Option<String>,
+}
+
+/// One evaluation to run.
+struct Job {
+    generation: u64,
+    loaded: Loaded,
+    cancel: Arc<AtomicBool>,
+    since: Instant,
+}
+
+/// The evaluation thread; it returns the bytes of a memory sink when it ends.
+type Worker = JoinHandle<Result<Option<Vec<u8>>, AppError>>;
+
+struct Shared {
+    status: Mutex<Status>,
+    changed: Condvar,
+}
+
+/// A live session: the document being edited and the thread that evaluates and streams it.
+///
+/// ```
+/// use std::time::Duration;
+/// use posecov::app::live::{Edit, EditValue, Live, LiveDocument};
+/// use posecov::sink::{RecordingIds, Sink, open_stream};
+/// let doc = LiveDocument::open("camera_on_robot").unwrap();
+/// let layout = posecov::scene::Scene::new("camera", "");
+/// let (rec, guard) = open_stream(&Sink::Memory, &RecordingIds::for_scenario("doc", 0), &layout).unwrap();
+/// let live = Live::start(doc, rec, guard, Default::default());
+/// let edit = Edit { id: "pose[0].cov.std_deg[2]".into(), value: EditValue::Number(40.0) };
+/// let generation = live.apply(&edit).unwrap();
+/// assert_eq!(live.wait_done(generation, Duration::from_secs(120)).shown, Some(generation));
+/// assert!(live.finish().unwrap().is_some_and(|bytes| !bytes.is_empty()));
+/// ```
+pub struct Live {
+    doc: Mutex<LiveDocument>,
+    jobs: Mutex<Option<Sender<Job>>>,
+    in_flight: Mutex<Arc<AtomicBool>>,
+    shared: Arc<Shared>,
+    thread: Mutex<Option<Worker>>,
+    generation: Mutex<u64>,
+}
+
+impl Live {
+    /// Starts the evaluation thread on `rec` (whose `guard` it keeps) and shows `doc`.
+    /// `overrides` apply to every generation (the block size; seed and samples come from
+    /// the document's controls).
+    pub fn start(
+        doc: LiveDocument,
+        rec: rerun::RecordingStream,
+        guard: SinkGuard,
+        overrides: Overrides,
+    ) -> Arc<Self> {
+        let (tx, rx) = channel();
+        let shared = Arc::new(Shared {
+            status: Mutex::new(Status {
+                phase: "idle",
+                ..Status::default()
+            }),
+            changed: Condvar::new(),
+        });
+        let worker_shared = Arc::clone(&shared);
+        let thread = std::thread::Builder::new()
+            .name("posecov-live".into())
+            .spawn(move || run(rx, rec, guard, &overrides, &worker_shared))
+            .expect("spawning the live evaluation thread");
+        let live = Arc::new(Self {
+            doc: Mutex::new(doc),
+            jobs: Mutex::new(Some(tx)),
+            in_flight: Mutex::new(Arc::new(AtomicBool::new(false))),
+            shared,
+            thread: Mutex::new(Some(thread)),
+            generation: Mutex::new(0),
+        });
+        live.submit(false);
+        live
+    }
+
+    /// Applies an edit; on success a new generation is evaluated and streamed (the one in
+    /// flight is cancelled). Returns the new generation.
+    ///
+    /// # Errors
+    /// [`EditError`]: nothing changes, the last good picture stays.
+    pub fn apply(&self, edit: &Edit) -> Result<u64, EditError> {
+        lock(&self.doc).apply(edit)?;
+        Ok(self.submit(true))
+    }
+
+    /// Returns to the file's values.
+    pub fn reset(&self) -> Result<u64, AppError> {
+        lock(&self.doc).reset()?;
+        Ok(self.submit(true))
+    }
+
+    /// Replaces the source text (`--watch`: the file changed).
+    ///
+    /// # Errors
+    /// The new text's error; the last good picture stays.
+    pub fn replace_source(&self, text: &str) -> Result<u64, AppError> {
+        lock(&self.doc).replace_source(text)?;
+        Ok(self.submit(true))
+    }
+
+    /// Runs `f` on the document (controls, text, origin).
+    pub fn with_doc<T>(&self, f: impl FnOnce(&LiveDocument) -> T) -> T {
+        f(&lock(&self.doc))
+    }
+
+    /// The status now.
+    pub fn status(&self) -> Status {
+        lock(&self.shared.status).clone()
+    }
+
+    /// Waits until generation `generation`'s final picture was sent, or an error for it or a
+    /// later one, or `timeout`. Returns the status then.
+    pub fn wait_done(&self, generation: u64, timeout: Duration) -> Status {
+        let deadline = Instant::now() + timeout;
+        let mut status = lock(&self.shared.status);
+        loop {
+            let finished = status.shown.is_some_and(|g| g >= generation) && status.done;
+            if finished || (status.error.is_some() && status.generation >= generation) {
+                return status.clone();
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return status.clone();
+            }
+            status = self
+                .shared
+                .changed
+                .wait_timeout(status, deadline - now)
+                .map(|(s, _)| s)
+                .unwrap_or_else(|e| e.into_inner().0);
+        }
+    }
+
+    /// Stops the thread and closes the sink; returns the bytes of a memory sink.
+    ///
+    /// # Errors
+    /// What the thread or the sink reported.
+    pub fn finish(&self) -> Result<Option<Vec<u8>>, AppError> {
+        lock(&self.in_flight).store(true, Ordering::SeqCst);
+        lock(&self.jobs).take();
+        let handle = lock(&self.thread).take();
+        match handle.map(JoinHandle::join) {
+            Some(Ok(result)) => result,
+            Some(Err(_)) => Err(AppError::Live("the live evaluation thread panicked".into())),
+            None => Ok(None),
+        }
+    }
+
+    fn submit(&self, newer: bool) -> u64 {
+        let generation = {
+            let mut g = lock(&self.generation);
+            if newer {
+                *g += 1;
+            }
+            *g
+        };
+        let cancel = Arc::new(AtomicBool::new(false));
+        let previous = std::mem::replace(&mut *lock(&self.in_flight), Arc::clone(&cancel));
+        previous.store(true, Ordering::SeqCst);
+        {
+            let mut status = lock(&self.shared.status);
+            status.generation = generation;
+            status.error = None;
+        }
+        let job = Job {
+            generation,
+            loaded: lock(&self.doc).loaded().clone(),
+            cancel,
+            since: Instant::now(),
+        };
+        if let Some(tx) = lock(&self.jobs).as_ref() {
+            tx.send(job).ok();
+        }
+        generation
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+fn run(
+    rx: Receiver<Job>,
+    rec: rerun::RecordingStream,
+    guard: SinkGuard,
+    overrides: &Overrides,
+    shared: &Shared,
+) -> Result<Option<Vec<u8>>, AppError> {
+    let mut restream = Restream::new();
+    while let Ok(mut job) = rx.recv() {
+        while let Ok(newer) = rx.try_recv() {
+            job = newer;
+        }
+        if let Err(err) = show(&job, &rec, &mut restream, overrides, shared) {
+            if job.cancel.load(Ordering::SeqCst) {
+                continue;
+            }
+            let mut status = lock(&shared.status);
+            status.phase = "idle";
+            if status.generation == job.generation {
+                status.error = Some(err.to_string());
+            }
+            shared.changed.notify_all();
+        }
+    }
+    Ok(guard.finish(rec)?)
+}
+
+/// The passes of one job: a preview when the full sample is larger, then the full one.
+fn passes(loaded: &Loaded, overrides: &Overrides) -> Result<Vec<u64>, AppError> {
+    let full = resolve(&loaded.input, overrides, None)?;
+    let samples = full.eval.samples as u64;
+    let monte_carlo = full.eval.methods.contains(&Method::MonteCarlo);
+    Ok(if monte_carlo && samples > 2 * PREVIEW_SAMPLES {
+        vec![PREVIEW_SAMPLES, samples]
+    } else {
+        vec![samples]
+    })
+}
+
+fn show(
+    job: &Job,
+    rec: &rerun::RecordingStream,
+    restream: &mut Restream,
+    overrides: &Overrides,
+    shared: &Shared,
+) -> Result<(), AppError> {
+    let passes = passes(&job.loaded, overrides)?;
+    let last = passes.len() - 1;
+    for (i, &samples) in passes.iter().enumerate() {
+        {
+            let mut status = lock(&shared.status);
+            status.phase = if i < last { "preview" } else { "full" };
+            status.samples = samples;
+            shared.changed.notify_all();
+        }
+        let pass = Overrides {
+            samples: Some(samples),
+            ..overrides.clone()
+        };
+        let mut session =
+            Session::from_loaded(job.loaded.clone(), &pass, Some(Arc::clone(&job.cancel)))?;
+        if job.cancel.load(Ordering::SeqCst) {
+            return Ok(());
+        }
+        let scene = std::mem::take(&mut session.scene);
+        let items = scene.items.len();
+        let mut outcome = restream.log(rec, scene, &job.cancel)?;
+        if outcome == LogOutcome::Complete && i == last {
+            outcome = session.log_blocks(rec, &job.cancel, |part| {
+                Ok(restream.log_part(rec, part, &job.cancel)?)
+            })?;
+        }
+        rec.flush_with_timeout(FLUSH_TIMEOUT)
+            .map_err(|e| AppError::Sink(SinkError::Flush(e.to_string())))?;
+        if outcome != LogOutcome::Complete {
+            // A newer change is on its way; it clears whatever this one left half-logged.
+            return Ok(());
+        }
+        let ms = job.since.elapsed().as_secs_f64() * 1e3;
+        let mut status = lock(&shared.status);
+        status.shown = Some(job.generation);
+        status.shown_samples = if session.settings.eval.methods.contains(&Method::MonteCarlo) {
+            samples
+        } else {
+            0
+        };
+        status.items = items;
+        if i == 0 {
+            status.first_picture_ms = Some(ms);
+            status.final_picture_ms = None;
+        }
+        status.done = i == last;
+        if i == last {
+            status.final_picture_ms = Some(ms);
+            status.phase = "idle";
+        }
+        shared.changed.notify_all();
+    }
+    Ok(())
+}

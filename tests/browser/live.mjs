@@ -1,0 +1,83 @@
+// End-to-end test of `posecov live` in headless Chromium (Debian's `chromium`), driven by
+// playwright-core. Usage: node live.mjs CONTROL_PAGE_URL [SCREENSHOT.png]
+//
+// Opens the control page, drags the heading σ slider of camera_on_robot with the mouse,
+// waits until the page reports the new generation's final picture as sent, clicks Save when
+// the page offers it, and prints one JSON line {"id", "value", "generation", "saved"} for the
+// Rust side (tests/live_browser.rs), which
+// checks on the viewer's gRPC stream that the new data arrived.
+import { chromium } from "playwright-core";
+import { mkdtempSync, rmSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+
+const [url, screenshot] = process.argv.slice(2);
+if (!url) {
+  console.error("usage: node live.mjs CONTROL_PAGE_URL [SCREENSHOT.png]");
+  process.exit(2);
+}
+const ID = "pose[0].cov.std_deg[2]";
+const profile = mkdtempSync(join(tmpdir(), "posecov-chromium-"));
+// A fresh profile directory (playwright passes it as --user-data-dir).
+const browser = await chromium.launchPersistentContext(profile, {
+  executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
+  headless: true,
+  viewport: { width: 1400, height: 860 },
+  args: [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+  ],
+});
+let code = 1;
+try {
+  const page = browser.pages()[0] || await browser.newPage();
+  page.on("console", (m) => { if (m.type() === "error") console.error("page:", m.text()); });
+  await page.goto(url);
+  const slider = page.locator(`input[type=range][data-id="${ID}"]`);
+  await slider.waitFor({ timeout: 30000 });
+  const status = page.locator("#status");
+  await page.waitForFunction(() => document.getElementById("status").dataset.done === "true", null, { timeout: 60000 });
+  const before = Number(await slider.inputValue());
+  // Drag the thumb from its place to 55 % of the track with the mouse, as a user would.
+  const box = await slider.boundingBox();
+  const min = Number(await slider.getAttribute("min"));
+  const max = Number(await slider.getAttribute("max"));
+  const x0 = box.x + box.width * ((before - min) / (max - min));
+  const y = box.y + box.height / 2;
+  await page.mouse.move(x0, y);
+  await page.mouse.down();
+  for (let i = 1; i <= 10; i++) await page.mouse.move(x0 + (box.x + 0.55 * box.width - x0) * (i / 10), y);
+  await page.mouse.up();
+  const after = Number(await slider.inputValue());
+  if (!(after > before)) throw new Error(`the slider did not move: ${before} → ${after}`);
+  // The page shows the newest generation's final picture as sent.
+  await page.waitForFunction(() => {
+    const s = document.getElementById("status").dataset;
+    return s.done === "true" && s.shown !== "" && s.shown === s.generation && Number(s.generation) >= 1;
+  }, null, { timeout: 60000 });
+  const typed = Number(await page.locator(`input[type=number][data-id="${ID}"]`).inputValue());
+  if (Math.abs(typed - after) > 1e-9) throw new Error(`typed value ${typed} does not follow the slider ${after}`);
+  const generation = Number(await status.getAttribute("data-generation"));
+  // "Save" (shown with --save-scenario) writes the current scenario to that file.
+  let saved = null;
+  if (await page.locator("#save").isVisible()) {
+    const [response] = await Promise.all([
+      page.waitForResponse((r) => r.url().endsWith("/api/save")),
+      page.click("#save"),
+    ]);
+    if (!response.ok()) throw new Error(`save failed: ${await response.text()}`);
+    saved = (await response.json()).saved;
+  }
+  if (screenshot) {
+    await page.waitForTimeout(3000);
+    await page.screenshot({ path: screenshot });
+  }
+  console.log(JSON.stringify({ id: ID, value: after, generation, saved }));
+  code = 0;
+} catch (e) {
+  console.error(String(e && e.stack || e));
+} finally {
+  await browser.close();
+  rmSync(profile, { recursive: true, force: true });
+}
+process.exit(code);

@@ -1,0 +1,277 @@
+//! Live mode's control API on an in-memory recording: a change re-streams in place, and what
+//! the viewer's own query engine (Rerun's `EntityDb`, latest-at per step) shows afterwards is
+//! exactly what a fresh recording of the edited scenario shows: nothing stale, one recording.
+
+use std::collections::BTreeSet;
+use std::sync::Arc;
+use std::time::Duration;
+
+use posecov::app::live::{Edit, EditValue, Live, LiveDocument, Status};
+use posecov::app::{Overrides, load_text, pipeline};
+use posecov::sink::{RecordingIds, Sink, open_stream, scene_to_rrd_bytes};
+use rerun::external::arrow::array::{Array as _, ArrayRef, StringArray};
+use rerun::external::re_entity_db::EntityDb;
+use rerun::external::re_entity_db::external::re_chunk_store::LatestAtQuery;
+use rerun::external::re_log_encoding::DecoderApp;
+use rerun::external::re_log_types::TimeInt;
+use rerun::external::re_sdk_types::blueprint::archetypes::ViewBlueprint;
+use rerun::log::LogMsg;
+use rerun::{EntityPath, StoreKind};
+
+mod rrd;
+
+const WAIT: Duration = Duration::from_secs(120);
+
+fn edit(id: &str, value: f64) -> Edit {
+    Edit {
+        id: id.into(),
+        value: EditValue::Number(value),
+    }
+}
+
+/// A live session on a memory sink, with `samples` set first.
+fn start(name: &str, samples: u64) -> (Arc<Live>, Status) {
+    let mut doc = LiveDocument::open(name).unwrap();
+    doc.apply(&edit("scenario.samples", samples as f64))
+        .unwrap();
+    let (_, scene) = pipeline(doc.loaded(), &Overrides::default(), None).unwrap();
+    let ids = RecordingIds::for_scenario(name, 0);
+    let (rec, guard) = open_stream(&Sink::Memory, &ids, &scene).unwrap();
+    let live = Live::start(doc, rec, guard, Overrides::default());
+    let status = live.wait_done(0, WAIT);
+    assert_eq!(status.shown, Some(0), "{status:?}");
+    (live, status)
+}
+
+/// A fresh recording of the current text of `live`.
+fn fresh(live: &Live) -> Vec<u8> {
+    let text = live.with_doc(|d| d.text());
+    let loaded = load_text(&text, "fresh.toml").unwrap();
+    let (_, scene) = pipeline(&loaded, &Overrides::default(), None).unwrap();
+    scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("fresh", 0)).unwrap()
+}
+
+fn messages(bytes: &[u8]) -> Vec<LogMsg> {
+    DecoderApp::decode_eager(std::io::Cursor::new(bytes))
+        .unwrap()
+        .map(Result::unwrap)
+        .collect()
+}
+
+fn db_of(bytes: &[u8]) -> EntityDb {
+    let chunks = rrd::recording_chunks(bytes);
+    let store_id = messages(bytes)
+        .iter()
+        .find(|m| m.store_id().kind() == StoreKind::Recording)
+        .map(|m| m.store_id().clone())
+        .unwrap();
+    let mut db = EntityDb::new(store_id);
+    for chunk in chunks {
+        db.add_chunk(&Arc::new(chunk)).unwrap();
+    }
+    db
+}
+
+fn entities(db: &EntityDb) -> BTreeSet<EntityPath> {
+    db.storage_engine().store().all_entities_sorted()
+}
+
+/// What a view shows of `path` at `step` (`None`: before any step): every component's
+/// latest-at value, clears applied (the clear's own component left out).
+fn shown(db: &EntityDb, path: &EntityPath, step: Option<i64>) -> Vec<(String, ArrayRef)> {
+    let components: Vec<_> = db
+        .storage_engine()
+        .store()
+        .schema()
+        .all_components_for_entity(path)
+        .map(|set| set.iter().copied().collect())
+        .unwrap_or_default();
+    let clear = rerun::Clear::descriptor_is_recursive().component;
+    let at = step.map_or(TimeInt::MIN, TimeInt::new_temporal);
+    let query = LatestAtQuery::new("step".into(), at);
+    let results = db.latest_at(&query, path, components.iter().copied());
+    let mut out: Vec<(String, ArrayRef)> = components
+        .iter()
+        .filter(|c| **c != clear)
+        .filter_map(|c| results.component_batch_raw(*c).map(|a| (c.to_string(), a)))
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
+/// Panics unless the 3-D world and the text look the same in both recordings at every step
+/// up to `last_step` (and before the first).
+fn assert_same_view(live: &[u8], fresh: &[u8], last_step: i64) {
+    let (a, b) = (db_of(live), db_of(fresh));
+    let world = |p: &EntityPath| {
+        let s = p.to_string();
+        s.starts_with("/world") || s.starts_with("/description")
+    };
+    let paths: BTreeSet<EntityPath> = entities(&a)
+        .into_iter()
+        .chain(entities(&b))
+        .filter(world)
+        .collect();
+    assert!(!paths.is_empty());
+    for step in std::iter::once(None).chain((0..=last_step + 1).map(Some)) {
+        for path in &paths {
+            let (x, y) = (shown(&a, path, step), shown(&b, path, step));
+            if x != y {
+                let names =
+                    |v: &[(String, ArrayRef)]| v.iter().map(|c| c.0.clone()).collect::<Vec<_>>();
+                let differ: Vec<&String> = x
+                    .iter()
+                    .zip(&y)
+                    .filter(|(p, q)| p != q)
+                    .map(|(p, _)| &p.0)
+                    .collect();
+                panic!(
+                    "{path} at step {step:?}: live shows {:?}, a fresh recording {:?}; values differ in {differ:?}",
+                    names(&x),
+                    names(&y),
+                );
+            }
+        }
+    }
+}
+
+fn recordings(bytes: &[u8]) -> BTreeSet<String> {
+    messages(bytes)
+        .iter()
+        .filter(|m| m.store_id().kind() == StoreKind::Recording)
+        .map(|m| format!("{:?}", m.store_id()))
+        .collect()
+}
+
+#[test]
+fn a_sigma_change_re_streams_in_place_like_a_fresh_recording() {
+    let (live, _) = start("camera_on_robot", 2000);
+    let before = fresh(&live);
+    let generation = live.apply(&edit("pose[0].cov.std_deg[2]", 40.0)).unwrap();
+    assert_eq!(generation, 1);
+    let status = live.wait_done(1, WAIT);
+    assert_eq!((status.shown, status.done), (Some(1), true), "{status:?}");
+    assert!(
+        live.with_doc(|d| d.text())
+            .contains("std_deg = [0.05, 0.05, 40.0]")
+    );
+    let after = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    assert_same_view(&bytes, &after, 0);
+    // The check can fail: the picture did change.
+    let old = db_of(&before);
+    let new = db_of(&after);
+    let cloud: EntityPath = "world/map_from_camera/monte_carlo/cloud".into();
+    assert_ne!(shown(&old, &cloud, None), shown(&new, &cloud, None));
+    assert_eq!(recordings(&bytes).len(), 1, "one recording");
+}
+
+#[test]
+fn a_bad_value_is_refused_with_its_field_and_the_picture_stays() {
+    let (live, _) = start("camera_on_robot", 2000);
+    let err = live
+        .apply(&edit("pose[0].cov.std_deg[2]", -5.0))
+        .unwrap_err();
+    assert_eq!(err.field().as_deref(), Some("pose[0].cov"), "{err}");
+    assert!(err.to_string().contains("negative"), "{err}");
+    let status = live.status();
+    assert_eq!(
+        (status.generation, status.shown),
+        (0, Some(0)),
+        "{status:?}"
+    );
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    assert_same_view(&bytes, &expected, 0);
+}
+
+#[test]
+fn fewer_steps_and_hidden_clouds_leave_nothing_stale() {
+    let (live, _) = start("barfoot_compounding", 1024);
+    live.apply(&edit("operation[0].steps", 30.0)).unwrap();
+    live.apply(&Edit {
+        id: "draw.clouds".into(),
+        value: EditValue::Toggle(false),
+    })
+    .unwrap();
+    let status = live.wait_done(2, WAIT);
+    assert_eq!((status.shown, status.done), (Some(2), true), "{status:?}");
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    assert_same_view(&bytes, &expected, 101);
+    assert_eq!(recordings(&bytes).len(), 1, "one recording");
+}
+
+#[test]
+fn reset_returns_to_the_files_picture() {
+    let (live, _) = start("na568_se2_odometry", 1024);
+    live.apply(&edit("operation[0].noise.std[2]", 0.3)).unwrap();
+    live.apply(&edit("operation[0].controls[6][0]", 1.2))
+        .unwrap();
+    let generation = live.reset().unwrap();
+    let status = live.wait_done(generation, WAIT);
+    assert_eq!(status.shown, Some(generation), "{status:?}");
+    let text = live.with_doc(|d| d.text());
+    let file = posecov::input::scenario::bundled::find("na568_se2_odometry").unwrap();
+    assert_eq!(text, file.text, "reset returns to the file's text");
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    assert_same_view(&bytes, &expected, 10);
+}
+
+/// The plots: each generation's series under `plots/<plot>/g<N>/`, the layout's plot views
+/// rooted there (Rerun does not clear plotted points).
+#[test]
+fn plots_show_the_newest_generation_only() {
+    let (live, _) = start("na568_se2_odometry", 1024);
+    live.apply(&edit("operation[0].noise.std[2]", 0.3)).unwrap();
+    let status = live.wait_done(1, WAIT);
+    assert_eq!(status.shown, Some(1), "{status:?}");
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    if let Some(path) = std::env::var_os("POSECOV_LIVE_RRD") {
+        std::fs::write(path, &bytes).unwrap();
+    }
+    // The newest generation's series hold exactly the fresh recording's points.
+    let series = |bytes: &[u8], prefix: &str| -> Vec<(String, usize)> {
+        let mut v: Vec<(String, usize)> = rrd::recording_chunks(bytes)
+            .iter()
+            .filter_map(|c| {
+                let p = c.entity_path().to_string();
+                let rest = p.strip_prefix("/plots/")?;
+                let (plot, tail) = rest.split_once('/')?;
+                let tail = tail.strip_prefix(prefix)?;
+                (c.num_rows() > 1).then(|| (format!("{plot}/{tail}"), c.num_rows()))
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let newest = series(&bytes, "g1/");
+    assert!(!newest.is_empty());
+    assert_eq!(newest, series(&expected, ""));
+    // The active layout (the last one sent) plots generation 1's series only.
+    let origins: Vec<String> = messages(&bytes)
+        .iter()
+        .filter_map(|m| match m {
+            LogMsg::ArrowMsg(store, arrow) if store.kind() == StoreKind::Blueprint => {
+                rerun::log::Chunk::from_arrow_msg(arrow).ok()
+            }
+            _ => None,
+        })
+        .filter_map(|c| {
+            let origin = ViewBlueprint::descriptor_space_origin().component;
+            let array = c.component_batch_raw(origin, 0)?.ok()?;
+            let text = array
+                .as_any()
+                .downcast_ref::<StringArray>()?
+                .value(0)
+                .to_owned();
+            text.trim_start_matches('/')
+                .strip_prefix("plots/")
+                .map(str::to_owned)
+        })
+        .collect();
+    let last = origins.last().expect("a plot view");
+    assert!(last.ends_with("/g1"), "{origins:?}");
+}
