@@ -132,14 +132,10 @@ fn log_items(
     Ok(LogOutcome::Complete)
 }
 
-/// Sends one row with all `parts` as one chunk: no log time, no batcher, fixed order.
-pub(super) fn send(
-    rec: &rr::RecordingStream,
-    path: impl Into<rr::EntityPath>,
-    timing: Timing,
-    parts: &[&dyn AsComponents],
-) -> Result<(), SinkError> {
-    let timepoint = match timing {
+/// Where an item of `timing` is logged: nowhere on a timeline (static), at a step of the `step`
+/// sequence, or at a stamp (nanoseconds) of the `stamp` timeline.
+pub(super) fn time_point(timing: Timing) -> rr::TimePoint {
+    match timing {
         Timing::Static => rr::TimePoint::default(),
         Timing::Step(k) => {
             rr::TimePoint::default().with(rr::Timeline::new_sequence(STEP_TIMELINE), k)
@@ -147,7 +143,17 @@ pub(super) fn send(
         Timing::Stamp(ns) => {
             rr::TimePoint::default().with(rr::Timeline::new_timestamp(STAMP_TIMELINE), ns)
         }
-    };
+    }
+}
+
+/// Sends one row with all `parts` as one chunk: no log time, no batcher, fixed order.
+pub(super) fn send(
+    rec: &rr::RecordingStream,
+    path: impl Into<rr::EntityPath>,
+    timing: Timing,
+    parts: &[&dyn AsComponents],
+) -> Result<(), SinkError> {
+    let timepoint = time_point(timing);
     let path = path.into();
     let batches = parts.iter().flat_map(|p| p.as_serialized_batches());
     let chunk = Chunk::builder(path.clone())

@@ -25,9 +25,9 @@ use std::sync::atomic::AtomicBool;
 
 use ::rerun as rr;
 
+use super::rerun::{send, time_point};
 use super::send_layout;
-use super::rerun::send;
-use super::{LogOutcome, STEP_TIMELINE, SinkError, log_part_cancellable, log_scene_cancellable};
+use super::{LogOutcome, SinkError, log_part_cancellable, log_scene_cancellable};
 use crate::scene::{self, Scene, SceneItem, Timing};
 
 /// The state of a recording that generations are re-streamed into.
@@ -201,25 +201,28 @@ impl Restream {
     }
 }
 
-/// One chunk of clears per entity: a static row if it was static, one row per step it was
-/// logged at.
+/// One chunk of clears per entity: a static row if it was static, one row per step (or stamp)
+/// it was logged at.
 fn clear_all(
     rec: &rr::RecordingStream,
     path: &str,
-    times: &BTreeSet<Option<i64>>,
+    times: &BTreeSet<Timing>,
     clear: &rr::Clear,
 ) -> Result<(), SinkError> {
-    if times.contains(&None) {
+    if times.contains(&Timing::Static) {
         send(rec, path, Timing::Static, &[clear])?;
     }
-    let steps: Vec<i64> = times.iter().flatten().copied().collect();
-    if steps.is_empty() {
+    let timed: Vec<Timing> = times
+        .iter()
+        .copied()
+        .filter(|t| *t != Timing::Static)
+        .collect();
+    if timed.is_empty() {
         return Ok(());
     }
     let mut builder = rr::log::Chunk::builder(rr::EntityPath::from(path));
-    for step in steps {
-        let at = rr::TimePoint::default().with(rr::Timeline::new_sequence(STEP_TIMELINE), step);
-        builder = builder.with_archetype(rr::log::RowId::new(), at, clear);
+    for t in timed {
+        builder = builder.with_archetype(rr::log::RowId::new(), time_point(t), clear);
     }
     let chunk = builder.build().map_err(|err| SinkError::Chunk {
         path: path.to_owned(),
@@ -227,13 +230,6 @@ fn clear_all(
     })?;
     rec.send_chunk(chunk);
     Ok(())
-}
-
-fn timing_key(t: Timing) -> Option<i64> {
-    match t {
-        Timing::Static => None,
-        Timing::Step(k) => Some(k),
-    }
 }
 
 /// `plots/<plot>/<rest>` → `plots/<plot>/g<N>/<rest>`.
