@@ -362,9 +362,12 @@ impl<G: LieGroup<N>, const N: usize> JointInputs<G, N> {
     /// use posecov::lie::{LieGroup, So2};
     /// use posecov::propagate::sigma_point::{JointInputs, Unscented};
     /// use posecov::uncertain::{Side, UncertainPose};
-    /// let a = UncertainPose::try_from_std_devs(So2::identity(), [3.0], Side::Right).unwrap();
-    /// let wrap = JointInputs::independent(&[a]).unwrap().wrap_around(&Unscented::default()).unwrap();
-    /// assert_eq!(wrap.unwrap().largest_rotation, 3.0);
+    /// // L = 1, γ = 1: a σ of 4 rad puts the points 4 rad out, beyond π; α = 0.7 keeps them in.
+    /// let a = UncertainPose::try_from_std_devs(So2::identity(), [4.0], Side::Right).unwrap();
+    /// let inputs = JointInputs::independent(&[a]).unwrap();
+    /// assert_eq!(inputs.wrap_around(&Unscented::default()).unwrap().unwrap().largest_rotation, 4.0);
+    /// let inside = Unscented { alpha: 0.7, ..Default::default() };
+    /// assert_eq!(inputs.wrap_around(&inside).unwrap(), None);
     /// ```
     pub fn wrap_around(&self, params: &Unscented) -> Result<Option<WrapAround>> {
         let largest = self.largest_rotation(params)?;
