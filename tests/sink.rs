@@ -204,7 +204,9 @@ fn save_writes_atomically_and_two_processes_write_the_same_content() {
         .map(|f| std::fs::read(f).expect("read rrd"));
     assert_same_content(&a, &b);
     match rerun_cli() {
-        None => eprintln!("SKIPPED rrd verify/compare: /work/shared/scripts/rerun-cli unavailable"),
+        None => eprintln!(
+            "SKIPPED rrd verify/compare: no rerun CLI ($POSECOV_RERUN_CLI, or ../shared/scripts/rerun-cli)"
+        ),
         Some(cli) => {
             for args in [vec!["rrd", "verify"], vec!["rrd", "compare"]] {
                 let out = Command::new(&cli)
