@@ -31,7 +31,7 @@ pub fn list() -> Result<String, AppError> {
         if !out.is_empty() {
             out.push('\n');
         }
-        let _ = writeln!(out, "{}s ({}):", format.name(), extensions.join(", "));
+        let _ = writeln!(out, "{} ({}):", format.name_plural(), extensions.join(", "));
         for e in of_format {
             let title = match crate::input::bag::bundled::find(e.name) {
                 Some(log) => log.title.to_owned(),

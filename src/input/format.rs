@@ -70,6 +70,21 @@ impl Format {
         }
     }
 
+    /// The format in words, plural (a heading of `posecov list`).
+    ///
+    /// ```
+    /// use posecov::input::Format;
+    /// assert_eq!(Format::Mcap.name_plural(), "MCAP files (ROS 2 bags)");
+    /// ```
+    pub fn name_plural(self) -> &'static str {
+        match self {
+            Format::Scenario => "TOML scenarios",
+            Format::Ros1Bag => "ROS 1 bags",
+            Format::Mcap => "MCAP files (ROS 2 bags)",
+            Format::Graph => "g2o / GTSAM pose graphs",
+        }
+    }
+
     /// The file extensions of the format (lower case, without the dot).
     ///
     /// ```
