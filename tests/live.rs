@@ -219,39 +219,21 @@ fn reset_returns_to_the_files_picture() {
     assert_same_view(&bytes, &expected, 10);
 }
 
-/// The plots: each generation's series under `plots/<plot>/g<N>/`, the layout's plot views
-/// rooted there (Rerun does not clear plotted points).
-#[test]
-fn plots_show_the_newest_generation_only() {
-    let (live, _) = start("na568_se2_odometry", 1024);
-    live.apply(&edit("operation[0].noise.std[2]", 0.3)).unwrap();
-    let status = live.wait_done(1, WAIT);
-    assert_eq!(status.shown, Some(1), "{status:?}");
-    let expected = fresh(&live);
-    let bytes = live.finish().unwrap().unwrap();
-    if let Some(path) = std::env::var_os("POSECOV_LIVE_RRD") {
-        std::fs::write(path, &bytes).unwrap();
+/// The blueprint stores sent into a recording: one per layout.
+fn layouts(bytes: &[u8]) -> Vec<String> {
+    let mut ids: Vec<String> = Vec::new();
+    for m in messages(bytes) {
+        let id = format!("{:?}", m.store_id());
+        if m.store_id().kind() == StoreKind::Blueprint && !ids.contains(&id) {
+            ids.push(id);
+        }
     }
-    // The newest generation's series hold exactly the fresh recording's points.
-    let series = |bytes: &[u8], prefix: &str| -> Vec<(String, usize)> {
-        let mut v: Vec<(String, usize)> = rrd::recording_chunks(bytes)
-            .iter()
-            .filter_map(|c| {
-                let p = c.entity_path().to_string();
-                let rest = p.strip_prefix("/plots/")?;
-                let (plot, tail) = rest.split_once('/')?;
-                let tail = tail.strip_prefix(prefix)?;
-                (c.num_rows() > 1).then(|| (format!("{plot}/{tail}"), c.num_rows()))
-            })
-            .collect();
-        v.sort();
-        v
-    };
-    let newest = series(&bytes, "g1/");
-    assert!(!newest.is_empty());
-    assert_eq!(newest, series(&expected, ""));
-    // The active layout (the last one sent) plots generation 1's series only.
-    let origins: Vec<String> = messages(&bytes)
+    ids
+}
+
+/// The space origins of the plot views in the recording's blueprints, in the order sent.
+fn plot_origins(bytes: &[u8]) -> Vec<String> {
+    messages(bytes)
         .iter()
         .filter_map(|m| match m {
             LogMsg::ArrowMsg(store, arrow) if store.kind() == StoreKind::Blueprint => {
@@ -271,7 +253,121 @@ fn plots_show_the_newest_generation_only() {
                 .strip_prefix("plots/")
                 .map(str::to_owned)
         })
+        .collect()
+}
+
+/// The plots: each generation's series go under `plots/<plot>/g<N>/`, inside the plot view;
+/// the series of earlier generations get a static, empty `Scalars` (which shadows their
+/// points in every query: Rerun's plots ignore clears); the layout is sent once, so the
+/// viewer keeps its camera.
+#[test]
+fn plots_show_the_newest_generation_only_and_the_layout_stays() {
+    let (live, _) = start("na568_se2_odometry", 1024);
+    live.apply(&edit("operation[0].noise.std[2]", 0.3)).unwrap();
+    let status = live.wait_done(1, WAIT);
+    assert_eq!(status.shown, Some(1), "{status:?}");
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    if let Some(path) = std::env::var_os("POSECOV_LIVE_RRD") {
+        std::fs::write(path, &bytes).unwrap();
+    }
+    let chunks = rrd::recording_chunks(&bytes);
+    // The newest generation's series hold exactly the fresh recording's points.
+    let series = |chunks: &[rerun::log::Chunk], prefix: &str| -> Vec<(String, usize)> {
+        let mut v: Vec<(String, usize)> = chunks
+            .iter()
+            .filter_map(|c| {
+                let p = c.entity_path().to_string();
+                let rest = p.strip_prefix("/plots/")?;
+                let (plot, tail) = rest.split_once('/')?;
+                let tail = tail.strip_prefix(prefix)?;
+                (c.num_rows() > 1).then(|| (format!("{plot}/{tail}"), c.num_rows()))
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let newest = series(&chunks, "g1/");
+    assert!(!newest.is_empty());
+    assert_eq!(newest, series(&rrd::recording_chunks(&expected), ""));
+    // Generation 0's series are shadowed: a static chunk with an empty Scalars each.
+    let scalars = rerun::Scalars::descriptor_scalars().component;
+    let shadowed: BTreeSet<String> = chunks
+        .iter()
+        .filter(|c| c.is_static() && c.entity_path().to_string().contains("/g0/"))
+        .filter(|c| {
+            c.component_batch_raw(scalars, 0)
+                .and_then(Result::ok)
+                .is_some_and(|a| a.is_empty())
+        })
+        .map(|c| c.entity_path().to_string().replace("/g0/", "/"))
         .collect();
-    let last = origins.last().expect("a plot view");
-    assert!(last.ends_with("/g1"), "{origins:?}");
+    let old: BTreeSet<String> = series(&chunks, "g0/")
+        .into_iter()
+        .map(|(p, _)| format!("/plots/{p}"))
+        .collect();
+    assert!(!old.is_empty());
+    assert_eq!(shadowed, old);
+    // The newest generation is not shadowed.
+    assert!(!chunks.iter().any(|c| c.is_static()
+        && c.entity_path().to_string().contains("/g1/")
+        && c.component_batch_raw(scalars, 0).is_some()));
+    // One layout, its plot views rooted at the plot (all generations inside).
+    assert_eq!(layouts(&bytes).len(), 1, "the layout is sent once");
+    let origins = plot_origins(&bytes);
+    assert!(
+        !origins.is_empty() && origins.iter().all(|o| !o.contains('/')),
+        "{origins:?}"
+    );
+}
+
+/// A change of what the views are (a method switched off removes its view) sends the layout
+/// again; a change of values does not (the previous test).
+#[test]
+fn a_change_of_views_sends_the_layout_again() {
+    let (live, _) = start("camera_on_robot", 1024);
+    live.apply(&edit("pose[0].cov.std_deg[2]", 30.0)).unwrap();
+    assert_eq!(live.wait_done(1, WAIT).shown, Some(1));
+    live.apply(&Edit {
+        id: "scenario.methods.sigma_points".into(),
+        value: EditValue::Toggle(false),
+    })
+    .unwrap();
+    let status = live.wait_done(2, WAIT);
+    assert_eq!(status.shown, Some(2), "{status:?}");
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    assert_eq!(layouts(&bytes).len(), 2, "opened with one, sent again once");
+    assert_same_view(&bytes, &expected, 0);
+}
+
+/// A frame drawn again at the same position is overwritten, never cleared: the viewer
+/// resolves a cleared transform to the identity even when a newer one follows at that time
+/// (the robot's axes jumped to the origin). Clears stay for what is no longer drawn.
+#[test]
+fn frames_are_overwritten_not_cleared() {
+    let (live, _) = start("na568_se2_odometry", 1024);
+    live.apply(&edit("operation[0].noise.std[2]", 0.3)).unwrap();
+    assert_eq!(live.wait_done(1, WAIT).shown, Some(1));
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    let chunks = rrd::recording_chunks(&bytes);
+    let has = |c: &rerun::log::Chunk, component| c.component_batch_raw(component, 0).is_some();
+    let translation = rerun::Transform3D::descriptor_translation().component;
+    let clear = rerun::Clear::descriptor_is_recursive().component;
+    let framed: BTreeSet<String> = chunks
+        .iter()
+        .filter(|c| has(c, translation))
+        .map(|c| c.entity_path().to_string())
+        .collect();
+    assert!(!framed.is_empty());
+    let cleared: Vec<String> = chunks
+        .iter()
+        .filter(|c| has(c, clear) && framed.contains(&c.entity_path().to_string()))
+        .map(|c| c.entity_path().to_string())
+        .collect();
+    assert!(cleared.is_empty(), "frames cleared: {cleared:?}");
+    // Other entities were cleared (the mechanism still runs), and the view is the fresh one.
+    assert!(chunks.iter().any(|c| has(c, clear)));
+    assert_same_view(&bytes, &expected, 8);
 }

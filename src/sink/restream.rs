@@ -10,11 +10,20 @@
 //!   the entity only at an *earlier* step, its latest item is logged again at the cleared
 //!   step, so the step slider shows exactly what a fresh recording would. Clears are
 //!   per entity (not recursive) and cost one small chunk each.
+//! - **Frames** are the exception: the viewer resolves a cleared transform to the identity
+//!   even when a newer transform follows at the same time (checked in the real viewer: the
+//!   robot's axes jumped to the origin), so a frame position that the new generation draws
+//!   a frame at again is not cleared but overwritten — transform, axes and, where the old
+//!   frame had a label and the new one has none, an empty label marker.
 //! - **Plots** (range queries, which Rerun does not clear: a cleared point still plots):
-//!   each generation's series go under `plots/<plot>/g<N>/…`, and the layout is sent again
-//!   with each plot view's origin there. For scenes with plots this resets the camera to the
-//!   layout's; scenes without plots keep the camera the user set. (An update of the views'
-//!   contents alone would keep it, but the 0.36 viewer does not apply one.)
+//!   each generation's series go under `plots/<plot>/g<N>/…`, inside the plot view's
+//!   `$origin/**`, and every series of an earlier generation gets a *static, empty*
+//!   `Scalars`. Static data shadows a component's temporal data for every query, range
+//!   queries included, so the old line vanishes from its plot; the layout stays as it was.
+//! - **The layout** (a blueprint, which the viewer clones on arrival and the user then edits:
+//!   the camera lives there) is sent again only when the views or plots themselves change
+//!   (a method switched on adds a plot, a view is split); a change of values keeps the
+//!   viewer's camera and layout. A view's camera is not part of that comparison.
 //!
 //! Rerun lets static data shadow temporal data on the same entity forever, so an entity that
 //! was ever logged static and is later logged at steps is logged static (its last step):
@@ -28,7 +37,7 @@ use ::rerun as rr;
 use super::rerun::{send, time_point};
 use super::send_layout;
 use super::{LogOutcome, SinkError, log_part_cancellable, log_scene_cancellable};
-use crate::scene::{self, Scene, SceneItem, Timing};
+use crate::scene::{self, ItemKind, Scene, SceneItem, Timing};
 
 /// The state of a recording that generations are re-streamed into.
 #[derive(Debug, Default)]
@@ -37,6 +46,14 @@ pub struct Restream {
     touched: BTreeMap<String, BTreeSet<Timing>>,
     /// Entities that were ever static (and so can never show temporal data again).
     ever_static: BTreeSet<String>,
+    /// Frame positions logged with a label (their marker must be emptied if the new frame
+    /// has none).
+    labelled: BTreeSet<(String, Timing)>,
+    /// Series logged by earlier generations whose lines are not yet shadowed.
+    series: BTreeSet<String>,
+    /// What the layout sent last is made of ([`layout_key`]; `None`: the opener's layout,
+    /// taken to be the first scene's).
+    layout: Option<String>,
     /// Generations logged so far.
     generation: u64,
 }
@@ -87,21 +104,15 @@ impl Restream {
         let generation = self.generation;
         self.generation += 1;
         self.clear_and_carry(rec, &scene)?;
-        if !scene.series.is_empty() {
-            for series in &mut scene.series {
-                series.path = generation_path(&series.path, generation);
-            }
-            // The plot views show this generation's series only (a new layout: Rerun's
-            // plots do not honour clears).
-            let ids: Vec<String> = scene.plots.iter().map(|p| p.id.clone()).collect();
-            for plot in &mut scene.plots {
-                plot.id = format!("{}/g{generation}", plot.id);
-            }
-            let sent = send_layout(rec, &scene);
-            for (plot, id) in scene.plots.iter_mut().zip(ids) {
-                plot.id = id;
-            }
-            sent?;
+        let key = layout_key(&scene);
+        if self.layout.as_ref().is_some_and(|sent| *sent != key) {
+            send_layout(rec, &scene)?;
+        }
+        self.layout = Some(key);
+        self.shadow_series(rec)?;
+        for series in &mut scene.series {
+            series.path = generation_path(&series.path, generation);
+            self.series.insert(series.path.clone());
         }
         let outcome = log_scene_cancellable(rec, &scene, cancel)?;
         self.touch(&scene);
@@ -122,6 +133,16 @@ impl Restream {
         let outcome = log_part_cancellable(rec, &part, cancel)?;
         self.touch(&part);
         Ok(outcome)
+    }
+
+    /// Hides the lines of earlier generations: a static, empty `Scalars` on each series
+    /// shadows its temporal values in every query (see the module docs).
+    fn shadow_series(&mut self, rec: &rr::RecordingStream) -> Result<(), SinkError> {
+        let empty = rr::Scalars::new(std::iter::empty::<f64>());
+        for path in std::mem::take(&mut self.series) {
+            send(rec, path.as_str(), Timing::Static, &[&empty])?;
+        }
+        Ok(())
     }
 
     /// Items at steps on entities that were ever static become static (their last step).
@@ -169,10 +190,37 @@ impl Restream {
                 .insert(item.timing, item);
         }
         let mut carried = Scene::new(String::new(), String::new());
+        let mut unlabel = Vec::new();
         for (path, times) in &self.touched {
-            clear_all(rec, path, times, &clear)?;
+            let new = at.get(path.as_str());
+            // The item the new generation shows at `t`: its own, else (carried) its latest
+            // before `t`; static items cover every step.
+            let shown = |t: Timing| {
+                new.and_then(|n| {
+                    n.get(&t)
+                        .or_else(|| n.get(&Timing::Static))
+                        .or_else(|| match t {
+                            Timing::Step(_) => n.range(..t).next_back().map(|(_, i)| i),
+                            _ => None,
+                        })
+                })
+            };
+            let cleared: BTreeSet<Timing> = times
+                .iter()
+                .copied()
+                .filter(|&t| match shown(t).map(|i| &i.kind) {
+                    Some(ItemKind::Frame(frame)) => {
+                        if frame.label.is_none() && self.labelled.contains(&(path.clone(), t)) {
+                            unlabel.push((path.as_str(), t));
+                        }
+                        false
+                    }
+                    _ => true,
+                })
+                .collect();
+            clear_all(rec, path, &cleared, &clear)?;
             for &t in times {
-                let (Timing::Step(step), Some(new)) = (t, at.get(path.as_str())) else {
+                let (Timing::Step(step), Some(new)) = (t, new) else {
                     continue;
                 };
                 if new.contains_key(&t) || new.contains_key(&Timing::Static) {
@@ -185,14 +233,24 @@ impl Restream {
                 }
             }
         }
+        let no_marker = rr::Points3D::new(std::iter::empty::<[f32; 3]>());
+        for (path, t) in unlabel {
+            send(rec, path, t, &[&no_marker])?;
+        }
         if !carried.items.is_empty() {
             log_part_cancellable(rec, &carried, &AtomicBool::new(false))?;
+            self.touch(&carried);
         }
         Ok(())
     }
 
     fn touch(&mut self, scene: &Scene) {
         for item in &scene.items {
+            let key = (item.path.clone(), item.timing);
+            match &item.kind {
+                ItemKind::Frame(frame) if frame.label.is_some() => self.labelled.insert(key),
+                _ => self.labelled.remove(&key),
+            };
             self.touched
                 .entry(item.path.clone())
                 .or_default()
@@ -230,6 +288,30 @@ fn clear_all(
     })?;
     rec.send_chunk(chunk);
     Ok(())
+}
+
+/// What a layout is made of, cameras left out: the views (their names and what they show
+/// and hide), the plots (ids and titles) and the timeline. Two scenes with the same key get
+/// the same layout but for the cameras.
+///
+/// ```
+/// use posecov::scene::{Camera, Scene, View3d};
+/// use posecov::sink::restream::layout_key;
+/// let mut a = Scene::new("t", "d");
+/// a.views.push(View3d { name: "3D".into(), ..Default::default() });
+/// let mut b = a.clone();
+/// b.views[0].camera = Some(Camera { position: [3.0, 0.0, 1.0], target: [0.0; 3], up: [0.0, 0.0, 1.0] });
+/// assert_eq!(layout_key(&a), layout_key(&b));
+/// b.views[0].hidden.push("world/x".into());
+/// assert_ne!(layout_key(&a), layout_key(&b));
+/// ```
+pub fn layout_key(scene: &Scene) -> String {
+    let views: Vec<_> = scene
+        .views
+        .iter()
+        .map(|v| (&v.name, &v.include, &v.exclude, &v.hidden))
+        .collect();
+    format!("{views:?} {:?} {:?}", scene.plots, scene.timeline)
 }
 
 /// `plots/<plot>/<rest>` → `plots/<plot>/g<N>/<rest>`.
