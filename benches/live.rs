@@ -2,8 +2,9 @@
 //! handed to the viewer, per bundled scenario, the way the live thread does it — apply the
 //! edit to the document (parse + lower: the file's validation), evaluate, draw, re-stream in
 //! place ([`Restream`], with its clears) and encode what was logged (the bytes a viewer
-//! receives). `preview`: the quick first picture (one random chunk of samples when the
-//! scenario's Monte Carlo sample is larger); `full`: the scenario's own sample.
+//! receives). `preview`: the quick first picture, the first of live mode's own
+//! [`passes`] (one random chunk of samples when the scenario's Monte Carlo sample is larger,
+//! fewer steps kept when a propagation is long); `full`: the scenario's own picture.
 //!
 //! Run (dev profile, as the tests build; a release build of Rerun is ~20 min cold):
 //! `cargo bench --profile dev --bench live -- --warm-up-time 1 --measurement-time 3`
@@ -12,9 +13,9 @@ use std::hint::black_box;
 use std::sync::atomic::AtomicBool;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use posecov::app::live::{Control, ControlKind, Edit, EditValue, LiveDocument, PREVIEW_SAMPLES};
+use posecov::app::Overrides;
+use posecov::app::live::{Control, ControlKind, Edit, EditValue, LiveDocument, passes};
 use posecov::app::session::Session;
-use posecov::app::{Overrides, resolve};
 use posecov::input::scenario::bundled::BUNDLED;
 use posecov::sink::Restream;
 
@@ -43,14 +44,11 @@ fn live(c: &mut Criterion) {
         g.sample_size(10);
         for b in BUNDLED {
             let mut doc = LiveDocument::new(b.text, b.name).expect("bundled scenario loads");
-            let full = resolve(&doc.loaded().input, &Overrides::default(), None)
-                .expect("settings")
-                .eval
-                .samples as u64;
-            let samples = if pass == "preview" {
-                full.min(PREVIEW_SAMPLES)
+            let mut all = passes(doc.loaded(), &Overrides::default()).expect("settings");
+            let overrides = if pass == "preview" {
+                all.swap_remove(0)
             } else {
-                full
+                all.pop().expect("a full pass")
             };
             let (id, values) = knob(&doc);
             let (rec, storage) = rerun::RecordingStreamBuilder::new("posecov")
@@ -59,11 +57,10 @@ fn live(c: &mut Criterion) {
             let mut restream = Restream::new();
             let cancel = AtomicBool::new(false);
             let mut k = 0usize;
-            let overrides = Overrides {
-                samples: Some(samples),
-                ..Overrides::default()
-            };
-            eprintln!("{pass} {}: {id} at {samples} samples", b.name);
+            eprintln!(
+                "{pass} {}: {id} at {:?} samples, steps {:?}",
+                b.name, overrides.samples, overrides.steps
+            );
             g.bench_function(b.name, |bench| {
                 bench.iter(|| {
                     k += 1;

@@ -216,6 +216,7 @@ impl ScenarioArgs {
             block_samples: self.block_samples,
             topics: self.topics.clone(),
             every: self.every,
+            steps: None,
         }
     }
 }

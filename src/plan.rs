@@ -412,6 +412,31 @@ pub enum AnyPlan {
     Se3(Plan<Se3, 6>),
 }
 
+impl AnyPlan {
+    /// The most steps any one operation records ([`Op::steps`]; 0 without propagations).
+    ///
+    /// ```
+    /// use posecov::app::load;
+    /// assert_eq!(load("barfoot_compounding").unwrap().input.plan.longest_propagation(), 100);
+    /// assert_eq!(load("camera_on_robot").unwrap().input.plan.longest_propagation(), 0);
+    /// ```
+    pub fn longest_propagation(&self) -> u64 {
+        fn longest<G: LieGroup<N>, const N: usize>(plan: &Plan<G, N>) -> u64 {
+            plan.operations
+                .iter()
+                .map(|o| o.op.steps())
+                .max()
+                .unwrap_or(0)
+        }
+        match self {
+            Self::So2(p) => longest(p),
+            Self::Se2(p) => longest(p),
+            Self::So3(p) => longest(p),
+            Self::Se3(p) => longest(p),
+        }
+    }
+}
+
 /// Which steps of a long propagation keep their numbers and their particles: numbers at most
 /// [`max_recorded`](Self::max_recorded) steps (every k-th, k = ⌈steps / max⌉, and the last),
 /// particles (and so clouds and surfaces) at most [`max_detailed`](Self::max_detailed). Memory

@@ -187,7 +187,13 @@ fn a_bad_value_is_refused_with_its_field_and_the_picture_stays() {
 
 #[test]
 fn fewer_steps_and_hidden_clouds_leave_nothing_stale() {
-    let (live, _) = start("barfoot_compounding", 1024);
+    let (live, first) = start("barfoot_compounding", 1024);
+    // 100 compounds: a preview with fewer steps kept came first, then the full picture.
+    let (preview, full) = (
+        first.first_picture_ms.unwrap(),
+        first.final_picture_ms.unwrap(),
+    );
+    assert!(preview < full, "{first:?}");
     live.apply(&edit("operation[0].steps", 30.0)).unwrap();
     live.apply(&Edit {
         id: "draw.clouds".into(),

@@ -29,6 +29,9 @@ pub struct Overrides {
     pub topics: Vec<String>,
     /// `--every N` (robot logs only): draw every N-th message.
     pub every: Option<u64>,
+    /// Which steps of long propagations are kept (no flag: live mode's quick preview thins
+    /// them); `None`: [`StepPolicy::default`].
+    pub steps: Option<StepPolicy>,
 }
 
 /// A command-line value out of range: names the flag, the value and what is accepted.
@@ -122,7 +125,7 @@ pub fn resolve(
         .confidence
         .or(file.confidence)
         .unwrap_or(DEFAULT_CONFIDENCE);
-    let steps = StepPolicy::default();
+    let steps = overrides.steps.unwrap_or_default();
     Ok(Settings {
         eval: EvalSettings {
             seed: overrides.seed.or(file.seed).unwrap_or(0),

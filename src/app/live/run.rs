@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use super::document::{Edit, EditValue, LiveDocument};
 use super::server::{PageOptions, serve_page};
-use super::worker::{Live, PREVIEW_SAMPLES};
+use super::worker::{Live, passes};
 use crate::app::session::{ServeOptions, ViewOptions, choose_sink, scenario_name, serve_limit};
 use crate::app::{AppError, Overrides, pipeline};
 use crate::sink::{RecordingIds, Sink, open_stream};
@@ -116,11 +116,8 @@ fn start(doc: LiveDocument, view: &ViewOptions) -> Result<(Arc<Live>, Option<Str
             "streams to a viewer (--spawn, --connect or --serve); to keep a recording, save the scenario and run `posecov FILE --save out.rrd`".into(),
         ));
     }
-    let preview = Overrides {
-        samples: Some(PREVIEW_SAMPLES),
-        ..view.overrides.clone()
-    };
-    let (_, scene) = pipeline(doc.loaded(), &preview, None)?;
+    let first = passes(doc.loaded(), &view.overrides)?.swap_remove(0);
+    let (_, scene) = pipeline(doc.loaded(), &first, None)?;
     let seed = doc.loaded().input.defaults.seed.unwrap_or(0);
     let mut ids = RecordingIds::for_scenario(&scenario_name(&view.scenario), seed);
     ids.recording_id.push_str("/live");

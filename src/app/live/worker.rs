@@ -14,6 +14,7 @@ use serde::Serialize;
 use super::document::{Edit, EditError, LiveDocument};
 use crate::app::session::Session;
 use crate::app::{AppError, Loaded, Overrides, resolve};
+use crate::plan::StepPolicy;
 use crate::sample::CHUNK_SIZE;
 use crate::sink::{LogOutcome, Restream, SinkError, SinkGuard};
 use crate::uncertain::Method;
@@ -21,6 +22,14 @@ use crate::uncertain::Method;
 /// Samples of the quick preview shown before a larger full sample: one random chunk, so
 /// the preview's draws are the first draws of the full run.
 pub const PREVIEW_SAMPLES: u64 = CHUNK_SIZE as u64;
+
+/// The steps the quick preview keeps of a propagation longer than `max_recorded`: numbers
+/// at 25 of them (and the last), clouds and surfaces at 5. Every step is still simulated
+/// with the same draws; the full pass then fills in the rest.
+pub const PREVIEW_STEPS: StepPolicy = StepPolicy {
+    max_recorded: 25,
+    max_detailed: 5,
+};
 
 /// How long a remote viewer may take to receive a generation before we move on.
 const FLUSH_TIMEOUT: Duration = Duration::from_secs(5);
@@ -258,16 +267,52 @@ fn run(
     Ok(guard.finish(rec)?)
 }
 
-/// The passes of one job: a preview when the full sample is larger, then the full one.
-fn passes(loaded: &Loaded, overrides: &Overrides) -> Result<Vec<u64>, AppError> {
+/// The passes of one job, as the overrides of each: a quick preview when the full picture is
+/// larger — fewer samples ([`PREVIEW_SAMPLES`], when Monte Carlo has more than twice as
+/// many) and fewer steps kept ([`PREVIEW_STEPS`], when a propagation is longer than its
+/// `max_recorded`) — then the full one. The preview's draws are the full run's first.
+///
+/// # Errors
+/// The settings' error (a value out of range).
+///
+/// ```
+/// use posecov::app::{Overrides, load};
+/// use posecov::app::live::{PREVIEW_SAMPLES, PREVIEW_STEPS, passes};
+/// let barfoot = passes(&load("barfoot_compounding").unwrap(), &Overrides::default()).unwrap();
+/// assert_eq!(barfoot.len(), 2);
+/// assert_eq!((barfoot[0].samples, barfoot[0].steps), (Some(PREVIEW_SAMPLES), Some(PREVIEW_STEPS)));
+/// assert_eq!((barfoot[1].samples, barfoot[1].steps), (Some(5000), None));
+/// let so3 = passes(&load("so3_sampling").unwrap(), &Overrides { samples: Some(1500), ..Default::default() }).unwrap();
+/// assert_eq!(so3.len(), 1);
+/// ```
+pub fn passes(loaded: &Loaded, overrides: &Overrides) -> Result<Vec<Overrides>, AppError> {
     let full = resolve(&loaded.input, overrides, None)?;
     let samples = full.eval.samples as u64;
-    let monte_carlo = full.eval.methods.contains(&Method::MonteCarlo);
-    Ok(if monte_carlo && samples > 2 * PREVIEW_SAMPLES {
-        vec![PREVIEW_SAMPLES, samples]
-    } else {
-        vec![samples]
-    })
+    let fewer_samples =
+        full.eval.methods.contains(&Method::MonteCarlo) && samples > 2 * PREVIEW_SAMPLES;
+    let fewer_steps = loaded.input.plan.longest_propagation() > PREVIEW_STEPS.max_recorded
+        && overrides.steps.is_none();
+    let full = Overrides {
+        samples: Some(samples),
+        ..overrides.clone()
+    };
+    if !(fewer_samples || fewer_steps) {
+        return Ok(vec![full]);
+    }
+    let preview = Overrides {
+        samples: Some(if fewer_samples {
+            PREVIEW_SAMPLES
+        } else {
+            samples
+        }),
+        steps: if fewer_steps {
+            Some(PREVIEW_STEPS)
+        } else {
+            overrides.steps
+        },
+        ..overrides.clone()
+    };
+    Ok(vec![preview, full])
 }
 
 fn show(
@@ -279,19 +324,16 @@ fn show(
 ) -> Result<(), AppError> {
     let passes = passes(&job.loaded, overrides)?;
     let last = passes.len() - 1;
-    for (i, &samples) in passes.iter().enumerate() {
+    for (i, pass) in passes.iter().enumerate() {
+        let samples = pass.samples.unwrap_or_default();
         {
             let mut status = lock(&shared.status);
             status.phase = if i < last { "preview" } else { "full" };
             status.samples = samples;
             shared.changed.notify_all();
         }
-        let pass = Overrides {
-            samples: Some(samples),
-            ..overrides.clone()
-        };
         let mut session =
-            Session::from_loaded(job.loaded.clone(), &pass, Some(Arc::clone(&job.cancel)))?;
+            Session::from_loaded(job.loaded.clone(), pass, Some(Arc::clone(&job.cancel)))?;
         if job.cancel.load(Ordering::SeqCst) {
             return Ok(());
         }
