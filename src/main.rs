@@ -62,14 +62,17 @@ enum Command {
 /// Options of `posecov live`.
 #[derive(Debug, Args)]
 struct LiveArgs {
+    /// A bundled scenario (see `posecov list`) or a TOML scenario file (live mode edits
+    /// scenarios; robot logs and pose graphs are shown without it).
+    scenario: String,
     #[command(flatten)]
-    scenario: ScenarioArgs,
+    settings: EvalArgs,
     #[command(flatten)]
-    sink: LiveSinkArgs,
+    viewer: ViewerArgs,
     #[command(flatten)]
     serve: ServeArgs,
-    /// Address of the control page [default: 127.0.0.1:9091; port 0: any free port]. Only
-    /// loopback unless you give another address here.
+    /// Address of the control page (port 0: any free port). Only loopback unless you give
+    /// another address here.
     #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:9091")]
     bind: std::net::SocketAddr,
     /// File that the page's "Save" writes the current scenario to (comments and layout kept).
@@ -77,29 +80,64 @@ struct LiveArgs {
     save_scenario: Option<PathBuf>,
 }
 
-/// The viewer live mode streams to (default: spawn a viewer, else serve the web viewer).
+/// The viewer to stream to (at most one; default: spawn a viewer if `rerun` is on PATH, else
+/// serve the web viewer).
 #[derive(Debug, Args)]
-#[group(id = "live_sink", multiple = false)]
-struct LiveSinkArgs {
+#[group(id = "viewer", multiple = false)]
+struct ViewerArgs {
     /// Spawn a native `rerun` 0.36 viewer and stream to it.
     #[arg(long)]
     spawn: bool,
     /// Stream to a running viewer [default URL: rerun+http://127.0.0.1:9876/proxy].
     #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = rerun::DEFAULT_CONNECT_URL)]
     connect: Option<String>,
-    /// Serve the embedded web viewer on 127.0.0.1 and show it beside the controls.
+    /// Serve the embedded web viewer on 127.0.0.1 and print its URL (`live`: shown beside
+    /// the controls).
     #[arg(long)]
     serve: bool,
+}
+
+impl ViewerArgs {
+    /// The viewer sink the flags ask for, or `None` for the default.
+    fn sink(&self, o: &ServeOptions) -> Option<Sink> {
+        if let Some(url) = &self.connect {
+            Some(Sink::Connect(url.clone()))
+        } else if self.spawn {
+            Some(Sink::Spawn)
+        } else if self.serve {
+            Some(Sink::Serve {
+                web_port: o.web_port,
+                grpc_port: o.grpc_port,
+                open_browser: o.open_browser,
+            })
+        } else {
+            None
+        }
+    }
 }
 
 /// Which scenario, evaluated how.
 #[derive(Clone, Debug, Args)]
 struct ScenarioArgs {
-    /// A bundled example (see `posecov list`) or a file: a TOML scenario or a g2o / GTSAM pose
-    /// graph (.g2o, .txt), recognised by content and extension.
+    /// A bundled example (see `posecov list`) or a file: a TOML scenario, a g2o / GTSAM pose
+    /// graph (.g2o, .txt), a ROS 1 bag (.bag) or an MCAP file (.mcap), recognised by content
+    /// and extension.
     // `Option` only so that `posecov <COMMAND>` parses; clap requires it otherwise.
     #[arg(required = true)]
     scenario: Option<String>,
+    #[command(flatten)]
+    settings: EvalArgs,
+    /// Robot logs: read only this topic (repeatable; default every pose-with-covariance topic).
+    #[arg(long = "topic", value_name = "NAME")]
+    topics: Vec<String>,
+    /// Robot logs: draw every N-th message (default: at most ~200 per topic, evenly spaced).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    every: Option<u64>,
+}
+
+/// How to evaluate: values that override the file's.
+#[derive(Clone, Debug, Args)]
+struct EvalArgs {
     /// Seed of every random draw (default: the scenario's; same seed, same recording content).
     #[arg(long)]
     seed: Option<u64>,
@@ -114,12 +152,20 @@ struct ScenarioArgs {
     /// stays bounded, statistics use every sample, and each block's cloud is logged in turn.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     block_samples: Option<u64>,
-    /// Robot logs: read only this topic (repeatable; default every pose-with-covariance topic).
-    #[arg(long = "topic", value_name = "NAME")]
-    topics: Vec<String>,
-    /// Robot logs: draw every N-th message (default: at most ~200 per topic, evenly spaced).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
-    every: Option<u64>,
+}
+
+impl EvalArgs {
+    fn overrides(&self) -> Overrides {
+        Overrides {
+            seed: self.seed,
+            samples: self.samples,
+            confidence: self.confidence,
+            block_samples: self.block_samples,
+            topics: Vec::new(),
+            every: None,
+            steps: None,
+        }
+    }
 }
 
 #[derive(Debug, Args)]
@@ -143,22 +189,14 @@ struct ViewArgs {
 
 /// Where the recording goes (at most one; default: spawn a viewer, else serve the web viewer).
 #[derive(Debug, Args)]
-#[group(id = "sink", multiple = false)]
 struct SinkArgs {
-    /// Spawn a native `rerun` 0.36 viewer and stream to it.
-    #[arg(long)]
-    spawn: bool,
-    /// Stream to a running viewer [default URL: rerun+http://127.0.0.1:9876/proxy].
-    #[arg(long, value_name = "URL", num_args = 0..=1, default_missing_value = rerun::DEFAULT_CONNECT_URL)]
-    connect: Option<String>,
-    /// Serve the embedded web viewer on 127.0.0.1 and print its URL (Ctrl-C stops).
-    #[arg(long)]
-    serve: bool,
+    #[command(flatten)]
+    viewer: ViewerArgs,
     /// Write an .rrd file (headless); same seed, same content.
-    #[arg(long, value_name = "FILE.rrd")]
+    #[arg(long, value_name = "FILE.rrd", conflicts_with_all = ["spawn", "connect", "serve", "stdout"])]
     save: Option<PathBuf>,
     /// Write .rrd bytes to stdout, e.g. `posecov camera_on_robot --stdout | rerun -`.
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["spawn", "connect", "serve"])]
     stdout: bool,
 }
 
@@ -210,13 +248,9 @@ impl ScenarioArgs {
 
     fn overrides(&self) -> Overrides {
         Overrides {
-            seed: self.seed,
-            samples: self.samples,
-            confidence: self.confidence,
-            block_samples: self.block_samples,
             topics: self.topics.clone(),
             every: self.every,
-            steps: None,
+            ..self.settings.overrides()
         }
     }
 }
@@ -232,32 +266,13 @@ impl ServeArgs {
     }
 }
 
-/// The viewer sink the flags ask for (at most one is set; clap checks), or `None` for the
-/// default.
-fn viewer_sink(connect: Option<&str>, spawn: bool, serve: bool, o: &ServeOptions) -> Option<Sink> {
-    if let Some(url) = connect {
-        Some(Sink::Connect(url.to_owned()))
-    } else if spawn {
-        Some(Sink::Spawn)
-    } else if serve {
-        Some(Sink::Serve {
-            web_port: o.web_port,
-            grpc_port: o.grpc_port,
-            open_browser: o.open_browser,
-        })
-    } else {
-        None
-    }
-}
-
 impl LiveArgs {
     fn options(&self) -> LiveOptions {
         let serve = self.serve.options();
-        let s = &self.sink;
-        let sink = viewer_sink(s.connect.as_deref(), s.spawn, s.serve, &serve);
+        let sink = self.viewer.sink(&serve);
         LiveOptions {
-            scenario: self.scenario.scenario().to_owned(),
-            overrides: self.scenario.overrides(),
+            scenario: self.scenario.clone(),
+            overrides: self.settings.overrides(),
             sink,
             serve,
             bind: self.bind,
@@ -275,7 +290,7 @@ impl ViewArgs {
         } else if sink.stdout {
             Some(Sink::Stdout)
         } else {
-            viewer_sink(sink.connect.as_deref(), sink.spawn, sink.serve, &serve)
+            sink.viewer.sink(&serve)
         };
         ViewOptions {
             scenario: self.scenario.scenario().to_owned(),

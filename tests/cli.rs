@@ -215,3 +215,46 @@ fn watch_rewrites_on_change_and_survives_errors() {
     assert!(stderr.contains("[1] streamed"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// At most one place for the recording, named as the user typed it; live mode takes the
+/// evaluation flags but not the robot-log ones. Nothing is written when the flags conflict.
+#[test]
+fn conflicting_sinks_are_refused_by_name() {
+    let dir = scratch("sinks");
+    let rrd = dir.join("x.rrd");
+    let rrd_arg = rrd.to_str().unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["camera_on_robot", "--save", rrd_arg, "--serve"],
+            "'--save <FILE.rrd>' cannot be used with '--serve'",
+        ),
+        (
+            &["camera_on_robot", "--stdout", "--connect"],
+            "'--stdout' cannot be used with '--connect [<URL>]'",
+        ),
+        (
+            &["camera_on_robot", "--spawn", "--serve"],
+            "'--spawn' cannot be used with '--serve'",
+        ),
+        (
+            &["camera_on_robot", "--save", rrd_arg, "--stdout"],
+            "'--save <FILE.rrd>' cannot be used with '--stdout'",
+        ),
+        (
+            &["live", "camera_on_robot", "--spawn", "--connect"],
+            "'--spawn' cannot be used with '--connect [<URL>]'",
+        ),
+        (
+            &["live", "camera_on_robot", "--topic", "/odom"],
+            "unexpected argument '--topic'",
+        ),
+    ];
+    for (args, expected) in cases {
+        let out = Command::new(BIN).args(args).output().expect("run posecov");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(!rrd.exists(), "{args:?} wrote a recording");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

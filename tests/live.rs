@@ -43,10 +43,18 @@ fn start(name: &str, samples: u64) -> (Arc<Live>, Status) {
     (live, status)
 }
 
-/// A fresh recording of the current text of `live`.
+/// A fresh recording of the current text of `live` (its description with live mode's note of
+/// the values changed from the file).
 fn fresh(live: &Live) -> Vec<u8> {
     let text = live.with_doc(|d| d.text());
-    let loaded = load_text(&text, "fresh.toml").unwrap();
+    let mut loaded = load_text(&text, "fresh.toml").unwrap();
+    let about = live.with_doc(|d| d.loaded().input.about.clone());
+    assert!(
+        about
+            .description
+            .starts_with(&loaded.input.about.description)
+    );
+    loaded.input.about = about;
     let (_, scene) = pipeline(&loaded, &Overrides::default(), None).unwrap();
     scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("fresh", 0)).unwrap()
 }

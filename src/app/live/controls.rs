@@ -454,8 +454,8 @@ fn range(x: f64, integer: bool, spread: bool, angle: Option<Angle>) -> (f64, f64
         (true, Some(Angle::Degrees)) => (0.0, (4.0 * x).clamp(10.0, 180.0).max(x)),
         (true, Some(Angle::Radians)) => (0.0, (4.0 * x).clamp(0.2, 3.2).max(x)),
         (true, None) => (0.0, if x > 0.0 { 4.0 * x } else { 1.0 }),
-        (false, Some(Angle::Degrees)) => (-180.0_f64.min(x), 180.0_f64.max(x)),
-        (false, Some(Angle::Radians)) => (-3.2_f64.min(x), 3.2_f64.max(x)),
+        (false, Some(Angle::Degrees)) => ((-180.0_f64).min(x), 180.0_f64.max(x)),
+        (false, Some(Angle::Radians)) => ((-3.2_f64).min(x), 3.2_f64.max(x)),
         (false, None) => {
             let r = (2.0 * x.abs()).max(1.0);
             (x - r, x + r)
@@ -527,5 +527,12 @@ mod tests {
     fn an_angular_spread_spans_four_times_the_file_value() {
         assert_eq!(range(20.0, false, true, Some(Angle::Degrees)).1, 80.0);
         assert_eq!(range(3.0, true, true, None), (1.0, 12.0, 1.0));
+    }
+
+    #[test]
+    fn an_angle_spans_a_turn_around_zero() {
+        assert_eq!(range(30.0, false, false, Some(Angle::Degrees)).0, -180.0);
+        assert_eq!(range(0.0, false, false, Some(Angle::Radians)).0, -3.2);
+        assert_eq!(range(-200.0, false, false, Some(Angle::Degrees)).0, -200.0);
     }
 }

@@ -77,6 +77,8 @@ pub struct LiveDocument {
     source: String,
     doc: DocumentMut,
     loaded: Loaded,
+    /// The controls as the file has them (what [`changes`] compares with).
+    file_controls: Vec<Control>,
 }
 
 impl LiveDocument {
@@ -94,12 +96,15 @@ impl LiveDocument {
     pub fn new(text: &str, origin: &str) -> Result<Self, AppError> {
         let loaded = load_text(text, origin)?;
         let doc = parse(text, origin)?;
-        Ok(Self {
+        let mut live = Self {
             origin: origin.to_owned(),
             source: text.to_owned(),
             doc,
             loaded,
-        })
+            file_controls: Vec::new(),
+        };
+        live.file_controls = live.controls();
+        Ok(live)
     }
 
     /// Opens a bundled scenario by name or a scenario file (`.toml`); other inputs are
@@ -191,8 +196,10 @@ impl LiveDocument {
         let mut doc = self.doc.clone();
         write(&mut doc, &slot, edit.value)?;
         let text = doc.to_string();
-        let loaded = load_text(&text, &self.origin)?;
+        let mut loaded = load_text(&text, &self.origin)?;
         self.doc = doc;
+        let note = changes(&self.file_controls, &self.controls());
+        loaded.input.about.description.push_str(&note);
         self.loaded = loaded;
         Ok(())
     }
@@ -213,6 +220,70 @@ impl LiveDocument {
         *self = next;
         Ok(())
     }
+}
+
+/// The values changed from the file, as a paragraph for the description (the file's prose
+/// still speaks of the file's values): "**Changed live:** pose map_from_robot σ θ = 40°
+/// (file: 20°); …". Empty when nothing differs.
+///
+/// ```
+/// use posecov::app::live::{Edit, EditValue, LiveDocument};
+/// let mut live = LiveDocument::open("camera_on_robot").unwrap();
+/// live.apply(&Edit { id: "pose[0].cov.std_deg[2]".into(), value: EditValue::Number(40.0) }).unwrap();
+/// let text = &live.loaded().input.about.description;
+/// assert!(text.ends_with("**Changed live:** pose map_from_robot σ θ = 40° (file: 20°)."), "{text}");
+/// ```
+fn changes(file: &[Control], now: &[Control]) -> String {
+    let value = |c: &Control| match c.kind {
+        ControlKind::Number { value, .. } => format!("{}{}", trim(value), c.unit),
+        ControlKind::Toggle { value } => (if value { "on" } else { "off" }).to_owned(),
+    };
+    let differ: Vec<String> = now
+        .iter()
+        .filter_map(|c| {
+            let was = file.iter().find(|f| f.id == c.id)?;
+            (was.kind != c.kind).then(|| {
+                format!(
+                    "{} {} = {} (file: {})",
+                    c.section,
+                    c.label,
+                    value(c),
+                    value(was)
+                )
+            })
+        })
+        .collect();
+    if differ.is_empty() {
+        String::new()
+    } else {
+        format!("\n\n**Changed live:** {}.", differ.join("; "))
+    }
+}
+
+/// A number in six significant digits, without trailing zeros: `40`, `0.05`, `0.3` (for
+/// 0.30000000000000004), `1.5e-5`.
+fn trim(x: f64) -> String {
+    let magnitude = x.abs();
+    if x == 0.0 || !x.is_finite() {
+        return x.to_string();
+    }
+    let short = |digits: &str| {
+        if digits.contains('.') {
+            digits
+                .trim_end_matches('0')
+                .trim_end_matches('.')
+                .to_owned()
+        } else {
+            digits.to_owned()
+        }
+    };
+    if !(1e-4..1e6).contains(&magnitude) {
+        let sci = format!("{x:.5e}");
+        let (mantissa, exponent) = sci.split_once('e').unwrap_or((&sci, "0"));
+        return format!("{}e{exponent}", short(mantissa));
+    }
+    let decimals = (5 - magnitude.log10().floor() as i32).clamp(0, 9) as usize;
+    short(&format!("{x:.decimals$}"))
 }
 
 fn parse(text: &str, origin: &str) -> Result<DocumentMut, AppError> {
@@ -349,5 +420,22 @@ fn value_leaf<'a>(value: &'a mut Value, rest: &[Seg]) -> Option<&'a mut Value> {
         (Value::InlineTable(t), [Seg::Key(k), tail @ ..]) => value_leaf(t.get_mut(k)?, tail),
         (Value::Array(a), [Seg::Index(i), tail @ ..]) => value_leaf(a.get_mut(*i)?, tail),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::trim;
+
+    #[test]
+    fn numbers_read_as_typed() {
+        assert_eq!(trim(40.0), "40");
+        assert_eq!(trim(0.05), "0.05");
+        assert_eq!(trim(0.1 + 0.2), "0.3");
+        assert_eq!(trim(-1.25), "-1.25");
+        assert_eq!(trim(123_456.0), "123456");
+        assert_eq!(trim(0.0), "0");
+        assert_eq!(trim(1.5e-5), "1.5e-5");
+        assert_eq!(trim(2e7), "2e7");
     }
 }
