@@ -120,7 +120,7 @@ impl ViewerArgs {
 #[derive(Clone, Debug, Args)]
 struct ScenarioArgs {
     /// A bundled example (see `posecov list`) or a file: a TOML scenario, a g2o / GTSAM pose
-    /// graph (.g2o, .txt), a ROS 1 bag (.bag) or an MCAP file (.mcap), recognised by content
+    /// graph (.g2o, .txt, TORO .graph), a ROS 1 bag (.bag) or an MCAP file (.mcap), recognised by content
     /// and extension.
     // `Option` only so that `posecov <COMMAND>` parses; clap requires it otherwise.
     #[arg(required = true)]

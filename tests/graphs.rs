@@ -84,6 +84,39 @@ fn pose2example_numbers_are_read_exactly() {
     assert_eq!(names, ["odometry_chain", "v9_via_v5", "v10_via_v3"]);
 }
 
+/// TORO's `EDGE2` (OpenSLAM TORO's format) writes the information as xx xy yy θθ xθ yθ; the
+/// same edge written as `EDGE_SE2` (upper triangle xx xy xθ yy yθ θθ) reads to the same Σ, and
+/// a bad number is named by its entry where it stands in the TORO line.
+#[test]
+fn toro_edge2_reads_the_information_in_toros_order() {
+    let g2o = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 1 0 0.1 40 3 1.5 25 -2 90\n";
+    let toro = "VERTEX2 0 0 0 0\nVERTEX2 1 1 0 0\nEDGE2 0 1 1 0 0.1 40 3 25 90 1.5 -2\n";
+    let noise = |text: &str| {
+        let AnyPlan::Se2(plan) = input(text).plan else {
+            panic!("planar")
+        };
+        let ops: Vec<_> = plan.operations.iter().map(|o| o.op.clone()).collect();
+        chain_noise(&ops)[0]
+    };
+    let expected = Matrix3::new(40.0, 3.0, 1.5, 3.0, 25.0, -2.0, 1.5, -2.0, 90.0)
+        .try_inverse()
+        .expect("invertible");
+    assert!((noise(g2o) - expected).norm() <= 1e-15 * expected.norm());
+    assert!((noise(toro) - expected).norm() <= 1e-15 * expected.norm());
+    // TORO's classic isotropic edge (xx 0 yy θθ 0 0) is positive definite in TORO's order
+    // (read as an upper triangle it would put θθ = 0 and be refused).
+    let diagonal = "VERTEX2 0 0 0 0\nVERTEX2 1 1 0 0\nEDGE2 0 1 1 0 0 20 0 20 100 0 0\n";
+    let d = noise(diagonal);
+    assert!((d - Matrix3::from_diagonal(&nalgebra::Vector3::new(0.05, 0.05, 0.01))).norm() < 1e-15);
+    // The 4th information number of a TORO line is I(θ,θ), at its own column.
+    let bad = "VERTEX2 0 0 0 0\nEDGE2 0 1 1 0 0 20 0 20 nan 0 0\n";
+    let e = read_text(bad, "g.graph").unwrap_err().to_string();
+    assert!(
+        e.starts_with("g.graph:2:25: EDGE2 0 1: I(θ,θ) = nan is not a finite number"),
+        "{e}"
+    );
+}
+
 #[test]
 fn reversed_chain_edge_is_inverted_with_its_covariance_moved() {
     // noisyToyGraph has edges 0→1, 1→2, 2→3 and loop closures 2→0, 0→3. Reverse one.
@@ -383,6 +416,12 @@ fn huge_files_are_refused_before_reading() {
 fn formats_are_decided_by_content_and_extension() {
     let graph = scratch("g.g2o", POSE2.as_bytes());
     let (source, _) = open(graph.to_str().expect("utf-8")).expect("a graph");
+    assert_eq!(source.format(), Format::Graph);
+    let toro = scratch(
+        "w.graph",
+        b"VERTEX2 0 0 0 0\nVERTEX2 1 1 0 0\nEDGE2 0 1 1 0 0 20 0 20 100 0 0\n",
+    );
+    let (source, _) = open(toro.to_str().expect("utf-8")).expect("a TORO graph");
     assert_eq!(source.format(), Format::Graph);
     let no_extension = scratch("pose2", POSE2.as_bytes());
     assert_eq!(

@@ -71,7 +71,7 @@ fn list_shows_the_bundled_graphs_and_they_run() {
     let (ok, stdout, _) = run(&["list"]);
     assert!(ok);
     assert!(
-        stdout.contains("g2o / GTSAM pose graphs (.g2o, .txt):"),
+        stdout.contains("g2o / GTSAM pose graphs (.g2o, .txt, .graph):"),
         "{stdout}"
     );
     for name in ["gtsam_pose2example", "gtsam_pose3example"] {

@@ -7,7 +7,7 @@
 //! | TOML scenario | `.toml` | text whose first line that is not a comment is a `[table]` or `key = value` |
 //! | ROS 1 bag | `.bag` | starts with `#ROSBAG V2.0\n` |
 //! | MCAP (ROS 2 bag) | `.mcap` | starts with `\x89MCAP0\r\n` |
-//! | g2o / GTSAM pose graph | `.g2o`, `.txt` | text whose first token that is not a comment is `VERTEX_SE2`, `EDGE_SE2`, `VERTEX_SE3:QUAT`, `EDGE_SE3:QUAT`, `VERTEX2` or `EDGE2` |
+//! | g2o / GTSAM / TORO pose graph | `.g2o`, `.txt`, `.graph` | text whose first token that is not a comment is `VERTEX_SE2`, `EDGE_SE2`, `VERTEX_SE3:QUAT`, `EDGE_SE3:QUAT`, `VERTEX2` or `EDGE2` |
 
 use std::io::Read as _;
 use std::path::Path;
@@ -89,14 +89,14 @@ impl Format {
     ///
     /// ```
     /// use posecov::input::Format;
-    /// assert_eq!(Format::Graph.extensions(), &["g2o", "txt"]);
+    /// assert_eq!(Format::Graph.extensions(), &["g2o", "txt", "graph"]);
     /// ```
     pub fn extensions(self) -> &'static [&'static str] {
         match self {
             Format::Scenario => &["toml"],
             Format::Ros1Bag => &["bag"],
             Format::Mcap => &["mcap"],
-            Format::Graph => &["g2o", "txt"],
+            Format::Graph => &["g2o", "txt", "graph"],
         }
     }
 

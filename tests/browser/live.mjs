@@ -31,7 +31,12 @@ const browser = await chromium.launchPersistentContext(profile, {
 let code = 1;
 try {
   const page = browser.pages()[0] || await browser.newPage();
-  page.on("console", (m) => { if (m.type() === "error") console.error("page:", m.text()); });
+  // The control page's own errors; the embedded viewer's (e.g. fetches it makes to the
+  // internet, which a sandbox refuses) are not the page's and are left out.
+  const origin = new URL(url).origin;
+  page.on("console", (m) => {
+    if (m.type() === "error" && (m.location().url || "").startsWith(origin)) console.error("page:", m.text(), m.location().url);
+  });
   await page.goto(url);
   const slider = page.locator(`input[type=range][data-id="${ID}"]`);
   await slider.waitFor({ timeout: 30000 });

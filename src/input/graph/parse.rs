@@ -2,7 +2,8 @@
 //!
 //! One record per line: a tag and whitespace-separated values; `#` starts a comment. Read:
 //! `VERTEX_SE2 id x y θ`, `VERTEX2` (the same), `EDGE_SE2 i j x y θ` + the 6 numbers of the
-//! information matrix's upper triangle (xx xy xθ yy yθ θθ), `EDGE2` (the same),
+//! information matrix's upper triangle (xx xy xθ yy yθ θθ), TORO's `EDGE2 i j x y θ` + the same
+//! 6 numbers in TORO's order (xx xy yy θθ xθ yθ; [`InformationOrder::Toro`]),
 //! `VERTEX_SE3:QUAT id x y z qx qy qz qw`, `EDGE_SE3:QUAT i j x y z qx qy qz qw` + 21 numbers
 //! (the upper triangle over (x, y, z, qx, qy, qz)). Other g2o records posecov does not draw
 //! (landmarks, `FIX`, parameters) are counted and skipped; any other first token is an error.
@@ -27,6 +28,34 @@ pub enum Kind {
     Edge,
 }
 
+/// How an edge writes its information matrix's entries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InformationOrder {
+    /// The upper triangle row by row (g2o, GTSAM): for SE(2) xx xy xθ yy yθ θθ.
+    UpperTriangle,
+    /// TORO's `EDGE2` (OpenSLAM TORO's file format: `inf_ff inf_fs inf_ss inf_rr inf_fr
+    /// inf_sr`, f forward, s sideways, r rotation): xx xy yy θθ xθ yθ.
+    Toro,
+}
+
+impl InformationOrder {
+    /// The upper-triangle position of the `k`-th number as the file writes it.
+    ///
+    /// ```
+    /// use posecov::input::graph::parse::InformationOrder;
+    /// assert_eq!(InformationOrder::UpperTriangle.upper_index(3), 3);
+    /// assert_eq!(InformationOrder::Toro.upper_index(3), 5); // θθ, upper-triangle index 5
+    /// assert_eq!(InformationOrder::Toro.upper_index(4), 2); // xθ
+    /// ```
+    pub fn upper_index(self, k: usize) -> usize {
+        const TORO: [usize; 6] = [0, 1, 3, 5, 2, 4];
+        match self {
+            Self::UpperTriangle => k,
+            Self::Toro => TORO.get(k).copied().unwrap_or(k),
+        }
+    }
+}
+
 /// A tag posecov reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Tag {
@@ -36,6 +65,8 @@ pub struct Tag {
     pub kind: Kind,
     /// Planar or spatial.
     pub dimension: Dimension,
+    /// How an edge's information is written (vertices: unused).
+    pub order: InformationOrder,
 }
 
 /// Every tag read, with its meaning.
@@ -44,31 +75,37 @@ pub const TAGS: &[Tag] = &[
         name: "VERTEX_SE2",
         kind: Kind::Vertex,
         dimension: Dimension::Planar,
+        order: InformationOrder::UpperTriangle,
     },
     Tag {
         name: "VERTEX2",
         kind: Kind::Vertex,
         dimension: Dimension::Planar,
+        order: InformationOrder::UpperTriangle,
     },
     Tag {
         name: "EDGE_SE2",
         kind: Kind::Edge,
         dimension: Dimension::Planar,
+        order: InformationOrder::UpperTriangle,
     },
     Tag {
         name: "EDGE2",
         kind: Kind::Edge,
         dimension: Dimension::Planar,
+        order: InformationOrder::Toro,
     },
     Tag {
         name: "VERTEX_SE3:QUAT",
         kind: Kind::Vertex,
         dimension: Dimension::Spatial,
+        order: InformationOrder::UpperTriangle,
     },
     Tag {
         name: "EDGE_SE3:QUAT",
         kind: Kind::Edge,
         dimension: Dimension::Spatial,
+        order: InformationOrder::UpperTriangle,
     },
 ];
 
@@ -111,7 +148,8 @@ pub struct Record {
     pub ids: Vec<(u64, usize)>,
     /// The pose or measurement values (3 for SE(2), 7 for SE(3)).
     pub pose: Vec<Value>,
-    /// The information matrix's upper triangle (edges only: 6 or 21).
+    /// The information matrix's upper triangle, row by row, whatever the file's order (edges
+    /// only: 6 or 21), each value with its place in the file.
     pub information: Vec<Value>,
 }
 
@@ -283,8 +321,12 @@ fn record(
         let what = match tag.kind {
             Kind::Vertex => format!("id {}", pose_names.join(" ")),
             Kind::Edge => format!(
-                "i j {} and the {info_count} numbers of the information matrix's upper triangle",
-                pose_names.join(" ")
+                "i j {} and the {info_count} numbers of the information matrix{}",
+                pose_names.join(" "),
+                match tag.order {
+                    InformationOrder::UpperTriangle => "'s upper triangle",
+                    InformationOrder::Toro => " in TORO's order: xx xy yy θθ xθ yθ",
+                }
             ),
         };
         let place = values.get(expected).map_or(at, |v| v.1);
@@ -340,11 +382,11 @@ fn record(
         .zip(pose_names)
         .map(|(t, name)| number(*t, name))
         .collect::<Result<Vec<_>, _>>()?;
-    let information = values[id_count + pose_names.len()..]
-        .iter()
-        .enumerate()
-        .map(|(k, t)| number(*t, &super::convention::upper_triangle_name(axes, k)))
-        .collect::<Result<Vec<_>, _>>()?;
+    let mut information = vec![Value { value: 0.0, at }; info_count];
+    for (k, t) in values[id_count + pose_names.len()..].iter().enumerate() {
+        let upper = tag.order.upper_index(k);
+        information[upper] = number(*t, &super::convention::upper_triangle_name(axes, upper))?;
+    }
     Ok(Record {
         tag,
         line,
