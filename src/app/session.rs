@@ -277,12 +277,17 @@ pub(crate) fn serve(
     cancel: &AtomicBool,
 ) -> Result<(), AppError> {
     let limit = serve_limit(options)?;
+    say_serving(limit);
+    guard.serve_until(cancel, limit);
+    Ok(())
+}
+
+/// Tells the user how long a server stays up.
+pub(crate) fn say_serving(limit: Option<Duration>) {
     match limit {
         Some(l) => eprintln!("Serving for {} s (Ctrl-C stops).", l.as_secs()),
         None => eprintln!("Serving until Ctrl-C."),
     }
-    guard.serve_until(cancel, limit);
-    Ok(())
 }
 
 /// `--watch`: evaluate, stream, and again whenever the file changes. A viewer gets one

@@ -10,7 +10,9 @@ use std::time::Duration;
 use super::document::{Edit, EditValue, LiveDocument};
 use super::server::{PageOptions, serve_page};
 use super::worker::{Live, passes};
-use crate::app::session::{ServeOptions, ViewOptions, choose_sink, scenario_name, serve_limit};
+use crate::app::session::{
+    ServeOptions, ViewOptions, choose_sink, say_serving, scenario_name, serve_limit,
+};
 use crate::app::{AppError, Overrides, pipeline};
 use crate::sink::{RecordingIds, Sink, open_stream};
 
@@ -99,7 +101,7 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
             println!("Web viewer: {v}");
         }
         println!("Controls: {url}");
-        eprintln!("Serving until Ctrl-C.");
+        say_serving(limit);
     });
     cancel.store(true, Ordering::SeqCst);
     live.finish()?;
