@@ -111,6 +111,28 @@ fn save_writes_a_recording_and_every_thins_it() {
         size(&thin),
         size(&all)
     );
+    // The Jackal's stamps are simulated time (47.584 s … 108.764 s): the `stamp` timeline
+    // holds durations, not 1970 dates, and every stamped chunk agrees.
+    let bytes = std::fs::read(&thin).unwrap();
+    let stamped: Vec<_> = rrd::recording_chunks(&bytes)
+        .into_iter()
+        .filter_map(|c| c.timelines().get(&"stamp".into()).cloned())
+        .collect();
+    assert!(!stamped.is_empty());
+    for column in &stamped {
+        assert_eq!(
+            column.timeline().typ(),
+            rerun::external::re_log_types::TimeType::DurationNs
+        );
+    }
+    let first = stamped.iter().map(|c| c.time_range().min().as_i64()).min();
+    assert_eq!(first, Some(47_584_000_000), "{first:?}");
+    // Each plot's time axis spans the log (the viewer's default window would cut its start).
+    let ranges = rrd::store_chunks(&bytes, rerun::StoreKind::Blueprint)
+        .iter()
+        .filter(|c| c.entity_path().to_string().ends_with("/TimeAxis"))
+        .count();
+    assert_eq!(ranges, 3, "σ of position, σ of rotation, trace");
     std::fs::remove_dir_all(&dir).ok();
 }
 

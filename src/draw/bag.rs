@@ -94,10 +94,20 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
         methods: Vec::new(),
     };
     p.scene.planar = planar;
-    p.scene.timeline = Timeline::Stamp;
     for (k, topic) in e.topics.iter().enumerate() {
         draw_topic(&mut p, k, topic);
     }
+    // Dates, or durations when the stamps are not dates (simulated time).
+    let stamps = p.scene.items.iter().filter_map(|i| match i.timing {
+        Timing::Stamp(ns) => Some(ns),
+        Timing::Static | Timing::Step(_) => None,
+    });
+    let series = p
+        .scene
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|q| q.0));
+    p.scene.timeline = Timeline::for_stamps(stamps.chain(series));
     plots(&mut p.scene, e);
     // Views and cameras as for every scene: a planar log from straight above.
     let plan = views::ViewPlan {

@@ -111,8 +111,35 @@ pub enum Timeline {
     /// The `step` sequence (propagation steps; series points are steps).
     #[default]
     Step,
-    /// The `stamp` time timeline (robot logs; series points are nanoseconds).
+    /// The `stamp` time timeline as dates (robot logs with wall-clock stamps; series points
+    /// are nanoseconds since the epoch).
     Stamp,
+    /// The `stamp` time timeline as durations (robot logs whose stamps are not dates —
+    /// simulated time, time since boot — [`Timeline::for_stamps`]; series points are
+    /// nanoseconds since that clock's zero).
+    Elapsed,
+}
+
+impl Timeline {
+    /// Stamps before this (2000-01-01T00:00:00Z, in nanoseconds since the epoch) are not
+    /// wall-clock dates: ROS simulated time starts at 0, time since boot is small.
+    pub const FIRST_DATE_NS: i64 = 946_684_800_000_000_000;
+
+    /// The timeline for a robot log's stamps: dates when every stamp is one, else durations
+    /// (a log in simulated time reads "47.6 s", not "1970-01-01 00:00:47.6").
+    ///
+    /// ```
+    /// use posecov::scene::Timeline;
+    /// assert_eq!(Timeline::for_stamps([47_584_000_000, 108_764_000_000]), Timeline::Elapsed);
+    /// assert_eq!(Timeline::for_stamps([1_700_000_000_000_000_000]), Timeline::Stamp);
+    /// ```
+    pub fn for_stamps(stamps: impl IntoIterator<Item = i64>) -> Self {
+        if stamps.into_iter().all(|ns| ns >= Self::FIRST_DATE_NS) {
+            Self::Stamp
+        } else {
+            Self::Elapsed
+        }
+    }
 }
 
 /// How an ellipsoid is drawn.

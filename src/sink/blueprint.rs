@@ -27,10 +27,11 @@ use rr::blueprint::components::{
 use rr::components::{Name, Position3D, Vector3D, Visible};
 use rr::external::re_log_types::BlueprintActivationCommand;
 use rr::external::re_sdk_types::blueprint::archetypes::{
-    ContainerBlueprint, EntityBehavior, EyeControls3D, PanelBlueprint, TimePanelBlueprint,
-    ViewBlueprint, ViewContents, ViewportBlueprint,
+    ContainerBlueprint, EntityBehavior, EyeControls3D, PanelBlueprint, TimeAxis,
+    TimePanelBlueprint, ViewBlueprint, ViewContents, ViewportBlueprint,
 };
-use rr::external::re_sdk_types::blueprint::components::{ColumnShare, GridColumns};
+use rr::external::re_sdk_types::blueprint::components::{ColumnShare, GridColumns, TimeRange};
+use rr::external::re_sdk_types::datatypes::{self, TimeInt, TimeRangeBoundary};
 use rr::external::re_sdk_types::datatypes::{Float32, UInt32, Uuid};
 
 use super::rerun::{STAMP_TIMELINE, STEP_TIMELINE};
@@ -104,13 +105,14 @@ fn layout_messages(
     let mut shares = vec![3.0];
     for plot in &scene.plots {
         let origin = format!("{}/{}", scene::PLOTS, plot.id);
-        right.push(log_view(
-            &bp,
-            &mut ids,
-            "TimeSeries",
-            &plot.label(),
-            &origin,
-        )?);
+        let view = log_view(&bp, &mut ids, "TimeSeries", &plot.label(), &origin)?;
+        if let Some(range) = stamp_range(scene, &origin) {
+            bp.log(
+                format!("{view}/TimeAxis"),
+                &TimeAxis::new().with_view_range(range),
+            )?;
+        }
+        right.push(view);
         shares.push(2.0);
     }
     let right = log_container(&bp, &mut ids, ContainerKind::Vertical, &right, &shares)?;
@@ -139,7 +141,7 @@ fn layout_messages(
             .with_timeline(TimelineName(
                 match scene.timeline {
                     scene::Timeline::Step => STEP_TIMELINE,
-                    scene::Timeline::Stamp => STAMP_TIMELINE,
+                    scene::Timeline::Stamp | scene::Timeline::Elapsed => STAMP_TIMELINE,
                 }
                 .into(),
             ))
@@ -151,6 +153,28 @@ fn layout_messages(
         .map(|m| m.store_id().clone())
         .ok_or_else(|| SinkError::Flush("the blueprint stream produced no messages".into()))?;
     Ok((messages, BlueprintActivationCommand::make_active(store)))
+}
+
+/// A robot log's plot shows the whole log: the time axis spans the first to the last stamp of
+/// the series under `origin` (without it the viewer opens a time plot on a window around the
+/// time cursor, cutting off the start). Step plots keep the viewer's own fit (`None`).
+fn stamp_range(scene: &Scene, origin: &str) -> Option<TimeRange> {
+    if scene.timeline == scene::Timeline::Step {
+        return None;
+    }
+    let prefix = format!("{origin}/");
+    let stamps = scene
+        .series
+        .iter()
+        .filter(|s| s.path.starts_with(&prefix))
+        .flat_map(|s| s.points.iter().map(|p| p.0));
+    let (first, last) = stamps.fold(None, |r: Option<(i64, i64)>, t| {
+        Some(r.map_or((t, t), |(a, b)| (a.min(t), b.max(t))))
+    })?;
+    Some(TimeRange(datatypes::TimeRange {
+        start: TimeRangeBoundary::Absolute(TimeInt(first)),
+        end: TimeRangeBoundary::Absolute(TimeInt(last)),
+    }))
 }
 
 /// A blueprint id: the UUID and its text, as used in entity paths.

@@ -61,11 +61,16 @@ pub fn log_scene_cancellable(
     rec.set_log_tick_enabled(false);
     // The recording's name, sent like `send_recording_name` but as a chunk in sequence.
     let name = rr::RecordingInfo::update_fields().with_name(scene.title.as_str());
-    send(rec, rr::EntityPath::properties(), Timing::Static, &[&name])?;
+    send(
+        rec,
+        rr::EntityPath::properties(),
+        rr::TimePoint::default(),
+        &[&name],
+    )?;
     send(
         rec,
         scene::WORLD,
-        Timing::Static,
+        rr::TimePoint::default(),
         // z is up in every scene (planar ones lie in the x–y plane, the grid's plane); each
         // view's camera says where the eye is.
         &[&rr::ViewCoordinates::RIGHT_HAND_Z_UP()],
@@ -73,7 +78,7 @@ pub fn log_scene_cancellable(
     send(
         rec,
         scene::DESCRIPTION,
-        Timing::Static,
+        rr::TimePoint::default(),
         &[&rr::TextDocument::from_markdown(
             scene.description_markdown.as_str(),
         )],
@@ -127,22 +132,29 @@ fn log_items(
             };
             return Ok(LogOutcome::Cancelled { next_step });
         }
-        log_item(rec, item)?;
+        log_item(rec, item, scene.timeline)?;
     }
     Ok(LogOutcome::Complete)
 }
 
 /// Where an item of `timing` is logged: nowhere on a timeline (static), at a step of the `step`
-/// sequence, or at a stamp (nanoseconds) of the `stamp` timeline.
-pub(super) fn time_point(timing: Timing) -> rr::TimePoint {
+/// sequence, or at a stamp (nanoseconds) of the `stamp` timeline — a date, or a duration when
+/// the scene's `timeline` is [`Timeline::Elapsed`](scene::Timeline::Elapsed).
+pub(super) fn time_point(timing: Timing, timeline: scene::Timeline) -> rr::TimePoint {
     match timing {
         Timing::Static => rr::TimePoint::default(),
         Timing::Step(k) => {
             rr::TimePoint::default().with(rr::Timeline::new_sequence(STEP_TIMELINE), k)
         }
-        Timing::Stamp(ns) => {
-            rr::TimePoint::default().with(rr::Timeline::new_timestamp(STAMP_TIMELINE), ns)
-        }
+        Timing::Stamp(ns) => rr::TimePoint::default().with(
+            match timeline {
+                scene::Timeline::Elapsed => rr::Timeline::new_duration(STAMP_TIMELINE),
+                scene::Timeline::Step | scene::Timeline::Stamp => {
+                    rr::Timeline::new_timestamp(STAMP_TIMELINE)
+                }
+            },
+            ns,
+        ),
     }
 }
 
@@ -150,10 +162,9 @@ pub(super) fn time_point(timing: Timing) -> rr::TimePoint {
 pub(super) fn send(
     rec: &rr::RecordingStream,
     path: impl Into<rr::EntityPath>,
-    timing: Timing,
+    timepoint: rr::TimePoint,
     parts: &[&dyn AsComponents],
 ) -> Result<(), SinkError> {
-    let timepoint = time_point(timing);
     let path = path.into();
     let batches = parts.iter().flat_map(|p| p.as_serialized_batches());
     let chunk = Chunk::builder(path.clone())
@@ -167,8 +178,12 @@ pub(super) fn send(
     Ok(())
 }
 
-fn log_item(rec: &rr::RecordingStream, item: &SceneItem) -> Result<(), SinkError> {
-    let (path, at) = (item.path.as_str(), item.timing);
+fn log_item(
+    rec: &rr::RecordingStream,
+    item: &SceneItem,
+    timeline: scene::Timeline,
+) -> Result<(), SinkError> {
+    let (path, at) = (item.path.as_str(), time_point(item.timing, timeline));
     match &item.kind {
         ItemKind::Frame(frame) => log_frame(rec, path, at, frame),
         ItemKind::Triads(triads) => send(rec, path, at, &[&triad_strips(triads)]),
@@ -191,7 +206,7 @@ fn log_item(rec: &rr::RecordingStream, item: &SceneItem) -> Result<(), SinkError
 fn log_frame(
     rec: &rr::RecordingStream,
     path: &str,
-    at: Timing,
+    at: rr::TimePoint,
     frame: &Frame,
 ) -> Result<(), SinkError> {
     let transform =
@@ -304,13 +319,19 @@ fn log_series(
         .with_names([series.name.as_str()])
         .with_colors([color(series.color)])
         .with_widths([f(series.width)]);
-    send(rec, series.path.as_str(), Timing::Static, &[&style])?;
+    send(
+        rec,
+        series.path.as_str(),
+        rr::TimePoint::default(),
+        &[&style],
+    )?;
     if series.points.is_empty() {
         return Ok(());
     }
     let times = series.points.iter().map(|p| p.0);
     let steps = match timeline {
         scene::Timeline::Step => rr::TimeColumn::new_sequence(STEP_TIMELINE, times),
+        scene::Timeline::Elapsed => rr::TimeColumn::new_duration_nanos(STAMP_TIMELINE, times),
         scene::Timeline::Stamp => {
             rr::TimeColumn::new_timestamp_nanos_since_epoch(STAMP_TIMELINE, times)
         }

@@ -140,7 +140,7 @@ impl Restream {
     fn shadow_series(&mut self, rec: &rr::RecordingStream) -> Result<(), SinkError> {
         let empty = rr::Scalars::new(std::iter::empty::<f64>());
         for path in std::mem::take(&mut self.series) {
-            send(rec, path.as_str(), Timing::Static, &[&empty])?;
+            send(rec, path.as_str(), rr::TimePoint::default(), &[&empty])?;
         }
         Ok(())
     }
@@ -190,6 +190,7 @@ impl Restream {
                 .insert(item.timing, item);
         }
         let mut carried = Scene::new(String::new(), String::new());
+        carried.timeline = next.timeline;
         let mut unlabel = Vec::new();
         for (path, times) in &self.touched {
             let new = at.get(path.as_str());
@@ -218,7 +219,7 @@ impl Restream {
                     _ => true,
                 })
                 .collect();
-            clear_all(rec, path, &cleared, &clear)?;
+            clear_all(rec, path, &cleared, &clear, next.timeline)?;
             for &t in times {
                 let (Timing::Step(step), Some(new)) = (t, new) else {
                     continue;
@@ -235,7 +236,7 @@ impl Restream {
         }
         let no_marker = rr::Points3D::new(std::iter::empty::<[f32; 3]>());
         for (path, t) in unlabel {
-            send(rec, path, t, &[&no_marker])?;
+            send(rec, path, time_point(t, next.timeline), &[&no_marker])?;
         }
         if !carried.items.is_empty() {
             log_part_cancellable(rec, &carried, &AtomicBool::new(false))?;
@@ -266,9 +267,10 @@ fn clear_all(
     path: &str,
     times: &BTreeSet<Timing>,
     clear: &rr::Clear,
+    timeline: scene::Timeline,
 ) -> Result<(), SinkError> {
     if times.contains(&Timing::Static) {
-        send(rec, path, Timing::Static, &[clear])?;
+        send(rec, path, rr::TimePoint::default(), &[clear])?;
     }
     let timed: Vec<Timing> = times
         .iter()
@@ -280,7 +282,7 @@ fn clear_all(
     }
     let mut builder = rr::log::Chunk::builder(rr::EntityPath::from(path));
     for t in timed {
-        builder = builder.with_archetype(rr::log::RowId::new(), time_point(t), clear);
+        builder = builder.with_archetype(rr::log::RowId::new(), time_point(t, timeline), clear);
     }
     let chunk = builder.build().map_err(|err| SinkError::Chunk {
         path: path.to_owned(),

@@ -64,7 +64,8 @@ pub fn description(plan: &BagPlan, e: &BagEvaluation, confidence: f64) -> String
          parent's axes, rotation error local) converted to posecov's body-frame right form, \
          X = μ · Exp(ε); its Exp-mapped banana, Cartesian ellipsoid and a seeded sample cloud \
          (3-D: sampled axis tips).\n\
-         - Regions at {:.1} %; the timeline is the message stamp.",
+         - Regions at {:.1} %; the `stamp` timeline is the message stamp (a date, or the time \
+         since the clock's zero when the stamps are simulated time).",
         confidence * 100.0
     );
     s
