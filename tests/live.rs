@@ -355,6 +355,21 @@ fn a_change_of_views_sends_the_layout_again() {
     assert_same_view(&bytes, &expected, 0);
 }
 
+/// "Frame" sends the layout again (cameras fitted to the current picture) without changing a
+/// value; the picture stays the fresh one.
+#[test]
+fn frame_sends_the_layout_again_and_nothing_else_changes() {
+    let (live, _) = start("camera_on_robot", 1024);
+    live.apply(&edit("pose[0].cov.std_deg[2]", 60.0)).unwrap();
+    assert_eq!(live.wait_done(1, WAIT).shown, Some(1));
+    let generation = live.reframe();
+    assert_eq!(live.wait_done(generation, WAIT).shown, Some(generation));
+    let expected = fresh(&live);
+    let bytes = live.finish().unwrap().unwrap();
+    assert_eq!(layouts(&bytes).len(), 2, "opened with one, framed once");
+    assert_same_view(&bytes, &expected, 0);
+}
+
 /// A frame drawn again at the same position is overwritten, never cleared: the viewer
 /// resolves a cleared transform to the identity even when a newer one follows at that time
 /// (the robot's axes jumped to the origin). Clears stay for what is no longer drawn.

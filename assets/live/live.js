@@ -185,6 +185,11 @@ $("reset").addEventListener("click", async () => {
   if (ok) { render(data); updateStatus(data.status); showError(null); } else showError(data.error);
 });
 
+$("reframe").addEventListener("click", async () => {
+  const { ok, data } = await call("POST", "/api/reframe", {});
+  if (ok) updateStatus(data.status); else showError(data.error);
+});
+
 $("save").addEventListener("click", async () => {
   const { ok, data } = await call("POST", "/api/save", {});
   showError(ok ? null : data.error);

@@ -54,6 +54,8 @@ pub struct Restream {
     /// What the layout sent last is made of ([`layout_key`]; `None`: the opener's layout,
     /// taken to be the first scene's).
     layout: Option<String>,
+    /// Send the layout with the next generation even if its key is the same ([`Self::reframe`]).
+    reframe: bool,
     /// Generations logged so far.
     generation: u64,
 }
@@ -72,6 +74,17 @@ impl Restream {
     /// How many generations were logged.
     pub fn generations(&self) -> u64 {
         self.generation
+    }
+
+    /// Sends the layout again with the next generation, its cameras fitted to that scene
+    /// (a "frame the picture" request: otherwise the viewer keeps the user's camera).
+    ///
+    /// ```
+    /// let mut r = posecov::sink::Restream::new();
+    /// r.reframe();
+    /// ```
+    pub fn reframe(&mut self) {
+        self.reframe = true;
     }
 
     /// Logs `scene` in place of everything logged before (see the module docs): clears,
@@ -105,8 +118,9 @@ impl Restream {
         self.generation += 1;
         self.clear_and_carry(rec, &scene)?;
         let key = layout_key(&scene);
-        if self.layout.as_ref().is_some_and(|sent| *sent != key) {
+        if self.reframe || self.layout.as_ref().is_some_and(|sent| *sent != key) {
             send_layout(rec, &scene)?;
+            self.reframe = false;
         }
         self.layout = Some(key);
         self.shadow_series(rec)?;

@@ -7,6 +7,7 @@
 //! | `GET /api/status` | the evaluation status (generation shown, progress, timings, error) |
 //! | `POST /api/edit` `{"id", "value"}` | 200 with the new state, or 422 `{"error", "field"}` |
 //! | `POST /api/reset` | back to the file's values |
+//! | `POST /api/reframe` | the picture again with the layout, cameras fitted to it |
 //! | `POST /api/save` | writes the current scenario to the `--save-scenario` file |
 //! | `GET /api/scenario.toml` | the current scenario as a download |
 //!
@@ -231,11 +232,15 @@ fn route(app: &App, method: &Method, path: &str, body: &[u8]) -> Response {
             ),
         },
         ("POST", "/api/save") => save(app),
+        ("POST", "/api/reframe") => {
+            app.live.reframe();
+            reply(StatusCode::OK, &state(app))
+        }
         (
             _,
             "/" | "/live.js" | "/live.css" | "/api/state" | "/api/status" | "/api/scenario.toml",
         )
-        | (_, "/api/edit" | "/api/reset" | "/api/save") => reply(
+        | (_, "/api/edit" | "/api/reset" | "/api/save" | "/api/reframe") => reply(
             StatusCode::METHOD_NOT_ALLOWED,
             &json!({ "error": "method not allowed" }),
         ),

@@ -65,6 +65,8 @@ struct Job {
     loaded: Loaded,
     cancel: Arc<AtomicBool>,
     since: Instant,
+    /// Send the layout again, cameras fitted to this picture.
+    reframe: bool,
 }
 
 /// The evaluation thread; it returns the bytes of a memory sink when it ends.
@@ -130,7 +132,7 @@ impl Live {
             thread: Mutex::new(Some(thread)),
             generation: Mutex::new(0),
         });
-        live.submit(false);
+        live.submit(false, false);
         live
     }
 
@@ -141,13 +143,20 @@ impl Live {
     /// [`EditError`]: nothing changes, the last good picture stays.
     pub fn apply(&self, edit: &Edit) -> Result<u64, EditError> {
         lock(&self.doc).apply(edit)?;
-        Ok(self.submit(true))
+        Ok(self.submit(true, false))
     }
 
     /// Returns to the file's values.
     pub fn reset(&self) -> Result<u64, AppError> {
         lock(&self.doc).reset()?;
-        Ok(self.submit(true))
+        Ok(self.submit(true, false))
+    }
+
+    /// Shows the current picture again with the layout re-sent, each 3-D view's camera fitted
+    /// to it (the viewer otherwise keeps the user's camera, e.g. after σ grew the banana out
+    /// of view). Returns the new generation.
+    pub fn reframe(&self) -> u64 {
+        self.submit(true, true)
     }
 
     /// Replaces the source text (`--watch`: the file changed).
@@ -156,7 +165,7 @@ impl Live {
     /// The new text's error; the last good picture stays.
     pub fn replace_source(&self, text: &str) -> Result<u64, AppError> {
         lock(&self.doc).replace_source(text)?;
-        Ok(self.submit(true))
+        Ok(self.submit(true, false))
     }
 
     /// Runs `f` on the document (controls, text, origin).
@@ -207,7 +216,7 @@ impl Live {
         }
     }
 
-    fn submit(&self, newer: bool) -> u64 {
+    fn submit(&self, newer: bool, reframe: bool) -> u64 {
         let generation = {
             let mut g = lock(&self.generation);
             if newer {
@@ -228,6 +237,7 @@ impl Live {
             loaded: lock(&self.doc).loaded().clone(),
             cancel,
             since: Instant::now(),
+            reframe,
         };
         if let Some(tx) = lock(&self.jobs).as_ref() {
             tx.send(job).ok();
@@ -250,7 +260,12 @@ fn run(
     let mut restream = Restream::new();
     while let Ok(mut job) = rx.recv() {
         while let Ok(newer) = rx.try_recv() {
-            job = newer;
+            let reframe = job.reframe || newer.reframe;
+            job = Job { reframe, ..newer };
+        }
+        if job.reframe {
+            // Kept by the restream until a layout is sent, even if this job is cancelled.
+            restream.reframe();
         }
         if let Err(err) = show(&job, &rec, &mut restream, overrides, shared) {
             if job.cancel.load(Ordering::SeqCst) {
