@@ -46,9 +46,9 @@ pub struct Restream {
     touched: BTreeMap<String, BTreeSet<Timing>>,
     /// Entities that were ever static (and so can never show temporal data again).
     ever_static: BTreeSet<String>,
-    /// Frame positions logged with a label (their marker must be emptied if the new frame
-    /// has none).
-    labelled: BTreeSet<(String, Timing)>,
+    /// Positions last logged as a frame, and whether with a label (whose marker must be
+    /// emptied when the new frame has none).
+    frames: BTreeMap<(String, Timing), bool>,
     /// Series logged by earlier generations whose lines are not yet shadowed.
     series: BTreeSet<String>,
     /// What the layout sent last is made of ([`layout_key`]; `None`: the opener's layout,
@@ -87,9 +87,10 @@ impl Restream {
         self.reframe = true;
     }
 
-    /// Logs `scene` in place of everything logged before (see the module docs): clears,
-    /// the scene itself with its series under this generation's paths, and the plots'
-    /// blueprint update. `cancel` as in [`log_scene_cancellable`].
+    /// Logs `scene` in place of everything logged before (see the module docs): clears, the
+    /// layout when the views changed (or after [`reframe`](Self::reframe)), the shadows of
+    /// the last generation's series, then the scene with its series under this generation's
+    /// paths. `cancel` as in [`log_scene_cancellable`].
     ///
     /// # Errors
     /// [`SinkError::Scene`] if the scene is invalid (nothing is logged then), or an SDK error.
@@ -223,14 +224,17 @@ impl Restream {
             let cleared: BTreeSet<Timing> = times
                 .iter()
                 .copied()
-                .filter(|&t| match shown(t).map(|i| &i.kind) {
-                    Some(ItemKind::Frame(frame)) => {
-                        if frame.label.is_none() && self.labelled.contains(&(path.clone(), t)) {
-                            unlabel.push((path.as_str(), t));
+                .filter(|&t| {
+                    let was = self.frames.get(&(path.clone(), t));
+                    match (was, shown(t).map(|i| &i.kind)) {
+                        (Some(&labelled), Some(ItemKind::Frame(frame))) => {
+                            if labelled && frame.label.is_none() {
+                                unlabel.push((path.as_str(), t));
+                            }
+                            false
                         }
-                        false
+                        _ => true,
                     }
-                    _ => true,
                 })
                 .collect();
             clear_all(rec, path, &cleared, &clear, next.timeline)?;
@@ -263,8 +267,8 @@ impl Restream {
         for item in &scene.items {
             let key = (item.path.clone(), item.timing);
             match &item.kind {
-                ItemKind::Frame(frame) if frame.label.is_some() => self.labelled.insert(key),
-                _ => self.labelled.remove(&key),
+                ItemKind::Frame(frame) => self.frames.insert(key, frame.label.is_some()),
+                _ => self.frames.remove(&key),
             };
             self.touched
                 .entry(item.path.clone())
