@@ -266,6 +266,22 @@ impl<G: LieGroup<N>, const N: usize> Op<G, N> {
             _ => 0,
         }
     }
+
+    /// The steps each Monte Carlo particle takes through this operation: the recorded steps,
+    /// a differential drive's Euler–Maruyama steps (⌈duration / dt⌉), at least 1.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, So3};
+    /// use posecov::plan::Op;
+    /// let op = Op::<So3, 3>::EulerVsExp { rate: nalgebra::Vector3::z(), dt: 0.1, steps: 7 };
+    /// assert_eq!(op.particle_steps(), 7);
+    /// ```
+    pub fn particle_steps(&self) -> u64 {
+        match self {
+            Op::DiffDrive { motion, .. } => (motion.duration / motion.dt).ceil() as u64,
+            op => op.steps().max(1),
+        }
+    }
 }
 
 /// An operation with the name of what it defines.
@@ -413,6 +429,28 @@ pub enum AnyPlan {
 }
 
 impl AnyPlan {
+    /// The Monte Carlo work of `samples` particles, in particle-steps: each input pose's
+    /// draw and each operation's [`Op::particle_steps`], times `samples`.
+    ///
+    /// ```
+    /// use posecov::app::load;
+    /// let plan = load("barfoot_compounding").unwrap().input.plan;
+    /// assert_eq!(plan.monte_carlo_work(1000), 1000.0 * (2.0 + 100.0));
+    /// ```
+    pub fn monte_carlo_work(&self, samples: u64) -> f64 {
+        fn steps<G: LieGroup<N>, const N: usize>(plan: &Plan<G, N>) -> f64 {
+            let ops: u64 = plan.operations.iter().map(|o| o.op.particle_steps()).sum();
+            plan.poses.len() as f64 + ops as f64
+        }
+        samples as f64
+            * match self {
+                Self::So2(p) => steps(p),
+                Self::Se2(p) => steps(p),
+                Self::So3(p) => steps(p),
+                Self::Se3(p) => steps(p),
+            }
+    }
+
     /// The most steps any one operation records ([`Op::steps`]; 0 without propagations).
     ///
     /// ```

@@ -326,10 +326,7 @@ fn check_work<G: EvalGroup<N>, const N: usize>(
     let samples = settings.samples;
     let mut work = samples as f64 * plan.poses.len() as f64;
     for (i, o) in plan.operations.iter().enumerate() {
-        let steps = match &o.op {
-            Op::DiffDrive { motion, .. } => (motion.duration / motion.dt).ceil() as u64,
-            op => op.steps().max(1),
-        };
+        let steps = o.op.particle_steps();
         work += samples as f64 * steps as f64;
         if work > limits::MAX_PARTICLE_STEPS {
             return Err(EvalError::TooMuchWork {

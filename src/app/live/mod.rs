@@ -25,7 +25,7 @@ pub use run::{LiveOptions, live, watch_in_place};
 #[cfg(feature = "viewer")]
 pub use server::{PageOptions, serve_page};
 #[cfg(feature = "viewer")]
-pub use worker::{Live, PREVIEW_SAMPLES, PREVIEW_STEPS, Status, passes};
+pub use worker::{Live, PREVIEW_SAMPLES, PREVIEW_STEPS, PREVIEW_WORK, Status, passes};
 
 #[cfg(test)]
 mod tests {

@@ -31,6 +31,11 @@ pub const PREVIEW_STEPS: StepPolicy = StepPolicy {
     max_detailed: 5,
 };
 
+/// Monte Carlo work (particle-steps, [`AnyPlan::monte_carlo_work`](crate::plan::AnyPlan::monte_carlo_work))
+/// up to which the full sample is shown at once, without a preview: it takes a few
+/// milliseconds, and a preview would only make the cloud flicker from sparse to dense.
+pub const PREVIEW_WORK: f64 = 50_000.0;
+
 /// How long a remote viewer may take to receive a generation before we move on.
 const FLUSH_TIMEOUT: Duration = Duration::from_secs(5);
 
@@ -283,9 +288,10 @@ fn run(
 }
 
 /// The passes of one job, as the overrides of each: a quick preview when the full picture is
-/// larger — fewer samples ([`PREVIEW_SAMPLES`], when Monte Carlo has more than twice as
-/// many) and fewer steps kept ([`PREVIEW_STEPS`], when a propagation is longer than its
-/// `max_recorded`) — then the full one. The preview's draws are the full run's first.
+/// large — fewer samples ([`PREVIEW_SAMPLES`], when Monte Carlo has more than twice as many
+/// and more than [`PREVIEW_WORK`] particle-steps) and fewer steps kept ([`PREVIEW_STEPS`],
+/// when a propagation is longer than its `max_recorded`) — then the full one. The preview's
+/// draws are the full run's first.
 ///
 /// # Errors
 /// The settings' error (a value out of range).
@@ -299,12 +305,17 @@ fn run(
 /// assert_eq!((barfoot[1].samples, barfoot[1].steps), (Some(5000), None));
 /// let so3 = passes(&load("so3_sampling").unwrap(), &Overrides { samples: Some(1500), ..Default::default() }).unwrap();
 /// assert_eq!(so3.len(), 1);
+/// // 4000 samples of one composition: shown at once.
+/// assert_eq!(passes(&load("camera_on_robot").unwrap(), &Overrides::default()).unwrap().len(), 1);
+/// let dense = Overrides { samples: Some(40_000), ..Default::default() };
+/// assert_eq!(passes(&load("camera_on_robot").unwrap(), &dense).unwrap()[0].samples, Some(PREVIEW_SAMPLES));
 /// ```
 pub fn passes(loaded: &Loaded, overrides: &Overrides) -> Result<Vec<Overrides>, AppError> {
     let full = resolve(&loaded.input, overrides, None)?;
     let samples = full.eval.samples as u64;
-    let fewer_samples =
-        full.eval.methods.contains(&Method::MonteCarlo) && samples > 2 * PREVIEW_SAMPLES;
+    let fewer_samples = full.eval.methods.contains(&Method::MonteCarlo)
+        && samples > 2 * PREVIEW_SAMPLES
+        && loaded.input.plan.monte_carlo_work(samples) > PREVIEW_WORK;
     let fewer_steps = loaded.input.plan.longest_propagation() > PREVIEW_STEPS.max_recorded
         && overrides.steps.is_none();
     let full = Overrides {
