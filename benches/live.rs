@@ -2,12 +2,13 @@
 //! handed to the viewer, per bundled scenario, the way the live thread does it — apply the
 //! edit to the document (parse + lower: the file's validation), evaluate, draw, re-stream in
 //! place ([`Restream`], with its clears) and encode what was logged (the bytes a viewer
-//! receives). `preview`: the quick first picture, the first of live mode's own
-//! [`passes`] (one random chunk of samples when the scenario's Monte Carlo sample is larger,
-//! fewer steps kept when a propagation is long); `full`: the scenario's own picture.
+//! receives). `preview`: the first picture, the first of live mode's own [`passes`] (one
+//! random chunk of samples when the Monte Carlo work is large, fewer steps kept when a
+//! propagation is long; the whole picture for small scenes); `full`: the scenario's own.
 //!
-//! Run (dev profile, as the tests build; a release build of Rerun is ~20 min cold):
-//! `cargo bench --profile dev --bench live -- --warm-up-time 1 --measurement-time 3`
+//! Run (release, the numbers in BENCHMARKS.md; a cold release build of Rerun is ~20 min):
+//! `cargo bench --bench live -- --warm-up-time 1 --measurement-time 3`; with the test build's
+//! dependencies: `cargo bench --profile dev --bench live -- --warm-up-time 1 --measurement-time 3`.
 
 use std::hint::black_box;
 use std::sync::atomic::AtomicBool;
