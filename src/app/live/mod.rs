@@ -25,7 +25,9 @@ pub use run::{LiveOptions, live, watch_in_place};
 #[cfg(feature = "viewer")]
 pub use server::{PageOptions, serve_page};
 #[cfg(feature = "viewer")]
-pub use worker::{Live, PREVIEW_SAMPLES, PREVIEW_STEPS, PREVIEW_WORK, Status, passes};
+pub use worker::{
+    Live, MIN_PICTURE_INTERVAL, PREVIEW_SAMPLES, PREVIEW_STEPS, PREVIEW_WORK, Status, passes,
+};
 
 #[cfg(test)]
 mod tests {

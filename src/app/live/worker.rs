@@ -36,6 +36,18 @@ pub const PREVIEW_STEPS: StepPolicy = StepPolicy {
 /// milliseconds, and a preview would only make the cloud flicker from sparse to dense.
 pub const PREVIEW_WORK: f64 = 50_000.0;
 
+/// The shortest time between the starts of two pictures. A slider dragged fast then starts
+/// at most 40 pictures a second — each is new data in the viewer and in the served history
+/// (Rerun's gRPC server keeps up to 1 GiB of it for viewers that join later), 200 KB for
+/// camera_on_robot — at the cost of at most this much latency after a picture just started.
+pub const MIN_PICTURE_INTERVAL: Duration = Duration::from_millis(25);
+
+/// How long to wait before starting a picture when the previous one started `since_last`
+/// ago (`None`: none yet).
+fn wait_before(since_last: Option<Duration>) -> Duration {
+    since_last.map_or(Duration::ZERO, |d| MIN_PICTURE_INTERVAL.saturating_sub(d))
+}
+
 /// How long a remote viewer may take to receive a generation before we move on.
 const FLUSH_TIMEOUT: Duration = Duration::from_secs(5);
 
@@ -263,7 +275,10 @@ fn run(
     shared: &Shared,
 ) -> Result<Option<Vec<u8>>, AppError> {
     let mut restream = Restream::new();
+    let mut last_start: Option<Instant> = None;
     while let Ok(mut job) = rx.recv() {
+        std::thread::sleep(wait_before(last_start.map(|t| t.elapsed())));
+        last_start = Some(Instant::now());
         while let Ok(newer) = rx.try_recv() {
             let reframe = job.reframe || newer.reframe;
             job = Job { reframe, ..newer };
@@ -398,4 +413,20 @@ fn show(
         shared.changed.notify_all();
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pictures_start_at_most_every_interval() {
+        assert_eq!(wait_before(None), Duration::ZERO);
+        assert_eq!(
+            wait_before(Some(Duration::from_millis(10))),
+            Duration::from_millis(15)
+        );
+        assert_eq!(wait_before(Some(Duration::from_millis(25))), Duration::ZERO);
+        assert_eq!(wait_before(Some(Duration::from_secs(3))), Duration::ZERO);
+    }
 }
