@@ -94,7 +94,7 @@ pub fn serve_page(
     let addr = listener
         .local_addr()
         .map_err(|e| AppError::Live(e.to_string()))?;
-    let hosts = hosts_of(addr);
+    let hosts = hosts_of(addr, machine_name().as_deref());
     let url = format!("http://{}/", hosts[0]);
     let app = Arc::new(App {
         live,
@@ -118,9 +118,10 @@ pub fn serve_page(
     })
 }
 
-/// The `Host` values that name a server listening on `addr`: the address itself, and for
-/// loopback `localhost` too.
-fn hosts_of(addr: SocketAddr) -> Vec<String> {
+/// The `Host` values that name a server listening on `addr`: the address itself, for
+/// loopback `localhost` too, and bound to every interface also this machine's own name
+/// (`machine`, e.g. `lab-pc` and `lab-pc.local`).
+fn hosts_of(addr: SocketAddr, machine: Option<&str>) -> Vec<String> {
     let port = addr.port();
     let mut hosts = vec![match addr {
         SocketAddr::V4(a) if a.ip().is_unspecified() => format!("127.0.0.1:{port}"),
@@ -132,13 +133,28 @@ fn hosts_of(addr: SocketAddr) -> Vec<String> {
         hosts.push(format!("127.0.0.1:{port}"));
         hosts.push(format!("[::1]:{port}"));
     }
+    if let (true, Some(name)) = (addr.ip().is_unspecified(), machine) {
+        hosts.push(format!("{name}:{port}"));
+        hosts.push(format!("{name}.local:{port}"));
+    }
     hosts.dedup();
     hosts
 }
 
+/// This machine's host name (Linux: the kernel's), for `--bind` to every interface.
+fn machine_name() -> Option<String> {
+    ["/proc/sys/kernel/hostname", "/etc/hostname"]
+        .iter()
+        .find_map(|path| std::fs::read_to_string(path).ok())
+        .map(|name| name.trim().to_owned())
+        .filter(|name| !name.is_empty())
+}
+
 /// Whether the request comes from this server's own page (see the module docs). `hosts`:
 /// the `host:port` values naming this server; `open`: bound to every interface (`--bind
-/// 0.0.0.0:…`), where any host name with this port is accepted.
+/// 0.0.0.0:…`), where an IP address with this port is accepted too (whichever interface
+/// the request came in on). A DNS name other than this machine's own is refused even then:
+/// a foreign name that resolves to this machine is how DNS rebinding reaches it.
 fn allowed(
     hosts: &[String],
     open: bool,
@@ -150,8 +166,18 @@ fn allowed(
         .and_then(|h| h.to_str().ok())
         .ok_or("a Host header is required")?;
     let port = hosts[0].rsplit_once(':').map_or("", |x| x.1);
+    let ip_literal = |name: &str| {
+        name.parse::<std::net::IpAddr>().is_ok()
+            || name
+                .strip_prefix('[')
+                .and_then(|n| n.strip_suffix(']'))
+                .is_some_and(|n| n.parse::<std::net::Ipv6Addr>().is_ok())
+    };
     let own = hosts.iter().any(|o| o.eq_ignore_ascii_case(host))
-        || open && host.rsplit_once(':').is_some_and(|(_, p)| p == port);
+        || open
+            && host
+                .rsplit_once(':')
+                .is_some_and(|(name, p)| p == port && ip_literal(name));
     if !own {
         return Err("Host is not this server");
     }
@@ -365,7 +391,7 @@ mod tests {
 
     #[test]
     fn only_this_servers_own_page_may_drive_it() {
-        let hosts = hosts_of("127.0.0.1:8123".parse().unwrap());
+        let hosts = hosts_of("127.0.0.1:8123".parse().unwrap(), Some("lab-pc"));
         let json = (header::CONTENT_TYPE, "application/json");
         let get = |pairs: &[(header::HeaderName, &str)]| {
             allowed(&hosts, false, &Method::GET, &headers(pairs))
@@ -411,23 +437,50 @@ mod tests {
             ])
             .is_err()
         );
-        // Opened to the network on purpose: any name with this port, still same-origin only.
+        // Opened to the network on purpose: an address of this machine or its own name with
+        // this port, still same-origin only; never a foreign name (DNS rebinding).
+        let open_hosts = hosts_of("0.0.0.0:8123".parse().unwrap(), Some("lab-pc"));
         let open = |pairs: &[(header::HeaderName, &str)]| {
-            allowed(&hosts, true, &Method::GET, &headers(pairs))
+            allowed(&open_hosts, true, &Method::GET, &headers(pairs))
         };
-        assert!(open(&[(header::HOST, "lab-pc.local:8123")]).is_ok());
+        for host in [
+            "192.168.1.20:8123",
+            "[fe80::1]:8123",
+            "lab-pc:8123",
+            "LAB-PC.local:8123",
+            "localhost:8123",
+        ] {
+            assert!(open(&[(header::HOST, host)]).is_ok(), "{host}");
+        }
+        for host in [
+            "evil.example:8123",
+            "lab-pc.evil.example:8123",
+            "192.168.1.20:9999",
+            "192.168.1.20",
+        ] {
+            assert!(open(&[(header::HOST, host)]).is_err(), "{host}");
+        }
         assert!(
             open(&[
-                (header::HOST, "lab-pc.local:8123"),
+                (header::HOST, "192.168.1.20:8123"),
                 (header::ORIGIN, "http://evil.example")
             ])
             .is_err()
         );
+        assert!(
+            open(&[
+                (header::HOST, "192.168.1.20:8123"),
+                (header::ORIGIN, "http://192.168.1.20:8123")
+            ])
+            .is_ok()
+        );
+        // Bound to loopback, an IP address is no name of this server unless it is loopback.
+        assert!(get(&[(header::HOST, "192.168.1.20:8123")]).is_err());
     }
 
     #[test]
     fn loopback_hosts_include_localhost() {
-        let hosts = hosts_of("127.0.0.1:8123".parse().unwrap());
+        let hosts = hosts_of("127.0.0.1:8123".parse().unwrap(), Some("lab-pc"));
         assert!(hosts.contains(&"127.0.0.1:8123".to_owned()));
         assert!(hosts.contains(&"localhost:8123".to_owned()));
         assert!(!hosts.iter().any(|h| h.starts_with("evil")));
