@@ -16,7 +16,8 @@ use clap::{Args, Parser, Subcommand};
 use posecov::app::Overrides;
 use posecov::app::commands;
 use posecov::app::live::{self, LiveOptions};
-use posecov::app::session::{self, EXIT_INTERRUPTED, ServeOptions, ViewOptions};
+use posecov::app::sinks::{EXIT_INTERRUPTED, ServeOptions, ViewOptions};
+use posecov::app::view::view;
 use posecov::sink::Sink;
 
 /// See robot pose uncertainty: Lie-group poses with covariances, propagated and drawn in Rerun.
@@ -339,7 +340,7 @@ fn try_main() -> anyhow::Result<ExitCode> {
         }
         None => {
             let cancel = install_ctrl_c()?;
-            Ok(ExitCode::from(session::view(&cli.view.options(), &cancel)?))
+            Ok(ExitCode::from(view(&cli.view.options(), &cancel)?))
         }
     }
 }

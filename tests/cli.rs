@@ -212,7 +212,7 @@ fn watch_rewrites_on_change_and_survives_errors() {
         .ok();
     child.wait().ok();
     assert!(stderr.contains("missing field `group`"), "{stderr}");
-    assert!(stderr.contains("[1] streamed"), "{stderr}");
+    assert!(stderr.contains("[1] recorded"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -347,7 +347,7 @@ mod view {
 
     use super::{LogPlace, run};
     use crate::app::AppError;
-    use crate::app::session::{self, EXIT_INTERRUPTED, ViewOptions};
+    use crate::app::sinks::{self, EXIT_INTERRUPTED, ViewOptions};
     use crate::sink::{self, LogOutcome, RecordingIds, open_stream};
 
     /// Shows or saves a log like a scenario (`--save`, `--png`, `--spawn`, `--serve`, …);
@@ -381,17 +381,17 @@ mod view {
             }
         };
         if let Some((png, size)) = &options.png {
-            return session::render_with(options, &run.scene, &log, &ids, png, *size).map(read_cut);
+            return sinks::render_with(options, &run.scene, &log, &ids, png, *size).map(read_cut);
         }
-        let sink = session::choose_sink(options)?;
+        let sink = sinks::choose_sink(options)?;
         let (rec, guard) = open_stream(&sink, &ids, &run.scene)?;
         if let Some(url) = guard.viewer_url() {
             println!("Web viewer: {url}");
         }
         let outcome = log(&rec)?;
         if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
-            session::serve(&options.serve, &guard, cancel)?;
+            sinks::serve(&options.serve, &guard, cancel)?;
         }
-        session::finish(guard, rec, &sink, outcome).map(read_cut)
+        sinks::finish(guard, rec, &sink, outcome).map(read_cut)
     }
 }

@@ -27,6 +27,10 @@ pub mod live;
 #[cfg(feature = "viewer")]
 pub mod session;
 mod settings;
+#[cfg(feature = "viewer")]
+pub mod sinks;
+#[cfg(feature = "viewer")]
+pub mod view;
 
 pub use settings::{
     DEFAULT_CONFIDENCE, DEFAULT_SAMPLES, Overrides, Settings, SettingsError, resolve,

@@ -1,6 +1,6 @@
 //! One session: evaluate (with a spinner past a moment), draw, log to a sink, then log the
-//! clouds of any later Monte Carlo blocks one block at a time. The viewer, `--save`, `--png`
-//! and `--watch` all run it.
+//! clouds of any later Monte Carlo blocks one block at a time. The viewer, `--save`, `--png`,
+//! `--watch` and live mode all run it; where its picture goes is [`super::sinks`].
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -9,57 +9,15 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::{AppError, Loaded, Overrides, Settings, SettingsError, load, resolve};
+use super::sinks::{ViewOptions, choose_sink, finish, flush, render_with, scenario_name, serve};
+use super::{AppError, Loaded, Overrides, Settings, load, resolve};
 use crate::draw;
 use crate::eval::{self, AnyEvaluation};
 use crate::scene::Scene;
-use crate::sink::{
-    self, LogOutcome, RecordingIds, Sink, SinkError, SinkGuard, find_native_viewer, open_stream,
-    render_png,
-};
+use crate::sink::{self, LogOutcome, RecordingIds, Sink, open_stream};
 
-/// Hands everything logged so far to the sink (before the next block is simulated).
-fn flush(rec: &rerun::RecordingStream) -> Result<(), AppError> {
-    rec.flush_blocking()
-        .map_err(|e| AppError::Sink(SinkError::Flush(e.to_string())))
-}
-
-/// Exit code after Ctrl-C (128 + SIGINT), as shells expect.
-pub const EXIT_INTERRUPTED: u8 = 130;
 /// How often `--watch` looks at the file's modification time.
 const WATCH_POLL: Duration = Duration::from_millis(300);
-/// Environment variable bounding how long a served viewer is served (seconds), e.g. for CI.
-pub const SERVE_SECONDS_ENV: &str = "POSECOV_SERVE_SECONDS";
-
-/// Where and how to show a scenario.
-#[derive(Debug, Clone)]
-pub struct ViewOptions {
-    /// Bundled name or file.
-    pub scenario: String,
-    /// Command-line overrides.
-    pub overrides: Overrides,
-    /// The sink, or `None` for the default (a native viewer if found, else serve).
-    pub sink: Option<Sink>,
-    /// Web viewer port, gRPC port and whether to open a browser (for serving).
-    pub serve: ServeOptions,
-    /// Re-evaluate and re-stream on every change of the file.
-    pub watch: bool,
-    /// Render a PNG (needs the native viewer) of this size in points.
-    pub png: Option<(PathBuf, (u32, u32))>,
-}
-
-/// Options of a served web viewer.
-#[derive(Debug, Clone, Copy)]
-pub struct ServeOptions {
-    /// HTTP port of the web viewer.
-    pub web_port: u16,
-    /// gRPC port the web viewer reads from.
-    pub grpc_port: u16,
-    /// Stop after this many seconds (else `$POSECOV_SERVE_SECONDS`, else Ctrl-C).
-    pub seconds: Option<u64>,
-    /// Open the default browser.
-    pub open_browser: bool,
-}
 
 /// A scenario evaluated and drawn, ready to log.
 pub struct Session {
@@ -234,22 +192,12 @@ fn with_spinner<T>(message: &str, work: impl FnOnce() -> T) -> T {
     result
 }
 
-/// Name used in the recording id: a bundled name as is, a file by its stem.
-pub(crate) fn scenario_name(scenario: &str) -> String {
-    Path::new(scenario)
-        .file_stem()
-        .map_or_else(|| scenario.to_owned(), |s| s.to_string_lossy().into_owned())
-}
-
-/// Shows a scenario: in the viewer, a file, stdout or a PNG; with `watch`, again on every
-/// change. Returns the process exit code.
-pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppError> {
-    if let Some(place) = super::bag::locate(&options.scenario)? {
-        return super::bag::view(options, &place, cancel);
-    }
-    if options.watch {
-        return watch(options, cancel);
-    }
+/// Shows a scenario once: in the viewer, a file, stdout or a PNG. Returns the process exit
+/// code.
+///
+/// # Errors
+/// The scenario's error; the sink's.
+pub(crate) fn show(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppError> {
     let session = Session::start(
         &options.scenario,
         &options.overrides,
@@ -271,56 +219,21 @@ pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
     finish(guard, rec, &sink, outcome)
 }
 
-pub(crate) fn serve(
-    options: &ServeOptions,
-    guard: &SinkGuard,
+/// `--watch --save FILE.rrd`: the recording is written whole again on every change of the
+/// scenario file (a viewer is re-streamed in place instead, by
+/// [`super::live::watch_in_place`]). Errors in the file are printed and the previous recording
+/// stays. Returns the exit code: 0 at Ctrl-C between changes, 130 when
+/// Ctrl-C cut a recording short ([`EXIT_INTERRUPTED`](super::sinks::EXIT_INTERRUPTED)).
+///
+/// # Errors
+/// The sink's.
+pub(crate) fn watch_saving(
+    options: &ViewOptions,
+    file: &Path,
     cancel: &AtomicBool,
-) -> Result<(), AppError> {
-    let limit = serve_limit(options)?;
-    say_serving(limit);
-    guard.serve_until(cancel, limit);
-    Ok(())
-}
-
-/// Tells the user how long a server stays up.
-pub(crate) fn say_serving(limit: Option<Duration>) {
-    match limit {
-        Some(l) => eprintln!("Serving for {} s (Ctrl-C stops).", l.as_secs()),
-        None => eprintln!("Serving until Ctrl-C."),
-    }
-}
-
-/// `--watch`: evaluate, stream, and again whenever the file changes. A viewer gets one
-/// recording re-streamed in place ([`super::live::watch_in_place`]); a `--save` file is
-/// rewritten whole on every change. Errors in the file are printed and the previous picture
-/// stays up.
-fn watch(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, AppError> {
+) -> Result<u8, AppError> {
     let path = PathBuf::from(&options.scenario);
-    if !path.is_file() {
-        return Err(AppError::Watch(format!(
-            "needs a scenario file to watch; {path:?} is not one (copy a bundled scenario from assets/scenarios/)"
-        )));
-    }
-    if matches!(options.sink, Some(Sink::Stdout)) || options.png.is_some() {
-        return Err(AppError::Watch(
-            "streams to a viewer or rewrites a --save file; it does not combine with --stdout or --png"
-                .to_owned(),
-        ));
-    }
-    if !matches!(options.sink, Some(Sink::Save(_))) {
-        // A viewer: one recording, re-streamed in place (see `sink::restream`).
-        return super::live::watch_in_place(options, cancel);
-    }
-    let first_sink = choose_sink(options)?;
-    // Later generations connect to the viewer the first one reached.
-    let next_sink = match &first_sink {
-        Sink::Spawn => Sink::Connect(rerun::DEFAULT_CONNECT_URL.to_owned()),
-        Sink::Serve { grpc_port, .. } => {
-            Sink::Connect(format!("rerun+http://127.0.0.1:{grpc_port}/proxy"))
-        }
-        other => other.clone(),
-    };
-    let mut keep_alive: Option<(rerun::RecordingStream, SinkGuard)> = None;
+    let sink = Sink::Save(file.to_owned());
     let mut generation = 0u64;
     let mut last_seen = None;
     while !cancel.load(Ordering::Relaxed) {
@@ -335,28 +248,14 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, AppError> {
                 Ok(session) => {
                     let mut ids = session.ids(&options.scenario);
                     ids.recording_id = format!("{}/gen-{generation}", ids.recording_id);
-                    let sink = if generation == 0 {
-                        &first_sink
-                    } else {
-                        &next_sink
-                    };
-                    let (rec, guard) = open_stream(sink, &ids, &session.scene)?;
-                    if let Some(url) = guard.viewer_url() {
-                        println!("Web viewer: {url}");
-                    }
-                    session.log(&rec, cancel)?;
-                    if matches!(sink, Sink::Serve { .. }) {
-                        // The served viewer lives as long as this first stream's guard.
-                        flush(&rec)?;
-                        keep_alive = Some((rec, guard));
-                    } else {
-                        guard.finish(rec)?;
-                        if let Sink::Save(file) = sink {
-                            eprintln!("Wrote {}", file.display());
-                        }
+                    let (rec, guard) = open_stream(&sink, &ids, &session.scene)?;
+                    let outcome = session.log(&rec, cancel)?;
+                    let code = finish(guard, rec, &sink, outcome)?;
+                    if code != 0 {
+                        return Ok(code);
                     }
                     eprintln!(
-                        "[{generation}] streamed {} ({} items); watching {} for changes (Ctrl-C stops)",
+                        "[{generation}] recorded {} ({} items); watching {} for changes (Ctrl-C stops)",
                         path.display(),
                         session.scene.items.len(),
                         path.display()
@@ -367,62 +266,7 @@ fn watch(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, AppError> {
         }
         std::thread::sleep(WATCH_POLL);
     }
-    if let Some((rec, guard)) = keep_alive {
-        guard.finish(rec)?;
-    }
     Ok(0)
-}
-
-pub(crate) fn finish(
-    guard: SinkGuard,
-    rec: rerun::RecordingStream,
-    sink: &Sink,
-    outcome: LogOutcome,
-) -> Result<u8, AppError> {
-    guard.finish(rec)?;
-    if let Sink::Save(path) = sink {
-        eprintln!("Wrote {}", path.display());
-    }
-    Ok(match outcome {
-        LogOutcome::Complete => 0,
-        LogOutcome::Cancelled { .. } => EXIT_INTERRUPTED,
-    })
-}
-
-/// The sink asked for; without one: a native 0.36 viewer if available, else serve.
-pub(crate) fn choose_sink(options: &ViewOptions) -> Result<Sink, AppError> {
-    if let Some(sink) = &options.sink {
-        return Ok(sink.clone());
-    }
-    let serve = Sink::Serve {
-        web_port: options.serve.web_port,
-        grpc_port: options.serve.grpc_port,
-        open_browser: options.serve.open_browser,
-    };
-    Ok(match find_native_viewer() {
-        Ok(_) => Sink::Spawn,
-        Err(why) => {
-            eprintln!("{why}\nServing the embedded web viewer instead.");
-            serve
-        }
-    })
-}
-
-pub(crate) fn serve_limit(options: &ServeOptions) -> Result<Option<Duration>, AppError> {
-    if let Some(s) = options.seconds {
-        return Ok(Some(Duration::from_secs(s)));
-    }
-    match std::env::var(SERVE_SECONDS_ENV) {
-        Ok(s) => {
-            let secs: u64 = s.trim().parse().map_err(|_| SettingsError {
-                flag: "$POSECOV_SERVE_SECONDS",
-                value: format!("{s:?}"),
-                expected: "a whole number of seconds".to_owned(),
-            })?;
-            Ok(Some(Duration::from_secs(secs)))
-        }
-        Err(_) => Ok(None),
-    }
 }
 
 /// `--png`: record to an .rrd (the `--save` file, or a temporary one) and render it.
@@ -442,38 +286,4 @@ fn render(
         png,
         size,
     )
-}
-
-/// Saves a scene to an .rrd (`--save`, else a temporary file) with `log`, then renders it to
-/// `png` in the native viewer.
-pub(crate) fn render_with(
-    options: &ViewOptions,
-    scene: &Scene,
-    log: &dyn Fn(&rerun::RecordingStream) -> Result<LogOutcome, AppError>,
-    ids: &RecordingIds,
-    png: &Path,
-    size: (u32, u32),
-) -> Result<u8, AppError> {
-    let viewer = find_native_viewer()?;
-    let (rrd, temporary) = match &options.sink {
-        Some(Sink::Save(path)) => (path.clone(), false),
-        _ => (
-            std::env::temp_dir().join(format!("posecov-{}.rrd", std::process::id())),
-            true,
-        ),
-    };
-    let sink = Sink::Save(rrd.clone());
-    let (rec, guard) = open_stream(&sink, ids, scene)?;
-    let outcome = log(&rec)?;
-    guard.finish(rec)?;
-    if outcome != LogOutcome::Complete {
-        return Ok(EXIT_INTERRUPTED);
-    }
-    let rendered = render_png(&viewer, &rrd, png, size);
-    if temporary {
-        std::fs::remove_file(&rrd).ok();
-    }
-    rendered?;
-    eprintln!("Wrote {}", png.display());
-    Ok(0)
 }

@@ -10,7 +10,7 @@ use std::time::Duration;
 use super::document::{Edit, EditValue, LiveDocument};
 use super::server::{PageOptions, serve_page};
 use super::worker::{Live, passes};
-use crate::app::session::{
+use crate::app::sinks::{
     ServeOptions, ViewOptions, choose_sink, say_serving, scenario_name, serve_limit,
 };
 use crate::app::{AppError, Overrides, pipeline};
@@ -42,7 +42,7 @@ pub struct LiveOptions {
 /// ```no_run
 /// use std::sync::{Arc, atomic::AtomicBool};
 /// use posecov::app::live::{LiveOptions, live};
-/// use posecov::app::session::ServeOptions;
+/// use posecov::app::sinks::ServeOptions;
 /// let options = LiveOptions {
 ///     scenario: "camera_on_robot".into(),
 ///     overrides: Default::default(),
@@ -135,7 +135,7 @@ fn start(doc: LiveDocument, view: &ViewOptions) -> Result<(Arc<Live>, Option<Str
 /// The first load's error; the sink's.
 ///
 /// ```no_run
-/// use posecov::app::session::{ServeOptions, ViewOptions};
+/// use posecov::app::sinks::{ServeOptions, ViewOptions};
 /// let options = ViewOptions {
 ///     scenario: "my_scenario.toml".into(),
 ///     overrides: Default::default(),
