@@ -258,3 +258,22 @@ fn conflicting_sinks_are_refused_by_name() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A control-page port in use stops `live` with the flag, the address and a way out.
+#[test]
+fn live_refuses_a_taken_page_port_with_a_way_out() {
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
+    let page = taken.local_addr().expect("addr").port();
+    let out = Command::new(BIN)
+        .args(["live", "camera_on_robot", "--serve", "--serve-seconds", "5"])
+        .args(["--bind", &format!("127.0.0.1:{page}")])
+        .output()
+        .expect("run posecov live");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains(&format!("--bind 127.0.0.1:{page}: "))
+            && stderr.contains("`--bind 127.0.0.1:0` for any free one"),
+        "{stderr}"
+    );
+}

@@ -126,6 +126,7 @@ pub fn examples() -> Vec<Example> {
 /// ```
 /// let e = posecov::input::open("no_such_thing").unwrap_err().to_string();
 /// assert!(e.contains("camera_on_robot") && e.contains("gtsam_pose2example"), "{e}");
+/// assert!(e.contains("; MCAP files (ROS 2 bags): covariance_health"), "{e}");
 /// ```
 pub fn open(name_or_path: &str) -> Result<(Source, Input), InputError> {
     let path = Path::new(name_or_path);
@@ -145,7 +146,8 @@ pub fn open(name_or_path: &str) -> Result<(Source, Input), InputError> {
                         .filter(|e| e.format == *f)
                         .map(|e| e.name)
                         .collect();
-                    (!names.is_empty()).then(|| format!("{}s: {}", f.name(), names.join(", ")))
+                    (!names.is_empty())
+                        .then(|| format!("{}: {}", f.name_plural(), names.join(", ")))
                 })
                 .collect();
             Err(InputError::Read {

@@ -23,7 +23,7 @@ pub use document::{Edit, EditError, EditValue, LiveDocument};
 #[cfg(feature = "viewer")]
 pub use run::{LiveOptions, live, watch_in_place};
 #[cfg(feature = "viewer")]
-pub use server::{PageOptions, serve_page};
+pub use server::{PageOptions, bind_page, serve_page};
 #[cfg(feature = "viewer")]
 pub use worker::{
     Live, MIN_PICTURE_INTERVAL, PREVIEW_SAMPLES, PREVIEW_STEPS, PREVIEW_WORK, Status, passes,

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use super::document::{Edit, EditValue, LiveDocument};
-use super::server::{PageOptions, serve_page};
+use super::server::{PageOptions, bind_page, serve_page};
 use super::worker::{Live, passes};
 use crate::app::sinks::{
     ServeOptions, ViewOptions, choose_sink, say_serving, scenario_name, serve_limit,
@@ -72,6 +72,9 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
             .map_err(|e| AppError::Live(e.to_string()))?;
         }
     }
+    let limit = serve_limit(&options.serve)?;
+    // The page's port first: a port in use stops here, before a viewer is started.
+    let listener = bind_page(options.bind)?;
     let view = ViewOptions {
         scenario: options.scenario.clone(),
         overrides: Overrides {
@@ -85,7 +88,6 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
     };
     let (live, viewer_url) = start(doc, &view)?;
     let page = PageOptions {
-        bind: options.bind,
         viewer_url: viewer_url.clone(),
         save_to: options.save_scenario.clone(),
     };
@@ -95,14 +97,20 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
             options.bind
         );
     }
-    let limit = serve_limit(&options.serve)?;
-    let served = serve_page(Arc::clone(&live), page, Arc::clone(cancel), limit, |url| {
-        if let Some(v) = &viewer_url {
-            println!("Web viewer: {v}");
-        }
-        println!("Controls: {url}");
-        say_serving(limit);
-    });
+    let served = serve_page(
+        Arc::clone(&live),
+        listener,
+        page,
+        Arc::clone(cancel),
+        limit,
+        |url| {
+            if let Some(v) = &viewer_url {
+                println!("Web viewer: {v}");
+            }
+            println!("Controls: {url}");
+            say_serving(limit);
+        },
+    );
     cancel.store(true, Ordering::SeqCst);
     live.finish()?;
     served?;

@@ -43,8 +43,6 @@ const MAX_BODY: usize = 64 * 1024;
 /// How the page is served.
 #[derive(Clone, Debug)]
 pub struct PageOptions {
-    /// Address to listen on (port 0: any free port).
-    pub bind: SocketAddr,
     /// The web viewer to show beside the controls, if one is served.
     pub viewer_url: Option<String>,
     /// Where "save" writes (`--save-scenario`); `None`: download only.
@@ -56,27 +54,57 @@ struct App {
     options: PageOptions,
     /// `host:port` values that name this server.
     hosts: Vec<String>,
+    /// Bound to every interface (`--bind 0.0.0.0:…`).
+    open: bool,
 }
 
-/// Serves the page until `cancel` is raised or `limit` has passed; calls `ready` with the
-/// page's URL once listening.
+/// Listens on `addr` for the page (port 0: any free port). Done before the viewer starts, so
+/// a port in use stops live mode before anything is shown.
+///
+/// # Errors
+/// [`AppError::Live`] naming `--bind` and the address, with a way out when the port is taken.
+///
+/// ```
+/// let listener = posecov::app::live::bind_page("127.0.0.1:0".parse().unwrap()).unwrap();
+/// let port = listener.local_addr().unwrap().port();
+/// let taken = posecov::app::live::bind_page(format!("127.0.0.1:{port}").parse().unwrap());
+/// assert!(taken.unwrap_err().to_string().contains("--bind 127.0.0.1:0"));
+/// ```
+pub fn bind_page(addr: SocketAddr) -> Result<std::net::TcpListener, AppError> {
+    std::net::TcpListener::bind(addr).map_err(|e| {
+        let hint = if e.kind() == std::io::ErrorKind::AddrInUse {
+            format!(
+                " (another `posecov live`? give another port, or `--bind {}:0` for any free one)",
+                addr.ip()
+            )
+        } else {
+            String::new()
+        };
+        AppError::Live(format!("--bind {addr}: {e}{hint}"))
+    })
+}
+
+/// Serves the page on `listener` ([`bind_page`]) until `cancel` is raised or `limit` has
+/// passed; calls `ready` with the page's URL.
 ///
 /// # Errors
 /// [`AppError::Live`] when the address cannot be bound.
 ///
 /// ```no_run
 /// # use std::sync::{Arc, atomic::AtomicBool};
-/// # use posecov::app::live::{Live, LiveDocument, PageOptions, serve_page};
+/// # use posecov::app::live::{Live, LiveDocument, PageOptions, bind_page, serve_page};
 /// # use posecov::sink::{RecordingIds, Sink, open_stream};
 /// let doc = LiveDocument::open("camera_on_robot").unwrap();
 /// let layout = posecov::scene::Scene::new("camera", "");
 /// let (rec, guard) = open_stream(&Sink::Spawn, &RecordingIds::for_scenario("camera", 7), &layout).unwrap();
 /// let live = Live::start(doc, rec, guard, Default::default());
-/// let page = PageOptions { bind: "127.0.0.1:9091".parse().unwrap(), viewer_url: None, save_to: None };
-/// serve_page(live, page, Arc::new(AtomicBool::new(false)), None, |url| println!("Controls: {url}")).unwrap();
+/// let listener = bind_page("127.0.0.1:9091".parse().unwrap()).unwrap();
+/// let page = PageOptions { viewer_url: None, save_to: None };
+/// serve_page(live, listener, page, Arc::new(AtomicBool::new(false)), None, |url| println!("Controls: {url}")).unwrap();
 /// ```
 pub fn serve_page(
     live: Arc<Live>,
+    listener: std::net::TcpListener,
     options: PageOptions,
     cancel: Arc<AtomicBool>,
     limit: Option<Duration>,
@@ -86,8 +114,6 @@ pub fn serve_page(
         .enable_all()
         .build()
         .map_err(|e| AppError::Live(format!("starting the page server: {e}")))?;
-    let listener = std::net::TcpListener::bind(options.bind)
-        .map_err(|e| AppError::Live(format!("--bind {}: {e}", options.bind)))?;
     listener
         .set_nonblocking(true)
         .map_err(|e| AppError::Live(e.to_string()))?;
@@ -100,6 +126,7 @@ pub fn serve_page(
         live,
         options,
         hosts,
+        open: addr.ip().is_unspecified(),
     });
     let router = Router::new().fallback(handle).with_state(app);
     ready(&url);
@@ -209,8 +236,7 @@ async fn handle(
     headers: HeaderMap,
     body: Bytes,
 ) -> Response {
-    let open = app.options.bind.ip().is_unspecified();
-    if let Err(why) = allowed(&app.hosts, open, &method, &headers) {
+    if let Err(why) = allowed(&app.hosts, app.open, &method, &headers) {
         return reply(StatusCode::FORBIDDEN, &json!({ "error": why }));
     }
     if body.len() > MAX_BODY {
