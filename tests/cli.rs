@@ -277,3 +277,32 @@ fn live_refuses_a_taken_page_port_with_a_way_out() {
         "{stderr}"
     );
 }
+
+/// A served viewer's port in use is refused up front, naming its flag, before a URL is
+/// printed (the SDK's gRPC server would only fail later, on its own thread).
+#[test]
+fn serve_refuses_a_taken_viewer_port_up_front() {
+    let free = || {
+        std::net::TcpListener::bind("127.0.0.1:0")
+            .and_then(|l| l.local_addr())
+            .expect("a free port")
+            .port()
+    };
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
+    let busy = taken.local_addr().expect("addr").port();
+    for (flag, other) in [("--grpc-port", "--web-port"), ("--web-port", "--grpc-port")] {
+        let out = Command::new(BIN)
+            .args(["camera_on_robot", "--serve", "--serve-seconds", "30"])
+            .args([flag, &busy.to_string(), other, &free().to_string()])
+            .output()
+            .expect("run posecov --serve");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{flag}: {stderr}");
+        assert!(
+            stderr.contains(&format!("{flag} {busy}: 127.0.0.1:{busy} cannot be served")),
+            "{flag}: {stderr}"
+        );
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(!stdout.contains("Web viewer"), "{flag}: {stdout}");
+    }
+}

@@ -126,6 +126,18 @@ pub enum SinkError {
     /// The web viewer could not be served.
     #[error("serving the web viewer: {0}")]
     WebViewer(String),
+    /// A port the served viewer needs cannot be had.
+    #[error(
+        "{flag} {port}: 127.0.0.1:{port} cannot be served ({reason}); another viewer or posecov may be serving there: give another port with {flag}"
+    )]
+    Port {
+        /// The flag that sets it (`--web-port`, `--grpc-port`).
+        flag: &'static str,
+        /// The port.
+        port: u16,
+        /// The OS error.
+        reason: String,
+    },
     /// No native viewer of the right version was found.
     #[error(
         "no rerun 0.36 viewer found{found}; install one with `pip install rerun-sdk==0.36.3` \

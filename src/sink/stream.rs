@@ -107,12 +107,31 @@ pub fn open_stream(
     Ok((rec, SinkGuard { kind }))
 }
 
+/// Whether `127.0.0.1:port` can be listened on now (`flag` names it in the error).
+///
+/// # Errors
+/// [`SinkError::Port`] with the OS's reason.
+fn port_available(flag: &'static str, port: u16) -> Result<(), SinkError> {
+    std::net::TcpListener::bind(("127.0.0.1", port))
+        .map(drop)
+        .map_err(|e| SinkError::Port {
+            flag,
+            port,
+            reason: e.to_string(),
+        })
+}
+
 fn serve(
     builder: rr::RecordingStreamBuilder,
     web_port: u16,
     grpc_port: u16,
     open_browser: bool,
 ) -> Result<(rr::RecordingStream, GuardKind), SinkError> {
+    // The SDK's gRPC server binds on its own thread and, on a port in use, only fails later
+    // ("gRPC server thread shut down"): check both ports first, before anything is served.
+    for (flag, port) in [("--grpc-port", grpc_port), ("--web-port", web_port)] {
+        port_available(flag, port)?;
+    }
     let rec = builder.serve_grpc_opts("127.0.0.1", grpc_port, rr::ServerOptions::default())?;
     let grpc_url = format!("rerun+http://127.0.0.1:{grpc_port}/proxy");
     let web = rr::serve_web_viewer(rr::web_viewer::WebViewerConfig {
