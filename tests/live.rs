@@ -388,3 +388,111 @@ fn frames_are_overwritten_not_cleared() {
     assert!(chunks.iter().any(|c| has(c, clear)));
     assert_same_view(&bytes, &expected, 8);
 }
+
+/// The preview's Monte Carlo particles are exactly the full run's first draws, pose by pose
+/// and step by step, in every bundled scenario that shows a preview with fewer samples: the
+/// full picture refines the preview, it does not replace it with another cloud.
+#[test]
+fn the_previews_particles_are_the_full_runs_first_draws() {
+    use posecov::app::live::{PREVIEW_SAMPLES, passes};
+    use posecov::app::{evaluate, load, resolve};
+    use posecov::eval::AnyEvaluation;
+    use posecov::input::scenario::bundled::BUNDLED;
+    use posecov::lie::LieGroup as _;
+
+    /// (name, step) → particles, each as its matrix in `{:?}` (every f64 in full: Rust's
+    /// `Debug` prints the shortest text that reads back to the same bits).
+    fn particles(
+        e: &AnyEvaluation,
+    ) -> std::collections::BTreeMap<(String, Option<u64>), Vec<String>> {
+        posecov::with_evaluation!(e, e => e
+            .nodes
+            .iter()
+            .filter_map(|n| {
+                let p = n.particles.as_ref()?;
+                let text = p.iter().map(|x| format!("{:?}", x.to_matrix())).collect();
+                Some(((n.name.clone(), n.step), text))
+            })
+            .collect())
+    }
+    let mut checked = Vec::new();
+    for b in BUNDLED {
+        let loaded = load(b.name).unwrap();
+        let all = passes(&loaded, &Overrides::default()).unwrap();
+        let [preview, full] = all.as_slice() else {
+            continue;
+        };
+        if preview.samples != Some(PREVIEW_SAMPLES) {
+            continue;
+        }
+        let run = |o: &Overrides| {
+            let settings = resolve(&loaded.input, o, None).unwrap();
+            particles(&evaluate(&loaded, &settings.eval).unwrap())
+        };
+        let (short, long) = (run(preview), run(full));
+        let mut shared = 0;
+        for (key, draws) in &short {
+            let Some(all_draws) = long.get(key) else {
+                continue;
+            };
+            assert_eq!(draws.len() as u64, PREVIEW_SAMPLES, "{} {key:?}", b.name);
+            assert!(all_draws.len() > draws.len(), "{} {key:?}", b.name);
+            assert!(
+                all_draws[..draws.len()] == draws[..],
+                "{} {key:?}: the preview drew other particles than the full run's first",
+                b.name
+            );
+            shared += 1;
+        }
+        assert!(
+            shared > 0,
+            "{}: no pose with particles in both passes",
+            b.name
+        );
+        checked.push(b.name);
+    }
+    // The scenarios large enough for a preview (BENCHMARKS §6).
+    assert_eq!(
+        checked,
+        [
+            "vector_space_vs_lie",
+            "barfoot_compounding",
+            "diff_drive_banana"
+        ]
+    );
+}
+
+/// While a slider is dragged faster than pictures are made (here an edit every 4 ms, each
+/// picture of na568_se2_odometry taking longer), pictures keep coming, each of a newer value:
+/// a change's first picture is finished, not cancelled by the next mouse event (before, no
+/// picture came until the drag stopped).
+#[test]
+fn pictures_keep_coming_while_a_slider_is_dragged() {
+    let (live, _) = start("na568_se2_odometry", 2000);
+    let id = "operation[0].noise.std[2]";
+    let start = std::time::Instant::now();
+    let mut shown = BTreeSet::new();
+    let mut last = 0;
+    let mut k = 0u32;
+    while shown.len() < 3 {
+        assert!(
+            start.elapsed() < WAIT,
+            "no new picture while dragging: {shown:?} after {k} edits"
+        );
+        k += 1;
+        last = live
+            .apply(&edit(id, 0.05 + 0.001 * f64::from(k % 50)))
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(4));
+        if let Some(g) = live.status().shown.filter(|&g| g > 0) {
+            shown.insert(g);
+        }
+    }
+    let status = live.wait_done(last, WAIT);
+    assert_eq!(
+        (status.shown, status.done),
+        (Some(last), true),
+        "{status:?}"
+    );
+    assert_eq!(recordings(&live.finish().unwrap().unwrap()).len(), 1);
+}

@@ -1,7 +1,10 @@
 //! The evaluation thread of live mode: it owns the recording stream, takes the newest
 //! change, shows a quick preview (fewer samples from the same random streams), then the
 //! full picture, each re-streamed in place ([`Restream`]). A newer change cancels the
-//! evaluation in flight through the evaluation's own cancel flag.
+//! refinement in flight (the full pass, through the evaluation's own cancel flag), never a
+//! change's first picture: while a slider is dragged faster than pictures are made, each
+//! finished picture shows the newest value then, instead of every one being cancelled by the
+//! next mouse event until the drag stops. Only stopping live mode cancels a first picture.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, Sender, channel};
@@ -19,9 +22,12 @@ use crate::sample::CHUNK_SIZE;
 use crate::sink::{LogOutcome, Restream, SinkError, SinkGuard};
 use crate::uncertain::Method;
 
-/// Samples of the quick preview shown before a larger full sample: one random chunk, so
-/// the preview's draws are the first draws of the full run.
-pub const PREVIEW_SAMPLES: u64 = CHUNK_SIZE as u64;
+/// Samples of the quick preview shown before a larger full sample: the first half of the
+/// first random chunk, so the preview's draws are the first draws of the full run (a chunk
+/// draws its samples in order from one stream). Half a chunk, because one chunk is one
+/// thread's work: 1024 samples took diff_drive_banana's preview to ≈ 60–75 ms on this
+/// machine's slower days, 512 take it to ≈ 35 ms (BENCHMARKS §6).
+pub const PREVIEW_SAMPLES: u64 = CHUNK_SIZE as u64 / 2;
 
 /// The steps the quick preview keeps of a propagation longer than `max_recorded`: numbers
 /// at 25 of them (and the last), clouds and surfaces at 5. Every step is still simulated
@@ -113,6 +119,8 @@ pub struct Live {
     doc: Mutex<LiveDocument>,
     jobs: Mutex<Option<Sender<Job>>>,
     in_flight: Mutex<Arc<AtomicBool>>,
+    /// Raised when live mode stops: cancels whatever is in flight, a first picture too.
+    stop: Arc<AtomicBool>,
     shared: Arc<Shared>,
     thread: Mutex<Option<Worker>>,
     generation: Mutex<u64>,
@@ -137,14 +145,17 @@ impl Live {
             changed: Condvar::new(),
         });
         let worker_shared = Arc::clone(&shared);
+        let stop = Arc::new(AtomicBool::new(false));
+        let worker_stop = Arc::clone(&stop);
         let thread = std::thread::Builder::new()
             .name("posecov-live".into())
-            .spawn(move || run(rx, rec, guard, &overrides, &worker_shared))
+            .spawn(move || run(rx, rec, guard, &overrides, &worker_shared, &worker_stop))
             .expect("spawning the live evaluation thread");
         let live = Arc::new(Self {
             doc: Mutex::new(doc),
             jobs: Mutex::new(Some(tx)),
             in_flight: Mutex::new(Arc::new(AtomicBool::new(false))),
+            stop,
             shared,
             thread: Mutex::new(Some(thread)),
             generation: Mutex::new(0),
@@ -153,8 +164,9 @@ impl Live {
         live
     }
 
-    /// Applies an edit; on success a new generation is evaluated and streamed (the one in
-    /// flight is cancelled). Returns the new generation.
+    /// Applies an edit; on success a new generation is evaluated and streamed (the refinement
+    /// in flight is cancelled; a first picture in flight is finished first). Returns the new
+    /// generation.
     ///
     /// # Errors
     /// [`EditError`]: nothing changes, the last good picture stays.
@@ -223,6 +235,7 @@ impl Live {
     /// # Errors
     /// What the thread or the sink reported.
     pub fn finish(&self) -> Result<Option<Vec<u8>>, AppError> {
+        self.stop.store(true, Ordering::SeqCst);
         lock(&self.in_flight).store(true, Ordering::SeqCst);
         lock(&self.jobs).take();
         let handle = lock(&self.thread).take();
@@ -273,6 +286,7 @@ fn run(
     guard: SinkGuard,
     overrides: &Overrides,
     shared: &Shared,
+    stop: &Arc<AtomicBool>,
 ) -> Result<Option<Vec<u8>>, AppError> {
     let mut restream = Restream::new();
     let mut last_start: Option<Instant> = None;
@@ -287,7 +301,7 @@ fn run(
             // Kept by the restream until a layout is sent, even if this job is cancelled.
             restream.reframe();
         }
-        if let Err(err) = show(&job, &rec, &mut restream, overrides, shared) {
+        if let Err(err) = show(&job, &rec, &mut restream, overrides, shared, stop) {
             if job.cancel.load(Ordering::SeqCst) {
                 continue;
             }
@@ -356,16 +370,24 @@ pub fn passes(loaded: &Loaded, overrides: &Overrides) -> Result<Vec<Overrides>, 
     Ok(vec![preview, full])
 }
 
+/// Shows `job`'s passes. The first is cancelled only by `stop` (live mode ending), the later
+/// ones also by a newer change (the job's own flag; see the module docs).
 fn show(
     job: &Job,
     rec: &rerun::RecordingStream,
     restream: &mut Restream,
     overrides: &Overrides,
     shared: &Shared,
+    stop: &Arc<AtomicBool>,
 ) -> Result<(), AppError> {
     let passes = passes(&job.loaded, overrides)?;
     let last = passes.len() - 1;
     for (i, pass) in passes.iter().enumerate() {
+        let cancel = if i == 0 { stop } else { &job.cancel };
+        if cancel.load(Ordering::SeqCst) {
+            // A newer change is waiting (or live mode stops): this refinement is not wanted.
+            return Ok(());
+        }
         let samples = pass.samples.unwrap_or_default();
         {
             let mut status = lock(&shared.status);
@@ -373,14 +395,13 @@ fn show(
             status.samples = samples;
             shared.changed.notify_all();
         }
-        let mut session =
-            Session::from_loaded(job.loaded.clone(), pass, Some(Arc::clone(&job.cancel)))?;
-        if job.cancel.load(Ordering::SeqCst) {
+        let mut session = Session::from_loaded(job.loaded.clone(), pass, Some(Arc::clone(cancel)))?;
+        if cancel.load(Ordering::SeqCst) {
             return Ok(());
         }
         let scene = std::mem::take(&mut session.scene);
         let items = scene.items.len();
-        let mut outcome = restream.log(rec, scene, &job.cancel)?;
+        let mut outcome = restream.log(rec, scene, cancel)?;
         if outcome == LogOutcome::Complete && i == last {
             outcome = session.log_blocks(rec, &job.cancel, |part| {
                 Ok(restream.log_part(rec, part, &job.cancel)?)
