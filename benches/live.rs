@@ -16,7 +16,7 @@ use std::sync::atomic::AtomicBool;
 use criterion::{Criterion, criterion_group, criterion_main};
 use posecov::app::Overrides;
 use posecov::app::live::{Control, ControlKind, Edit, EditValue, LiveDocument, passes};
-use posecov::app::session::Session;
+use posecov::app::run::PlanRun;
 use posecov::input::scenario::bundled::BUNDLED;
 use posecov::sink::Restream;
 
@@ -70,7 +70,7 @@ fn live(c: &mut Criterion) {
                         value: EditValue::Number(values[k % 2]),
                     };
                     doc.apply(&edit).expect("the edit loads");
-                    let session = Session::from_loaded(doc.loaded().clone(), &overrides, None)
+                    let session = PlanRun::from_loaded(doc.loaded().clone(), &overrides, None)
                         .expect("the scenario runs");
                     restream.log(&rec, session.scene, &cancel).expect("logged");
                     black_box(storage.drain_as_bytes().expect("encoded").len())

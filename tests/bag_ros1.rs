@@ -129,7 +129,7 @@ fn ctrl_c_keeps_what_was_read_and_draws_it() {
         confidence: 0.95,
         axis_length: None,
     };
-    let text = posecov::draw::bag::description(&plan, &e, 0.95);
+    let text = posecov::draw::bag::description(&plan, posecov::input::Format::Ros1Bag, &e, 0.95);
     assert!(text.contains("Interrupted (Ctrl-C)"), "{text}");
     assert!(
         posecov::draw::bag::bag_scene(&e, &settings, &text)

@@ -2,7 +2,8 @@
 
 use std::fmt::Write as _;
 
-use super::{AppError, Overrides, bag, evaluate, load, report_json, resolve};
+use super::run::{Opened, PlanRun, open};
+use super::{AppError, Overrides, bag, evaluate, report_json, resolve, resolve_log};
 use crate::input::{Format, examples, open_text};
 
 /// Samples `check` evaluates with (enough to exercise every path, quick on any input).
@@ -52,15 +53,18 @@ pub fn list() -> Result<String, AppError> {
 /// assert_eq!(json["meta"]["samples"], 50);
 /// ```
 pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<String, AppError> {
-    if let Some(place) = bag::locate(scenario)? {
-        let run = bag::run(&place, scenario, overrides, None)?;
-        return Ok(if json {
-            serde_json::to_string_pretty(&bag::report_json(&run)).unwrap_or_default() + "\n"
-        } else {
-            bag::report_text(&run)
-        });
-    }
-    let loaded = load(scenario)?;
+    let loaded = match open(scenario)? {
+        Opened::Plan(loaded) => *loaded,
+        Opened::Log(located) => {
+            let run = bag::run(&located, &resolve_log(overrides)?, None)?;
+            return Ok(if json {
+                serde_json::to_string_pretty(&bag::report_json(scenario, &run)).unwrap_or_default()
+                    + "\n"
+            } else {
+                bag::report_text(scenario, &run)
+            });
+        }
+    };
     let settings = resolve(&loaded.input, overrides, None)?;
     let evaluation = evaluate(&loaded, &settings.eval)?;
     let confidence = settings.draw.confidence;
@@ -113,6 +117,13 @@ pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<Strin
 /// assert!(line.starts_with("camera_on_robot: ok ("), "{line}");
 /// ```
 pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> {
+    let loaded = match open(scenario)? {
+        Opened::Plan(loaded) => *loaded,
+        Opened::Log(located) => {
+            let run = bag::run(&located, &resolve_log(overrides)?, None)?;
+            return Ok(bag::check_line(scenario, &run));
+        }
+    };
     let quick = Overrides {
         samples: Some(
             overrides
@@ -122,13 +133,8 @@ pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> 
         ),
         ..overrides.clone()
     };
-    if let Some(place) = bag::locate(scenario)? {
-        return Ok(bag::check_line(&bag::run(
-            &place, scenario, overrides, None,
-        )?));
-    }
-    let loaded = load(scenario)?;
-    let (evaluation, scene) = super::pipeline(&loaded, &quick, None)?;
+    let run = PlanRun::from_loaded(loaded, &quick, None)?;
+    let (evaluation, scene) = (run.evaluation, run.scene);
     let findings = evaluation.findings().len();
     Ok(format!(
         "{scenario}: ok ({} results, {} drawn items, {} steps{})",

@@ -1,7 +1,8 @@
-//! The application: load an input, resolve its settings once (command line over file over
-//! defaults), evaluate, draw — the pure path every command shares — and, with the `viewer`
-//! feature, one `session` that logs the scene and any later Monte Carlo blocks to a sink,
-//! used by the viewer, `--watch` and `--save` alike; and [`live`] mode, which re-evaluates and
+//! The application: open an input (deciding once whether it is a plan or a robot log,
+//! [`run::open`]), resolve its settings once (command line over file over defaults, one table
+//! of which flags apply to which input), evaluate, draw — one pure [`run::Run`] every command
+//! shares — and, with the `viewer` feature, one sequence in `session` that shows a run on any
+//! sink (the viewer, `--watch`, `--save`, `--png`); and [`live`] mode, which re-evaluates and
 //! re-streams in place as controls change.
 //!
 //! ```
@@ -24,6 +25,7 @@ use crate::scene::{Scene, SceneError};
 pub mod bag;
 pub mod commands;
 pub mod live;
+pub mod run;
 #[cfg(feature = "viewer")]
 pub mod session;
 mod settings;
@@ -33,7 +35,8 @@ pub mod sinks;
 pub mod view;
 
 pub use settings::{
-    DEFAULT_CONFIDENCE, DEFAULT_SAMPLES, Overrides, Settings, SettingsError, resolve,
+    DEFAULT_CONFIDENCE, DEFAULT_SAMPLES, LogSettings, MAX_CLOUD_SAMPLES, Overrides, Settings,
+    SettingsError, resolve, resolve_log,
 };
 
 /// Why a command could not run. Each names where the problem is in the user's words: the
@@ -95,8 +98,9 @@ impl Loaded {
     }
 }
 
-/// Loads a file of any format posecov reads (by content and extension, see
-/// [`input::format`]) or a bundled example by name, and checks it ([`input::open`]).
+/// Loads a plan — a scenario or a pose graph file (by content and extension, see
+/// [`input::format`]) or a bundled example by name — and checks it ([`input::open`]); a robot
+/// log is refused (see [`run::open`] for any input).
 ///
 /// ```
 /// let e = posecov::app::load("no_such_thing").unwrap_err().to_string();
@@ -138,11 +142,22 @@ pub fn pipeline(
     overrides: &Overrides,
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<(AnyEvaluation, Scene), AppError> {
+    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, cancel)?;
+    Ok((evaluation, scene))
+}
+
+/// Resolves, evaluates, draws and validates: the one plan path ([`pipeline`],
+/// [`run::PlanRun::from_loaded`]).
+fn evaluate_and_draw(
+    loaded: &Loaded,
+    overrides: &Overrides,
+    cancel: Option<Arc<AtomicBool>>,
+) -> Result<(Settings, AnyEvaluation, Scene), AppError> {
     let settings = resolve(&loaded.input, overrides, cancel)?;
     let evaluation = evaluate(loaded, &settings.eval)?;
     let scene = draw::scene(&evaluation, &settings.draw);
     scene.validate()?;
-    Ok((evaluation, scene))
+    Ok((settings, evaluation, scene))
 }
 
 /// The JSON report of an evaluation: the settings it ran with (`meta`, with the sigma-point

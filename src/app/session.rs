@@ -1,6 +1,7 @@
-//! One session: evaluate (with a spinner past a moment), draw, log to a sink, then log the
-//! clouds of any later Monte Carlo blocks one block at a time. The viewer, `--save`, `--png`,
-//! `--watch` and live mode all run it; where its picture goes is [`super::sinks`].
+//! Showing a run ([`super::run::Run`]) through one sequence for every input and sink: the
+//! scene logged, then for a plan the clouds of any later Monte Carlo blocks one block at a
+//! time; the viewer, `--save`, `--stdout`, `--png` and `--watch --save` all run it (live mode
+//! streams [`PlanRun::log_blocks`] too). Where its picture goes is [`super::sinks`].
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -9,78 +10,18 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::sinks::{ViewOptions, choose_sink, finish, flush, render_with, scenario_name, serve};
-use super::{AppError, Loaded, Overrides, Settings, load, resolve};
-use crate::draw;
-use crate::eval::{self, AnyEvaluation};
+use super::run::{Opened, PlanRun, Run, open};
+use super::sinks::{
+    EXIT_INTERRUPTED, ViewOptions, choose_sink, finish, flush, render_with, scenario_name, serve,
+};
+use super::{AppError, Overrides};
 use crate::scene::Scene;
 use crate::sink::{self, LogOutcome, RecordingIds, Sink, open_stream};
 
 /// How often `--watch` looks at the file's modification time.
 const WATCH_POLL: Duration = Duration::from_millis(300);
 
-/// A scenario evaluated and drawn, ready to log.
-pub struct Session {
-    /// What was loaded.
-    pub loaded: Loaded,
-    /// The settings resolved for it.
-    pub settings: Settings,
-    /// The numbers.
-    pub evaluation: AnyEvaluation,
-    /// The picture (validated).
-    pub scene: Scene,
-}
-
-impl Session {
-    /// Loads, resolves, evaluates (showing a spinner on a terminal after 0.3 s) and draws.
-    ///
-    /// ```no_run
-    /// use posecov::app::{Overrides, session::Session};
-    /// let s = Session::start("camera_on_robot", &Overrides::default(), None).unwrap();
-    /// assert!(!s.scene.items.is_empty());
-    /// ```
-    pub fn start(
-        scenario: &str,
-        overrides: &Overrides,
-        cancel: Option<Arc<AtomicBool>>,
-    ) -> Result<Self, AppError> {
-        let loaded = load(scenario)?;
-        with_spinner(&format!("evaluating {scenario}"), || {
-            Self::from_loaded(loaded, overrides, cancel)
-        })
-    }
-
-    /// Resolves, evaluates and draws an input already loaded (live mode: no spinner).
-    ///
-    /// ```
-    /// use posecov::app::{Overrides, load, session::Session};
-    /// let loaded = load("camera_on_robot").unwrap();
-    /// let s = Session::from_loaded(loaded, &Overrides { samples: Some(64), ..Default::default() }, None).unwrap();
-    /// assert!(!s.scene.items.is_empty());
-    /// ```
-    pub fn from_loaded(
-        loaded: Loaded,
-        overrides: &Overrides,
-        cancel: Option<Arc<AtomicBool>>,
-    ) -> Result<Self, AppError> {
-        let settings = resolve(&loaded.input, overrides, cancel)?;
-        let evaluation = super::evaluate(&loaded, &settings.eval)?;
-        let scene = draw::scene(&evaluation, &settings.draw);
-        scene.validate()?;
-        Ok(Self {
-            loaded,
-            settings,
-            evaluation,
-            scene,
-        })
-    }
-
-    /// How many Monte Carlo blocks beyond the first get logged after the main scene.
-    fn later_blocks(&self) -> u64 {
-        let (_, n, b, _) = self.evaluation.run();
-        (n.div_ceil(b.max(1)) as u64).saturating_sub(1)
-    }
-
+impl Run {
     /// Logs the scene, then the clouds of any later Monte Carlo blocks one block at a time
     /// (each re-simulated, drawn, logged, flushed and dropped: memory stays bounded); reports
     /// how far it got if Ctrl-C interrupted it.
@@ -89,16 +30,36 @@ impl Session {
         rec: &rerun::RecordingStream,
         cancel: &AtomicBool,
     ) -> Result<LogOutcome, AppError> {
-        let outcome = sink::log_scene_cancellable(rec, &self.scene, cancel)?;
+        let outcome = sink::log_scene_cancellable(rec, self.scene(), cancel)?;
         if outcome != LogOutcome::Complete {
             report_interrupted(outcome);
             return Ok(outcome);
         }
-        self.log_blocks(rec, cancel, |part| {
-            Ok(sink::log_part_cancellable(rec, &part, cancel)?)
-        })
+        match self {
+            Run::Plan(plan) => plan.log_blocks(rec, cancel, |part| {
+                Ok(sink::log_part_cancellable(rec, &part, cancel)?)
+            }),
+            Run::Log(_) => Ok(outcome),
+        }
     }
 
+    /// The recording id: the input's name (a file by its stem) and the seed in effect.
+    fn ids(&self, name: &str) -> RecordingIds {
+        RecordingIds::for_scenario(&scenario_name(name), self.seed())
+    }
+
+    /// The exit code of a run shown with `code`: 130 when Ctrl-C cut the read short (what
+    /// was read is shown, complete).
+    fn exit_code(&self, code: u8) -> u8 {
+        if self.cut_short() {
+            EXIT_INTERRUPTED
+        } else {
+            code
+        }
+    }
+}
+
+impl PlanRun {
     /// Logs the clouds of the later Monte Carlo blocks (after the scene) with `log_part`,
     /// one block at a time, each re-simulated, drawn, logged, flushed and dropped (memory
     /// stays bounded); reports how far it got if `cancel` interrupted it.
@@ -121,15 +82,9 @@ impl Session {
                     outcome = LogOutcome::Cancelled { next_step: None };
                     break;
                 }
-                let plan = &self.loaded.input.plan;
-                let Some(block) =
-                    eval::evaluate_block(plan, &self.settings.eval, &self.evaluation, k)
-                        .map_err(|e| self.loaded.locate(&e))?
-                else {
+                let Some(part) = self.block(k)? else {
                     break;
                 };
-                let part = draw::particle_part(&self.evaluation, &block, k, &self.settings.draw);
-                drop(block);
                 outcome = log_part(part)?;
                 flush(rec)?;
                 bar.inc(1);
@@ -148,11 +103,6 @@ impl Session {
         }
         Ok(outcome)
     }
-
-    /// The recording id: the scenario's name (a file by its stem) and the seed in effect.
-    fn ids(&self, scenario: &str) -> RecordingIds {
-        RecordingIds::for_scenario(&scenario_name(scenario), self.settings.eval.seed)
-    }
 }
 
 fn report_interrupted(outcome: LogOutcome) {
@@ -164,59 +114,33 @@ fn report_interrupted(outcome: LogOutcome) {
     }
 }
 
-/// Runs `work`, showing a spinner on a terminal when it takes more than 0.3 s.
-fn with_spinner<T>(message: &str, work: impl FnOnce() -> T) -> T {
-    let spinner = ProgressBar::new_spinner().with_message(message.to_owned());
-    spinner.set_style(
-        ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
-            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-    );
-    // indicatif draws only on a terminal; the work wakes the ticker when done.
-    let done = AtomicBool::new(false);
-    let result = std::thread::scope(|scope| {
-        let ticker = scope.spawn(|| {
-            let start = std::time::Instant::now();
-            while !done.load(Ordering::Acquire) {
-                if start.elapsed() > Duration::from_millis(300) {
-                    spinner.tick();
-                }
-                std::thread::park_timeout(Duration::from_millis(80));
-            }
-        });
-        let result = work();
-        done.store(true, Ordering::Release);
-        ticker.thread().unpark();
-        result
-    });
-    spinner.finish_and_clear();
-    result
-}
-
-/// Shows a scenario once: in the viewer, a file, stdout or a PNG. Returns the process exit
-/// code.
+/// Shows an opened input once, whatever it is: in the viewer, a file, stdout or a PNG — the
+/// one sequence every input and sink goes through. Returns the process exit code.
 ///
 /// # Errors
-/// The scenario's error; the sink's.
-pub(crate) fn show(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppError> {
-    let session = Session::start(
-        &options.scenario,
-        &options.overrides,
-        Some(Arc::clone(cancel)),
-    )?;
-    let ids = session.ids(&options.scenario);
+/// The input's error; the sink's.
+pub(crate) fn show(
+    options: &ViewOptions,
+    opened: Opened,
+    cancel: &Arc<AtomicBool>,
+) -> Result<u8, AppError> {
+    let run = Run::start(opened, &options.overrides, Some(Arc::clone(cancel)))?;
+    let ids = run.ids(&options.scenario);
     if let Some((png, size)) = &options.png {
-        return render(options, &session, &ids, png, *size, cancel);
+        let log = |rec: &rerun::RecordingStream| run.log(rec, cancel);
+        return render_with(options, run.scene(), &log, &ids, png, *size)
+            .map(|code| run.exit_code(code));
     }
     let sink = choose_sink(options)?;
-    let (rec, guard) = open_stream(&sink, &ids, &session.scene)?;
+    let (rec, guard) = open_stream(&sink, &ids, run.scene())?;
     if let Some(url) = guard.viewer_url() {
         println!("Web viewer: {url}");
     }
-    let outcome = session.log(&rec, cancel)?;
+    let outcome = run.log(&rec, cancel)?;
     if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
         serve(&options.serve, &guard, cancel)?;
     }
-    finish(guard, rec, &sink, outcome)
+    finish(guard, rec, &sink, outcome).map(|code| run.exit_code(code))
 }
 
 /// `--watch --save FILE.rrd`: the recording is written whole again on every change of the
@@ -240,16 +164,16 @@ pub(crate) fn watch_saving(
         let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
         if modified != last_seen {
             last_seen = modified;
-            match Session::start(&options.scenario, &options.overrides, None) {
+            match start(&options.scenario, &options.overrides) {
                 Err(err) => eprintln!(
                     "error: {err}\n(waiting for the next change of {})",
                     path.display()
                 ),
-                Ok(session) => {
-                    let mut ids = session.ids(&options.scenario);
+                Ok(run) => {
+                    let mut ids = run.ids(&options.scenario);
                     ids.recording_id = format!("{}/gen-{generation}", ids.recording_id);
-                    let (rec, guard) = open_stream(&sink, &ids, &session.scene)?;
-                    let outcome = session.log(&rec, cancel)?;
+                    let (rec, guard) = open_stream(&sink, &ids, run.scene())?;
+                    let outcome = run.log(&rec, cancel)?;
                     let code = finish(guard, rec, &sink, outcome)?;
                     if code != 0 {
                         return Ok(code);
@@ -257,7 +181,7 @@ pub(crate) fn watch_saving(
                     eprintln!(
                         "[{generation}] recorded {} ({} items); watching {} for changes (Ctrl-C stops)",
                         path.display(),
-                        session.scene.items.len(),
+                        run.scene().items.len(),
                         path.display()
                     );
                     generation += 1;
@@ -269,21 +193,7 @@ pub(crate) fn watch_saving(
     Ok(0)
 }
 
-/// `--png`: record to an .rrd (the `--save` file, or a temporary one) and render it.
-fn render(
-    options: &ViewOptions,
-    session: &Session,
-    ids: &RecordingIds,
-    png: &Path,
-    size: (u32, u32),
-    cancel: &AtomicBool,
-) -> Result<u8, AppError> {
-    render_with(
-        options,
-        &session.scene,
-        &|rec| session.log(rec, cancel),
-        ids,
-        png,
-        size,
-    )
+/// Opens and runs the watched file again.
+fn start(scenario: &str, overrides: &Overrides) -> Result<Run, AppError> {
+    Run::start(open(scenario)?, overrides, None)
 }

@@ -6,13 +6,17 @@ use std::sync::atomic::AtomicBool;
 
 use crate::draw::DrawSettings;
 use crate::eval::EvalSettings;
-use crate::input::Input;
+use crate::eval::bag::{BagEvalSettings, DEFAULT_CLOUD_SAMPLES};
+use crate::input::bag::BagOptions;
+use crate::input::{Input, InputKind};
 use crate::plan::{StepPolicy, limits};
 
 /// Monte Carlo samples when neither the command line nor the file says.
 pub const DEFAULT_SAMPLES: u64 = crate::eval::DEFAULT_SAMPLES as u64;
 /// Probability inside drawn regions when neither the command line nor the file says.
 pub const DEFAULT_CONFIDENCE: f64 = 0.95;
+/// At most this many cloud samples per drawn message of a robot log (`--samples`).
+pub const MAX_CLOUD_SAMPLES: u64 = 10_000;
 
 /// Values given on the command line (or by any other front end), overriding the file's.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -34,16 +38,79 @@ pub struct Overrides {
     pub steps: Option<StepPolicy>,
 }
 
-/// A command-line value out of range: names the flag, the value and what is accepted.
+/// A command-line value the input cannot take: names the flag, the value and why.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{flag} {value}: out of range: {expected}")]
-pub struct SettingsError {
-    /// The flag, e.g. `--samples`.
-    pub flag: &'static str,
-    /// The value given.
-    pub value: String,
-    /// What is accepted.
-    pub expected: String,
+pub enum SettingsError {
+    /// A value out of range.
+    #[error("{flag} {value}: out of range: {expected}")]
+    OutOfRange {
+        /// The flag, e.g. `--samples`.
+        flag: &'static str,
+        /// The value given.
+        value: String,
+        /// What is accepted.
+        expected: String,
+    },
+    /// A flag for the other kind of input (`--every` on a scenario).
+    #[error("{flag} {value}: applies to {} only ({why}); this input is {}", .applies_to.name_plural(), .given.name())]
+    DoesNotApply {
+        /// The flag.
+        flag: &'static str,
+        /// The value given.
+        value: String,
+        /// The kind of input it applies to.
+        applies_to: InputKind,
+        /// The kind of input given.
+        given: InputKind,
+        /// What the flag does.
+        why: &'static str,
+    },
+}
+
+/// The flags that apply to one kind of input only, what each does, and its value: the one
+/// table every input's flags are checked against.
+fn kind_flags(
+    overrides: &Overrides,
+) -> [(&'static str, InputKind, &'static str, Option<String>); 3] {
+    [
+        (
+            "--topic",
+            InputKind::Log,
+            "it picks which of a log's topics to read",
+            overrides.topics.first().cloned(),
+        ),
+        (
+            "--every",
+            InputKind::Log,
+            "it draws every N-th message of a log",
+            overrides.every.map(|n| n.to_string()),
+        ),
+        (
+            "--block-samples",
+            InputKind::Plan,
+            "Monte Carlo particles held at once; a log draws one cloud of --samples points per message",
+            overrides.block_samples.map(|n| n.to_string()),
+        ),
+    ]
+}
+
+/// Refuses the first flag given that does not apply to an input of kind `given`, naming it and
+/// what it is for; then checks the flags every input takes.
+fn check_flags(given: InputKind, overrides: &Overrides) -> Result<(), SettingsError> {
+    for (flag, applies_to, why, value) in kind_flags(overrides) {
+        if let Some(value) = value
+            && applies_to != given
+        {
+            return Err(SettingsError::DoesNotApply {
+                flag,
+                value,
+                applies_to,
+                given,
+                why,
+            });
+        }
+    }
+    check_confidence(overrides.confidence)
 }
 
 /// Everything the stages need, resolved.
@@ -56,9 +123,9 @@ pub struct Settings {
 }
 
 /// `--confidence` must be a probability strictly between 0 and 1 (every input's check).
-pub(super) fn check_confidence(confidence: Option<f64>) -> Result<(), SettingsError> {
+fn check_confidence(confidence: Option<f64>) -> Result<(), SettingsError> {
     match confidence {
-        Some(p) if !(p > 0.0 && p < 1.0) => Err(SettingsError {
+        Some(p) if !(p > 0.0 && p < 1.0) => Err(SettingsError::OutOfRange {
             flag: "--confidence",
             value: p.to_string(),
             expected: "a probability strictly between 0 and 1, e.g. 0.95".to_owned(),
@@ -75,6 +142,8 @@ pub(super) fn check_confidence(confidence: Option<f64>) -> Result<(), SettingsEr
 /// let loaded = load("camera_on_robot").unwrap();
 /// let e = resolve(&loaded.input, &Overrides { samples: Some(1), ..Default::default() }, None).unwrap_err();
 /// assert_eq!(e.to_string(), "--samples 1: out of range: use 2 ..= 10000000");
+/// let e = resolve(&loaded.input, &Overrides { every: Some(3), ..Default::default() }, None).unwrap_err();
+/// assert!(e.to_string().starts_with("--every 3: applies to robot logs (ROS 1 bags, MCAP files) only"), "{e}");
 /// let s = resolve(&loaded.input, &Overrides { seed: Some(9), ..Default::default() }, None).unwrap();
 /// assert_eq!(s.eval.seed, 9);
 /// ```
@@ -84,34 +153,20 @@ pub fn resolve(
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<Settings, SettingsError> {
     let file = &input.defaults;
-    if let Some(flag) = (!overrides.topics.is_empty())
-        .then_some("--topic")
-        .or(overrides.every.map(|_| "--every"))
-    {
-        return Err(SettingsError {
-            flag,
-            value: overrides
-                .topics
-                .first()
-                .cloned()
-                .unwrap_or_else(|| overrides.every.map_or_else(String::new, |n| n.to_string())),
-            expected: "a robot log (ROS 1 bag or MCAP file); this input is not one".to_owned(),
-        });
-    }
+    check_flags(InputKind::Plan, overrides)?;
     if let Some(n) = overrides.samples
         && !(limits::MIN_SAMPLES..=limits::MAX_SAMPLES).contains(&n)
     {
-        return Err(SettingsError {
+        return Err(SettingsError::OutOfRange {
             flag: "--samples",
             value: n.to_string(),
             expected: format!("use {} ..= {}", limits::MIN_SAMPLES, limits::MAX_SAMPLES),
         });
     }
-    check_confidence(overrides.confidence)?;
     if let Some(b) = overrides.block_samples
         && !(1..=limits::MAX_SAMPLES).contains(&b)
     {
-        return Err(SettingsError {
+        return Err(SettingsError::OutOfRange {
             flag: "--block-samples",
             value: b.to_string(),
             expected: format!("use 1 ..= {}", limits::MAX_SAMPLES),
@@ -142,5 +197,48 @@ pub fn resolve(
             choices: input.draw.clone(),
             steps,
         },
+    })
+}
+
+/// Everything reading, evaluating and drawing a robot log needs, resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogSettings {
+    /// For [`crate::input::bag::read_located`]: topics and thinning.
+    pub read: BagOptions,
+    /// For [`crate::eval::bag::evaluate_bag`]: seed and cloud samples.
+    pub eval: BagEvalSettings,
+    /// Probability inside drawn regions.
+    pub confidence: f64,
+}
+
+/// Resolves the settings of a robot log under `overrides` (a log file has no settings of its
+/// own): the same flag checks as [`resolve`], and `--samples` is the cloud drawn per message.
+///
+/// ```
+/// use posecov::app::{Overrides, resolve_log};
+/// let e = resolve_log(&Overrides { block_samples: Some(4096), ..Default::default() }).unwrap_err();
+/// assert!(e.to_string().starts_with("--block-samples 4096: applies to scenarios and pose graphs only"), "{e}");
+/// assert_eq!(resolve_log(&Overrides::default()).unwrap().eval.cloud_samples, 100);
+/// ```
+pub fn resolve_log(overrides: &Overrides) -> Result<LogSettings, SettingsError> {
+    check_flags(InputKind::Log, overrides)?;
+    let samples = overrides.samples.unwrap_or(DEFAULT_CLOUD_SAMPLES as u64);
+    if !(1..=MAX_CLOUD_SAMPLES).contains(&samples) {
+        return Err(SettingsError::OutOfRange {
+            flag: "--samples",
+            value: samples.to_string(),
+            expected: format!("1 ..= {MAX_CLOUD_SAMPLES} samples per drawn message of a robot log"),
+        });
+    }
+    Ok(LogSettings {
+        read: BagOptions {
+            topics: overrides.topics.clone(),
+            every: overrides.every,
+        },
+        eval: BagEvalSettings {
+            seed: overrides.seed.unwrap_or(0),
+            cloud_samples: samples as usize,
+        },
+        confidence: overrides.confidence.unwrap_or(DEFAULT_CONFIDENCE),
     })
 }

@@ -128,7 +128,7 @@ pub(crate) fn serve_limit(options: &ServeOptions) -> Result<Option<Duration>, Ap
     }
     match std::env::var(SERVE_SECONDS_ENV) {
         Ok(s) => {
-            let secs: u64 = s.trim().parse().map_err(|_| SettingsError {
+            let secs: u64 = s.trim().parse().map_err(|_| SettingsError::OutOfRange {
                 flag: "$POSECOV_SERVE_SECONDS",
                 value: format!("{s:?}"),
                 expected: "a whole number of seconds".to_owned(),

@@ -1,14 +1,16 @@
-//! `posecov <input>`: which path shows an input. A robot log goes to [`super::bag`]; a
-//! watched scenario file to [`super::live::watch_in_place`] (a viewer, re-streamed in place)
-//! or [`super::session`] (`--save`, rewritten whole); any other scenario or graph to one
-//! [`super::session`]. Every path takes its sink from [`super::sinks`].
+//! `posecov <input>`: which path shows an input. The input is opened once
+//! ([`super::run::open`]: a plan or a robot log); a watched scenario file goes to
+//! [`super::live::watch_in_place`] (a viewer, re-streamed in place) or [`super::session`]
+//! (`--save`, rewritten whole); any other input, plan or log, to [`super::session`]'s one
+//! sequence. Every path takes its sink from [`super::sinks`].
 
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
+use super::run::{Opened, open};
 use super::sinks::ViewOptions;
-use super::{AppError, bag, live, session};
+use super::{AppError, live, session};
 use crate::sink::Sink;
 
 /// Shows an input: in the viewer, a file, stdout or a PNG; with `watch`, again on every change
@@ -31,11 +33,14 @@ use crate::sink::Sink;
 /// assert_eq!(posecov::app::view::view(&options, &Arc::new(AtomicBool::new(false))).unwrap(), 0);
 /// ```
 pub fn view(options: &ViewOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppError> {
-    if let Some(place) = bag::locate(&options.scenario)? {
-        return bag::view(options, &place, cancel);
-    }
+    let opened = open(&options.scenario)?;
     if !options.watch {
-        return session::show(options, cancel);
+        return session::show(options, opened, cancel);
+    }
+    if matches!(opened, Opened::Log(_)) {
+        return Err(AppError::Watch(
+            "needs a scenario file to watch; a robot log is read once".to_owned(),
+        ));
     }
     let path = Path::new(&options.scenario);
     if !path.is_file() {

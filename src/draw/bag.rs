@@ -30,7 +30,7 @@ use crate::uncertain::Method;
 
 mod text;
 
-pub use text::description;
+pub use text::{description, issue_word};
 
 /// RViz's default covariance colour (its position shape).
 const RVIZ: Color = Color::rgb(204, 51, 204);
@@ -58,13 +58,13 @@ pub struct BagDrawSettings {
 /// ```
 /// use posecov::draw::bag::{BagDrawSettings, bag_scene, description};
 /// use posecov::eval::bag::{BagEvalSettings, evaluate_bag};
-/// use posecov::input::{About, bag::{BagOptions, read_bag}};
+/// use posecov::input::{About, Format, bag::{BagOptions, read_bag}};
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
 /// let plan = read_bag(path.as_ref(), &BagOptions::default(), &mut |_, _| {}, None).unwrap();
 /// let e = evaluate_bag(&plan, &BagEvalSettings::default());
 /// let about = About { title: "test2.bag".into(), description: String::new(), source: String::new() };
 /// let settings = BagDrawSettings { about, confidence: 0.95, axis_length: None };
-/// let scene = bag_scene(&e, &settings, &description(&plan, &e, 0.95));
+/// let scene = bag_scene(&e, &settings, &description(&plan, Format::Ros1Bag, &e, 0.95));
 /// assert!(scene.validate().is_ok());
 /// assert!(scene.items.iter().any(|i| i.path == "world/jackal_velocity_controller/odom/meaning/banana"));
 /// ```

@@ -30,6 +30,45 @@ pub enum Format {
     Graph,
 }
 
+/// What posecov does with an input: evaluate a typed plan, or stream a robot log. Decided
+/// once, from the [`Format`] ([`Format::kind`]); the application routes on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InputKind {
+    /// A scenario or a pose graph: read whole into a [`Plan`](crate::plan::Plan), evaluated
+    /// with Monte Carlo and the analytic methods.
+    Plan,
+    /// A robot log (ROS 1 bag, MCAP): streamed, message by message, into a bounded log
+    /// summary ([`crate::plan::bag`]).
+    Log,
+}
+
+impl InputKind {
+    /// One input of the kind, in words ("this input is a robot log").
+    ///
+    /// ```
+    /// assert_eq!(posecov::input::format::InputKind::Plan.name(), "a scenario or a pose graph");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            InputKind::Plan => "a scenario or a pose graph",
+            InputKind::Log => "a robot log",
+        }
+    }
+
+    /// The kind in words, for messages ("applies to robot logs").
+    ///
+    /// ```
+    /// assert_eq!(posecov::input::format::InputKind::Log.name_plural(), "robot logs (ROS 1 bags, MCAP files)");
+    /// ```
+    pub fn name_plural(self) -> &'static str {
+        match self {
+            InputKind::Plan => "scenarios and pose graphs",
+            InputKind::Log => "robot logs (ROS 1 bags, MCAP files)",
+        }
+    }
+}
+
 /// ROS 1 bag magic (format 2.0).
 pub const ROSBAG_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 /// MCAP magic.
@@ -67,6 +106,20 @@ impl Format {
             Format::Ros1Bag => "ROS 1 bag",
             Format::Mcap => "MCAP file (ROS 2 bag)",
             Format::Graph => "g2o / GTSAM pose graph",
+        }
+    }
+
+    /// Whether the format is a plan or a robot log: the one place that decides.
+    ///
+    /// ```
+    /// use posecov::input::{Format, format::InputKind};
+    /// assert_eq!(Format::Mcap.kind(), InputKind::Log);
+    /// assert_eq!(Format::Graph.kind(), InputKind::Plan);
+    /// ```
+    pub fn kind(self) -> InputKind {
+        match self {
+            Format::Scenario | Format::Graph => InputKind::Plan,
+            Format::Ros1Bag | Format::Mcap => InputKind::Log,
         }
     }
 

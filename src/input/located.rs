@@ -51,6 +51,27 @@ pub enum InputError {
 
 impl std::error::Error for InputError {}
 
+impl InputError {
+    /// The same error about the file named `to` instead of `from` (a bundled input read
+    /// through a temporary file is named as the user knows it).
+    ///
+    /// ```
+    /// use posecov::input::InputError;
+    /// let e = InputError::Format { file: "/tmp/x".into(), message: "cut".into() };
+    /// assert_eq!(e.renamed("/tmp/x", "a.bag (bundled)").to_string(), "a.bag (bundled): cut");
+    /// ```
+    pub fn renamed(mut self, from: &str, to: &str) -> InputError {
+        let (InputError::Read { path: file, .. }
+        | InputError::Format { file, .. }
+        | InputError::At { file, .. }
+        | InputError::In { file, .. }) = &mut self;
+        if file == from {
+            *file = to.to_owned();
+        }
+        self
+    }
+}
+
 impl fmt::Display for InputError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

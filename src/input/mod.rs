@@ -6,9 +6,12 @@
 //! - [`graph`]: g2o / GTSAM text pose graphs (and two bundled GTSAM examples);
 //! - [`bag`]: robot logs, ROS 1 bags and MCAP files (ROS 2), streamed.
 //!
-//! [`open`] is the one entry: it finds the file (or a bundled example by name), decides its
-//! [`Format`] by content and extension, and calls that format's reader. A new format is a
-//! [`Format`] variant, a [`Source`] variant and one arm in [`open_file`] and [`open_text`].
+//! [`locate`] is the one entry: it finds the file (or a bundled example by name) and decides
+//! its [`Format`] by content and extension, once; [`Format::kind`] says whether it is a plan
+//! ([`open_located`]: that format's reader) or a robot log ([`bag::read_located`]). A new plan
+//! format is a [`Format`] variant, a [`Source`] variant and one arm in [`open_file`] and
+//! [`open_text`]; a new log source is one module under [`bag`] and one arm in
+//! [`bag::read_located`].
 //!
 //! ```
 //! use posecov::input::{Format, open};
@@ -31,7 +34,7 @@ pub mod graph;
 mod located;
 pub mod scenario;
 
-pub use format::Format;
+pub use format::{Format, InputKind};
 pub use located::{InputError, Locator};
 
 /// The file an [`Input`] came from, kept to locate later (evaluation) errors in it.
@@ -120,44 +123,115 @@ pub fn examples() -> Vec<Example> {
         .collect()
 }
 
+/// Where an input is: a file on disk, or an example built into the binary.
+#[derive(Debug, Clone)]
+pub enum Place {
+    /// A file (its path as given).
+    File(std::path::PathBuf),
+    /// A bundled example.
+    Bundled(Example),
+}
+
+/// An input found and its format decided, once ([`locate`]): what every later step reads
+/// by, so that nothing detects the format again.
+#[derive(Debug, Clone)]
+pub struct Located {
+    /// Where it is.
+    pub place: Place,
+    /// Its format, by content and extension ([`format::detect`]) or the bundled example's.
+    pub format: Format,
+}
+
+impl Located {
+    /// The file as messages name it: the path as given, or `NAME.ext (bundled)`.
+    ///
+    /// ```
+    /// assert_eq!(posecov::input::locate("jackal_odometry").unwrap().origin(), "test2.bag (bundled)");
+    /// ```
+    pub fn origin(&self) -> String {
+        match &self.place {
+            Place::File(path) => path.display().to_string(),
+            Place::Bundled(e) => format!("{} (bundled)", e.file),
+        }
+    }
+
+    /// Whether it is a plan or a robot log ([`Format::kind`]).
+    pub fn kind(&self) -> format::InputKind {
+        self.format.kind()
+    }
+}
+
+/// Finds an input — a file (its format by content and extension, [`format::detect`]), else a
+/// bundled example by name — and decides its format, once. Errors name the file, or list the
+/// bundled examples for a name that is none.
+///
+/// ```
+/// use posecov::input::{Format, locate};
+/// assert_eq!(locate("covariance_health").unwrap().format, Format::Mcap);
+/// let e = locate("no_such_thing").unwrap_err().to_string();
+/// assert!(e.contains("camera_on_robot") && e.contains("gtsam_pose2example"), "{e}");
+/// assert!(e.contains("; MCAP files (ROS 2 bags): covariance_health"), "{e}");
+/// ```
+pub fn locate(name_or_path: &str) -> Result<Located, InputError> {
+    let path = Path::new(name_or_path);
+    if path.exists() {
+        let format = format::detect(name_or_path, &format::read_head(path)?)?;
+        return Ok(Located {
+            place: Place::File(path.to_owned()),
+            format,
+        });
+    }
+    let examples = examples();
+    let stem = |e: &Example| name_or_path == e.name || name_or_path == e.file;
+    if let Some(e) = examples.iter().find(|e| stem(e)) {
+        return Ok(Located {
+            place: Place::Bundled(*e),
+            format: e.format,
+        });
+    }
+    let by_format: Vec<String> = Format::ALL
+        .iter()
+        .filter_map(|f| {
+            let names: Vec<&str> = examples
+                .iter()
+                .filter(|e| e.format == *f)
+                .map(|e| e.name)
+                .collect();
+            (!names.is_empty()).then(|| format!("{}: {}", f.name_plural(), names.join(", ")))
+        })
+        .collect();
+    Err(InputError::Read {
+        path: name_or_path.to_owned(),
+        reason: format!(
+            "no such file, and no bundled example of that name (see `posecov list`; {})",
+            by_format.join("; ")
+        ),
+    })
+}
+
 /// Reads a file (its format by content and extension) or else a bundled example by name, and
-/// checks it. Errors name the file and the place in it.
+/// checks it: [`locate`], then [`open_located`]. Errors name the file and the place in it.
 ///
 /// ```
 /// let e = posecov::input::open("no_such_thing").unwrap_err().to_string();
 /// assert!(e.contains("camera_on_robot") && e.contains("gtsam_pose2example"), "{e}");
-/// assert!(e.contains("; MCAP files (ROS 2 bags): covariance_health"), "{e}");
 /// ```
 pub fn open(name_or_path: &str) -> Result<(Source, Input), InputError> {
-    let path = Path::new(name_or_path);
-    if path.exists() {
-        return open_file(path);
-    }
-    let examples = examples();
-    let stem = |e: &Example| name_or_path == e.name || name_or_path == e.file;
-    match examples.iter().find(|e| stem(e)) {
-        Some(e) => open_text(e.text, &format!("{} (bundled)", e.file), e.format),
-        None => {
-            let by_format: Vec<String> = Format::ALL
-                .iter()
-                .filter_map(|f| {
-                    let names: Vec<&str> = examples
-                        .iter()
-                        .filter(|e| e.format == *f)
-                        .map(|e| e.name)
-                        .collect();
-                    (!names.is_empty())
-                        .then(|| format!("{}: {}", f.name_plural(), names.join(", ")))
-                })
-                .collect();
-            Err(InputError::Read {
-                path: name_or_path.to_owned(),
-                reason: format!(
-                    "no such file, and no bundled example of that name (see `posecov list`; {})",
-                    by_format.join("; ")
-                ),
-            })
-        }
+    open_located(&locate(name_or_path)?)
+}
+
+/// Reads and checks a located plan input (a scenario or a graph) in its decided format; a
+/// robot log is refused (it is streamed by [`bag::read_located`]).
+///
+/// ```
+/// let located = posecov::input::locate("camera_on_robot").unwrap();
+/// let (_, input) = posecov::input::open_located(&located).unwrap();
+/// assert!(!input.about.title.is_empty());
+/// ```
+pub fn open_located(located: &Located) -> Result<(Source, Input), InputError> {
+    match &located.place {
+        Place::File(path) => open_file_as(path, located.format),
+        Place::Bundled(e) => open_text(e.text, &located.origin(), located.format),
     }
 }
 
@@ -169,7 +243,11 @@ pub fn open(name_or_path: &str) -> Result<(Source, Input), InputError> {
 /// ```
 pub fn open_file(path: &Path) -> Result<(Source, Input), InputError> {
     let file = path.display().to_string();
-    let format = format::detect(&file, &format::read_head(path)?)?;
+    open_file_as(path, format::detect(&file, &format::read_head(path)?)?)
+}
+
+/// Reads and checks a file of a format already decided.
+fn open_file_as(path: &Path, format: Format) -> Result<(Source, Input), InputError> {
     match format {
         Format::Scenario => {
             let s = scenario::Scenario::load(path)?;
@@ -180,7 +258,7 @@ pub fn open_file(path: &Path) -> Result<(Source, Input), InputError> {
             let (g, input) = graph::read_file(path)?;
             Ok((Source::Graph(g), input))
         }
-        Format::Ros1Bag | Format::Mcap => Err(not_a_plan(&file, format)),
+        Format::Ros1Bag | Format::Mcap => Err(not_a_plan(&path.display().to_string(), format)),
     }
 }
 
@@ -206,13 +284,13 @@ pub fn open_text(text: &str, origin: &str, format: Format) -> Result<(Source, In
     }
 }
 
-/// A robot log is streamed into a [`bag`] plan ([`bag::read_bag`]), not opened as an
-/// [`Input`]: the application routes it (`app::bag`).
+/// A robot log is streamed into a log summary ([`bag::read_located`]), not opened as an
+/// [`Input`]: the application routes it by [`Format::kind`].
 fn not_a_plan(file: &str, format: Format) -> InputError {
     InputError::Format {
         file: file.to_owned(),
         message: format!(
-            "a {} is a robot log: it is streamed by input::bag::read_bag (posecov FILE, report, check)",
+            "a {} is a robot log, read by `posecov FILE`, `report` and `check`; it has no scenario to edit or evaluate",
             format.name()
         ),
     }

@@ -27,30 +27,6 @@ pub const COV_LEN: usize = 36;
 /// rotation about the body's axes).
 pub const ROS_AXES: [&str; 6] = ["x", "y", "z", "roll", "pitch", "yaw"];
 
-/// Which container a log came in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum LogFormat {
-    /// ROS 1 bag, format 2.0.
-    Ros1Bag,
-    /// MCAP (ROS 2, CDR messages).
-    Mcap,
-}
-
-impl LogFormat {
-    /// The words a user knows.
-    ///
-    /// ```
-    /// assert_eq!(posecov::plan::bag::LogFormat::Mcap.label(), "MCAP (ROS 2)");
-    /// ```
-    pub fn label(self) -> &'static str {
-        match self {
-            LogFormat::Ros1Bag => "ROS 1 bag",
-            LogFormat::Mcap => "MCAP (ROS 2)",
-        }
-    }
-}
-
 /// The message types posecov reads a pose with covariance from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -150,26 +126,6 @@ pub enum Issue {
 }
 
 impl Issue {
-    /// The word shown in the text panel and the README.
-    ///
-    /// ```
-    /// assert_eq!(posecov::plan::bag::Issue::UnknownMarker.word(), "unknown (-1 marker)");
-    /// ```
-    pub fn word(self) -> &'static str {
-        match self {
-            Issue::AllZero => "all zero (unknown)",
-            Issue::UnknownMarker => "unknown (-1 marker)",
-            Issue::Placeholder => "placeholder (≥ 1e6)",
-            Issue::NonFinite => "NaN or infinite",
-            Issue::Asymmetric => "asymmetric",
-            Issue::NotPsd => "not positive semi-definite",
-            Issue::BadOrientation => "orientation not a unit quaternion",
-            Issue::SuddenDrop => "sudden drop (relocalisation?)",
-            Issue::Growth => "unbounded growth",
-            Issue::Undecodable => "undecodable bytes",
-        }
-    }
-
     /// Whether a message with this issue cannot be drawn as a Gaussian (it is drawn as an
     /// invalid marker instead). Placeholders, drops and growth are facts, not errors.
     ///
@@ -319,8 +275,6 @@ pub struct SkippedTopic {
 /// A whole log, reduced: the pose topics and what was skipped.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct BagPlan {
-    /// Container format (`None` only for an empty default).
-    pub format: Option<LogFormat>,
     /// The pose-with-covariance topics read (filtered by `--topic`), in name order.
     pub topics: Vec<TopicPlan>,
     /// Other topics, in name order.

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use serde::Serialize;
 
 use super::document::{Edit, EditError, LiveDocument};
-use crate::app::session::Session;
+use crate::app::run::PlanRun;
 use crate::app::{AppError, Loaded, Overrides, resolve};
 use crate::plan::StepPolicy;
 use crate::sample::CHUNK_SIZE;
@@ -395,7 +395,7 @@ fn show(
             status.samples = samples;
             shared.changed.notify_all();
         }
-        let mut session = Session::from_loaded(job.loaded.clone(), pass, Some(Arc::clone(cancel)))?;
+        let mut session = PlanRun::from_loaded(job.loaded.clone(), pass, Some(Arc::clone(cancel)))?;
         if cancel.load(Ordering::SeqCst) {
             return Ok(());
         }

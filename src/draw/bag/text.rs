@@ -4,6 +4,7 @@
 use std::fmt::Write;
 
 use crate::eval::bag::{BagEvaluation, PoseState};
+use crate::input::Format;
 use crate::plan::bag::{BagPlan, Issue, TopicPlan};
 use crate::uncertain::chi2_radius;
 
@@ -12,14 +13,35 @@ fn secs(ns: i64) -> String {
     format!("{:.3} s", ns as f64 * 1e-9)
 }
 
-/// The Markdown summary of a log: per topic its type, frames, counts, stamps, health (count
+/// The word for a covariance issue, shown in the text panel, the text report and the README.
+///
+/// ```
+/// use posecov::{draw::bag::issue_word, plan::bag::Issue};
+/// assert_eq!(issue_word(Issue::UnknownMarker), "unknown (-1 marker)");
+/// ```
+pub fn issue_word(issue: Issue) -> &'static str {
+    match issue {
+        Issue::AllZero => "all zero (unknown)",
+        Issue::UnknownMarker => "unknown (-1 marker)",
+        Issue::Placeholder => "placeholder (≥ 1e6)",
+        Issue::NonFinite => "NaN or infinite",
+        Issue::Asymmetric => "asymmetric",
+        Issue::NotPsd => "not positive semi-definite",
+        Issue::BadOrientation => "orientation not a unit quaternion",
+        Issue::SuddenDrop => "sudden drop (relocalisation?)",
+        Issue::Growth => "unbounded growth",
+        Issue::Undecodable => "undecodable bytes",
+    }
+}
+
+/// The Markdown summary of a log (a `format` file): per topic its type, frames, counts, stamps, health (count
 /// and first stamp per issue), what is drawn (planar or 3-D, χ² dimensions), then the skipped
 /// topics.
 ///
 /// See [`bag_scene`](super::bag_scene) for an example.
-pub fn description(plan: &BagPlan, e: &BagEvaluation, confidence: f64) -> String {
+pub fn description(plan: &BagPlan, format: Format, e: &BagEvaluation, confidence: f64) -> String {
     let mut s = String::new();
-    let format = plan.format.map_or("log", |f| f.label());
+    let format = format.name();
     let _ = writeln!(
         s,
         "**{format}**: {} messages, {} pose topic(s) read.",
@@ -111,7 +133,7 @@ fn topic(s: &mut String, t: &TopicPlan, e: &crate::eval::bag::TopicEvaluation, p
             "\n| covariance health | messages | first at |\n|---|---|---|"
         );
         for (issue, c) in &t.health.issues {
-            let mut word = issue.word().to_owned();
+            let mut word = issue_word(*issue).to_owned();
             if *issue == Issue::NotPsd
                 && let Some(lo) = t.health.min_eigenvalue
             {

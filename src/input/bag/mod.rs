@@ -21,12 +21,12 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::plan::bag::{
-    BagPlan, DrawnMessage, Health, Issue, LogFormat, PoseMessage, PoseMessageKind, SeriesPoint,
-    SkippedTopic, TopicPlan,
+    BagPlan, DrawnMessage, Health, Issue, PoseMessage, PoseMessageKind, SeriesPoint, SkippedTopic,
+    TopicPlan,
 };
 
-use super::InputError;
 use super::format::{self, Format};
+use super::{InputError, Located, Place};
 
 pub mod bundled;
 pub mod decode;
@@ -53,10 +53,10 @@ pub struct BagOptions {
     pub every: Option<u64>,
 }
 
-/// Reads a log into a [`BagPlan`]; its format by content and extension ([`format::detect`]).
-/// `progress(done, total)` is called as the read advances (chunks or bytes); a raised `cancel`
-/// stops the read at the next message and marks the plan `cancelled` (everything before is
-/// kept). Errors name the file: unreadable, damaged, not a log, or a `--topic` it lacks.
+/// Reads a log file into a [`BagPlan`], its format by content and extension
+/// ([`format::detect`]): [`locate`](crate::input::locate) the file, then [`read_located`].
+/// For tests and benchmarks that hold a path; the application locates once and calls
+/// [`read_located`].
 ///
 /// See the [module docs](self) for an example.
 pub fn read_bag(
@@ -66,22 +66,69 @@ pub fn read_bag(
     cancel: Option<&AtomicBool>,
 ) -> Result<BagPlan, InputError> {
     let file = path.display().to_string();
-    let format = match format::detect(&file, &format::read_head(path)?)? {
-        Format::Ros1Bag => LogFormat::Ros1Bag,
-        Format::Mcap => LogFormat::Mcap,
-        other => {
-            return Err(InputError::Format {
-                file,
-                message: format!("a {}, not a robot log (ROS 1 bag or MCAP)", other.name()),
-            });
-        }
+    let located = Located {
+        place: Place::File(path.to_owned()),
+        format: format::detect(&file, &format::read_head(path)?)?,
     };
-    let mut collector = Collector::new(options, cancel);
-    match format {
-        LogFormat::Ros1Bag => ros1::read(path, &mut collector, progress)?,
-        LogFormat::Mcap => mcap::read(path, &mut collector, progress)?,
+    read_located(&located, options, progress, cancel)
+}
+
+/// Reads a located robot log (a file, or a bundled log) into a [`BagPlan`] by its decided
+/// format: the one arm per log source. `progress(done, total)` is called as the read advances
+/// (chunks or bytes); a raised `cancel` stops the read at the next message and marks the plan
+/// `cancelled` (everything before is kept). Errors name the file: unreadable, damaged, not a
+/// log, or a `--topic` it lacks.
+///
+/// A new log source (a live topic subscription is the next one) is one module that hands
+/// every message to the per-topic collector, as `ros1.rs` and `mcap.rs` do, and one arm here.
+///
+/// ```
+/// use posecov::input::{locate, bag::{BagOptions, read_located}};
+/// let log = locate("covariance_health").unwrap();
+/// let plan = read_located(&log, &BagOptions::default(), &mut |_, _| {}, None).unwrap();
+/// assert_eq!(plan.topics.len(), 3);
+/// ```
+pub fn read_located(
+    located: &Located,
+    options: &BagOptions,
+    progress: &mut dyn FnMut(u64, u64),
+    cancel: Option<&AtomicBool>,
+) -> Result<BagPlan, InputError> {
+    let origin = located.origin();
+    let read = |path: &Path, progress: &mut dyn FnMut(u64, u64)| {
+        let mut collector = Collector::new(options, cancel);
+        match located.format {
+            Format::Ros1Bag => ros1::read(path, &mut collector, progress)?,
+            Format::Mcap => mcap::read(path, &mut collector, progress)?,
+            other => {
+                return Err(InputError::Format {
+                    file: origin.clone(),
+                    message: format!("a {}, not a robot log (ROS 1 bag or MCAP)", other.name()),
+                });
+            }
+        }
+        collector.finish(path)
+    };
+    match &located.place {
+        Place::File(path) => read(path, progress),
+        Place::Bundled(example) => {
+            // The readers take a file: the bundled bytes go to a temporary one, named back
+            // to the bundled log in every message.
+            let log = bundled::find(example.name).ok_or_else(|| InputError::Read {
+                path: origin.clone(),
+                reason: "not a bundled robot log".to_owned(),
+            })?;
+            let tmp =
+                std::env::temp_dir().join(format!("posecov-{}-{}", std::process::id(), log.file));
+            std::fs::write(&tmp, log.bytes).map_err(|e| InputError::Read {
+                path: tmp.display().to_string(),
+                reason: e.to_string(),
+            })?;
+            let plan = read(&tmp, progress);
+            std::fs::remove_file(&tmp).ok();
+            plan.map_err(|e| e.renamed(&tmp.display().to_string(), &origin))
+        }
     }
-    collector.finish(path, format)
 }
 
 /// A connection (ROS 1) or channel (MCAP): its topic, type and what posecov makes of it
@@ -289,7 +336,7 @@ impl<'a> Collector<'a> {
         state.add(decoded, log_time_ns);
     }
 
-    fn finish(self, path: &Path, format: LogFormat) -> Result<BagPlan, InputError> {
+    fn finish(self, path: &Path) -> Result<BagPlan, InputError> {
         for wanted in &self.options.topics {
             if !self.topics.contains_key(wanted) && !self.cancelled {
                 let why = match self.skipped.get(wanted) {
@@ -318,7 +365,6 @@ impl<'a> Collector<'a> {
             }
         }
         Ok(BagPlan {
-            format: Some(format),
             topics: self
                 .topics
                 .into_iter()
@@ -487,7 +533,7 @@ mod tests {
             Some(&kind),
         );
         c.declare("/camera", "sensor_msgs/Image", None);
-        let plan = c.finish(Path::new("x.bag"), LogFormat::Ros1Bag).unwrap();
+        let plan = c.finish(Path::new("x.bag")).unwrap();
         assert_eq!(plan.topics.len(), 1);
         assert_eq!(
             (plan.topics[0].name.as_str(), plan.topics[0].count),
@@ -506,7 +552,7 @@ mod tests {
             confidence: 0.95,
             axis_length: None,
         };
-        let text = crate::draw::bag::description(&plan, &e, 0.95);
+        let text = crate::draw::bag::description(&plan, Format::Ros1Bag, &e, 0.95);
         assert!(text.contains("0 messages"), "{text}");
         let scene = crate::draw::bag::bag_scene(&e, &settings, &text);
         assert!(scene.validate().is_ok());

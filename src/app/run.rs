@@ -1,0 +1,217 @@
+//! One pure run of any input: [`open`] decides, once, whether the input is a plan (a scenario,
+//! a pose graph) or a robot log; [`Run::start`] resolves its settings (one table of flags,
+//! [`super::resolve`] / [`super::resolve_log`]), evaluates and draws it. A run is the scene
+//! plus, for a plan whose Monte Carlo ran in blocks, the later blocks' clouds
+//! ([`PlanRun::block`]); every sink shows it through one sequence (`session::show`).
+//!
+//! ```
+//! use posecov::app::{Overrides, run::{Run, open}};
+//! let overrides = Overrides { samples: Some(64), ..Default::default() };
+//! let plan = Run::start(open("camera_on_robot").unwrap(), &overrides, None).unwrap();
+//! let log = Run::start(open("covariance_health").unwrap(), &overrides, None).unwrap();
+//! assert!(matches!(plan, Run::Plan(_)) && matches!(log, Run::Log(_)));
+//! assert!(plan.scene().validate().is_ok() && log.scene().validate().is_ok());
+//! ```
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::bag::{self, LogRun};
+use super::{AppError, Loaded, Overrides, Settings, resolve_log};
+use crate::draw;
+use crate::eval::{self, AnyEvaluation};
+use crate::input::{self, InputKind, Located};
+use crate::scene::Scene;
+
+/// An input found, its format decided once and its kind with it.
+#[derive(Debug, Clone)]
+pub enum Opened {
+    /// A scenario or a pose graph, read and checked (boxed: a plan is large).
+    Plan(Box<Loaded>),
+    /// A robot log, found but not read yet (it is streamed by the run).
+    Log(Located),
+}
+
+/// Finds an input (a file, or a bundled example by name), decides its format and kind once
+/// ([`input::locate`], [`crate::input::Format::kind`]), and reads it if it is a plan. The one
+/// place every command and sink routes an input.
+///
+/// ```
+/// use posecov::app::run::{Opened, open};
+/// assert!(matches!(open("jackal_odometry").unwrap(), Opened::Log(_)));
+/// assert!(matches!(open("gtsam_pose2example").unwrap(), Opened::Plan(_)));
+/// ```
+pub fn open(name_or_path: &str) -> Result<Opened, AppError> {
+    let located = input::locate(name_or_path)?;
+    Ok(match located.kind() {
+        InputKind::Plan => {
+            let (source, input) = input::open_located(&located)?;
+            Opened::Plan(Box::new(Loaded { source, input }))
+        }
+        InputKind::Log => Opened::Log(located),
+    })
+}
+
+/// A plan evaluated and drawn: the numbers, the scene, and what makes the later Monte Carlo
+/// blocks' clouds.
+#[derive(Debug)]
+pub struct PlanRun {
+    /// What was loaded.
+    pub loaded: Loaded,
+    /// The settings resolved for it.
+    pub settings: Settings,
+    /// The numbers.
+    pub evaluation: AnyEvaluation,
+    /// The picture (validated).
+    pub scene: Scene,
+}
+
+impl PlanRun {
+    /// Resolves, evaluates and draws a loaded plan (no spinner: live mode's path).
+    ///
+    /// ```
+    /// use posecov::app::{Overrides, load, run::PlanRun};
+    /// let loaded = load("camera_on_robot").unwrap();
+    /// let r = PlanRun::from_loaded(loaded, &Overrides { samples: Some(64), ..Default::default() }, None).unwrap();
+    /// assert!(!r.scene.items.is_empty() && r.later_blocks() == 0);
+    /// ```
+    pub fn from_loaded(
+        loaded: Loaded,
+        overrides: &Overrides,
+        cancel: Option<Arc<AtomicBool>>,
+    ) -> Result<Self, AppError> {
+        let (settings, evaluation, scene) = super::evaluate_and_draw(&loaded, overrides, cancel)?;
+        Ok(Self {
+            loaded,
+            settings,
+            evaluation,
+            scene,
+        })
+    }
+
+    /// How many Monte Carlo blocks beyond the first are shown after the scene.
+    pub fn later_blocks(&self) -> u64 {
+        let (_, n, b, _) = self.evaluation.run();
+        (n.div_ceil(b.max(1)) as u64).saturating_sub(1)
+    }
+
+    /// The clouds of Monte Carlo block `k` (1 ..= [`later_blocks`](Self::later_blocks)),
+    /// re-simulated and drawn; `None` when there is no such block.
+    ///
+    /// # Errors
+    /// An evaluation error, located in the file.
+    pub fn block(&self, k: usize) -> Result<Option<Scene>, AppError> {
+        let plan = &self.loaded.input.plan;
+        let Some(block) = eval::evaluate_block(plan, &self.settings.eval, &self.evaluation, k)
+            .map_err(|e| self.loaded.locate(&e))?
+        else {
+            return Ok(None);
+        };
+        Ok(Some(draw::particle_part(
+            &self.evaluation,
+            &block,
+            k,
+            &self.settings.draw,
+        )))
+    }
+}
+
+/// One run of any input: its scene, and for a plan the later blocks.
+#[derive(Debug)]
+pub enum Run {
+    /// A scenario or a pose graph (boxed, as the log: runs are large).
+    Plan(Box<PlanRun>),
+    /// A robot log.
+    Log(Box<LogRun>),
+}
+
+impl Run {
+    /// Resolves the settings of an opened input and evaluates and draws it: a plan with a
+    /// spinner on a terminal past 0.3 s, a log streamed with a progress bar (`cancel` stops
+    /// the read and keeps what was read).
+    ///
+    /// See the [module docs](self) for an example.
+    ///
+    /// # Errors
+    /// A flag the input cannot take; the input's errors, located in its file.
+    pub fn start(
+        opened: Opened,
+        overrides: &Overrides,
+        cancel: Option<Arc<AtomicBool>>,
+    ) -> Result<Run, AppError> {
+        match opened {
+            Opened::Plan(loaded) => {
+                let what = format!("evaluating {}", loaded.input.about.title);
+                with_spinner(&what, || PlanRun::from_loaded(*loaded, overrides, cancel))
+                    .map(|run| Run::Plan(Box::new(run)))
+            }
+            Opened::Log(located) => {
+                let settings = resolve_log(overrides)?;
+                bag::run(&located, &settings, cancel.as_deref()).map(|run| Run::Log(Box::new(run)))
+            }
+        }
+    }
+
+    /// The picture.
+    pub fn scene(&self) -> &Scene {
+        match self {
+            Run::Plan(r) => &r.scene,
+            Run::Log(r) => &r.scene,
+        }
+    }
+
+    /// The seed in effect (the recording's id carries it).
+    pub fn seed(&self) -> u64 {
+        match self {
+            Run::Plan(r) => r.settings.eval.seed,
+            Run::Log(r) => r.settings.eval.seed,
+        }
+    }
+
+    /// Monte Carlo blocks shown after the scene (none for a log).
+    pub fn later_blocks(&self) -> u64 {
+        match self {
+            Run::Plan(r) => r.later_blocks(),
+            Run::Log(_) => 0,
+        }
+    }
+
+    /// Ctrl-C cut the input's read short: what is shown is what was read.
+    pub fn cut_short(&self) -> bool {
+        match self {
+            Run::Plan(_) => false,
+            Run::Log(r) => r.plan.cancelled,
+        }
+    }
+}
+
+/// Runs `work`, showing a spinner on a terminal when it takes more than 0.3 s.
+fn with_spinner<T>(message: &str, work: impl FnOnce() -> T) -> T {
+    let spinner = ProgressBar::new_spinner().with_message(message.to_owned());
+    spinner.set_style(
+        ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    // indicatif draws only on a terminal; the work wakes the ticker when done.
+    let done = AtomicBool::new(false);
+    let result = std::thread::scope(|scope| {
+        let ticker = scope.spawn(|| {
+            let start = std::time::Instant::now();
+            while !done.load(Ordering::Acquire) {
+                if start.elapsed() > Duration::from_millis(300) {
+                    spinner.tick();
+                }
+                std::thread::park_timeout(Duration::from_millis(80));
+            }
+        });
+        let result = work();
+        done.store(true, Ordering::Release);
+        ticker.thread().unpark();
+        result
+    });
+    spinner.finish_and_clear();
+    result
+}
