@@ -11,7 +11,9 @@ use crate::error::{Error, Result, check_finite};
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 
 mod confidence;
-pub use confidence::{chi2_probability, chi2_radius, sigma_probability, sigma_radius};
+pub use confidence::{
+    Coverage, Region, anees_band, chi2_probability, chi2_radius, sigma_probability, sigma_radius,
+};
 
 /// Which side of the mean a covariance's perturbation multiplies.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -154,6 +154,22 @@ function showError(message) {
   $("error").textContent = message || "";
 }
 
+// "· inside the 95 % regions of map_from_camera: first order 95 % tangent, 70 % Cartesian; …"
+function coverageText(coverage) {
+  if (!coverage || coverage.length === 0) return "";
+  const names = { tangent: "tangent", tangent_position: "position", cartesian: "Cartesian", vector_space: "ellipse" };
+  const pct = (x) => `${(100 * x).toFixed(1)} %`;
+  const first = coverage[0];
+  const at = first.step === null ? first.output : `${first.output} (step ${first.step})`;
+  const methods = coverage.map((m) => {
+    const regions = m.coverage
+      .filter((c) => c.region !== "tangent_position")
+      .map((c) => `${pct(c.inside)} ${names[c.region] || c.region}`);
+    return `${m.method} ${regions.join(", ")}`;
+  });
+  return ` · inside the ${pct(first.confidence)} regions of ${at}: ${methods.join("; ")}`;
+}
+
 function updateStatus(s) {
   if (!s) return;
   const el = $("status");
@@ -164,7 +180,7 @@ function updateStatus(s) {
   const first = s.first_picture_ms !== null ? ` · first picture ${s.first_picture_ms.toFixed(0)} ms` : "";
   const final = s.final_picture_ms !== null && s.done ? ` · final ${s.final_picture_ms.toFixed(0)} ms` : "";
   const doing = busy ? ` · ${s.phase} of ${s.generation} (${s.samples} samples)…` : "";
-  el.textContent = `showing ${shown}${s.done ? "" : " (preview)"}${samples}${first}${final}${doing}`;
+  el.textContent = `showing ${shown}${s.done ? "" : " (preview)"}${samples}${first}${final}${doing}${coverageText(s.coverage)}`;
   el.dataset.generation = s.generation;
   el.dataset.shown = s.shown === null ? "" : s.shown;
   el.dataset.done = s.done;

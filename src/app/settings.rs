@@ -14,7 +14,7 @@ use crate::plan::{StepPolicy, limits};
 /// Monte Carlo samples when neither the command line nor the file says.
 pub const DEFAULT_SAMPLES: u64 = crate::eval::DEFAULT_SAMPLES as u64;
 /// Probability inside drawn regions when neither the command line nor the file says.
-pub const DEFAULT_CONFIDENCE: f64 = 0.95;
+pub const DEFAULT_CONFIDENCE: f64 = crate::eval::DEFAULT_CONFIDENCE;
 /// At most this many cloud samples per drawn message of a robot log (`--samples`).
 pub const MAX_CLOUD_SAMPLES: u64 = 10_000;
 
@@ -188,6 +188,7 @@ pub fn resolve(
             methods: file.methods.clone(),
             block_samples: overrides.block_samples.map(|b| b as usize),
             steps,
+            confidence,
             unscented: file.sigma_points.unwrap_or_default(),
             cancel,
         },

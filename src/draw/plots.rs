@@ -7,7 +7,7 @@ use crate::eval::{Evaluation, Node, Role};
 use crate::lie::LieGroup;
 use crate::plan::OpKind;
 use crate::scene::{self, Plot, ScalarSeries};
-use crate::uncertain::Method;
+use crate::uncertain::{Method, Region};
 
 /// A kind of plot: entity id, title (what and in which frame) and unit.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -39,6 +39,17 @@ const ORTHOGONALITY: PlotKind = PlotKind {
     unit: "",
 };
 
+const COVERAGE: PlotKind = PlotKind {
+    id: "share_of_monte_carlo_samples_inside_the_tangent_region",
+    title: "samples inside the drawn region",
+    unit: "",
+};
+const ANEES: PlotKind = PlotKind {
+    id: "anees_of_monte_carlo_samples",
+    title: "ANEES of the samples",
+    unit: "",
+};
+
 /// One line of a plot.
 pub(super) struct Line {
     kind: PlotKind,
@@ -46,6 +57,9 @@ pub(super) struct Line {
     method: Option<Method>,
     /// Legend label.
     pub(super) label: String,
+    /// A line that is not a method's: what the others are judged against (drawn in
+    /// [`scene::REFERENCE`]), else the nominal colour.
+    reference: bool,
     /// (step, value).
     pub(super) points: Vec<(i64, f64)>,
 }
@@ -67,6 +81,7 @@ fn add(
                 kind,
                 method: Some(method),
                 label: method.label().to_owned(),
+                reference: false,
                 points: vec![(step, value)],
             }),
         }
@@ -145,6 +160,68 @@ pub(super) fn along_track_lines<G: LieGroup<N>, const N: usize>(
     lines
 }
 
+/// Per method and step, the share of the Monte Carlo samples inside the tangent region drawn
+/// at the confidence (the vector-space method: inside its position ellipse) beside the
+/// confidence claimed, and their ANEES beside its 95 % band
+/// ([`crate::eval::consistency`]): where linearisation breaks, the lines leave p and the band.
+fn consistency_lines<G: LieGroup<N>, const N: usize>(
+    e: &Evaluation<G, N>,
+    name: &str,
+    lines: &mut Vec<Line>,
+) {
+    let mut claimed = Vec::new();
+    let mut band: [Vec<(i64, f64)>; 2] = Default::default();
+    for node in steps_of(e, name) {
+        let step = node.step.unwrap_or(0) as i64;
+        let measured = node
+            .estimates
+            .iter()
+            .filter_map(|est| Some((est.result.method, est.consistency.as_ref()?)));
+        let inside = measured.clone().filter_map(|(m, c)| {
+            let region = c
+                .region(Region::Tangent)
+                .or(c.region(Region::VectorSpace))?;
+            Some((m, region.inside))
+        });
+        add(lines, COVERAGE, step, inside);
+        add(
+            lines,
+            ANEES,
+            step,
+            measured
+                .clone()
+                .filter_map(|(m, c)| Some((m, c.anees?.value))),
+        );
+        if let Some((_, c)) = measured.clone().next() {
+            claimed.push((step, c.confidence));
+        }
+        if let Some(a) = measured.filter_map(|(_, c)| c.anees).find(|a| a.dof == N) {
+            band[0].push((step, a.band[0]));
+            band[1].push((step, a.band[1]));
+        }
+    }
+    if !claimed.is_empty() {
+        lines.push(Line {
+            kind: COVERAGE,
+            method: None,
+            label: "confidence p drawn".to_owned(),
+            reference: true,
+            points: claimed,
+        });
+    }
+    for (points, label) in band.into_iter().zip(["95 % band, low", "95 % band, high"]) {
+        if !points.is_empty() {
+            lines.push(Line {
+                kind: ANEES,
+                method: None,
+                label: label.to_owned(),
+                reference: true,
+                points,
+            });
+        }
+    }
+}
+
 /// max |RᵀR − I| per step of the Euler matrices and of the Exp rotations.
 fn orthogonality_lines<G: LieGroup<N>, const N: usize>(
     e: &Evaluation<G, N>,
@@ -161,12 +238,14 @@ fn orthogonality_lines<G: LieGroup<N>, const N: usize>(
         kind: ORTHOGONALITY,
         method: None,
         label: "Euler steps R(I + ω̂dt)".to_owned(),
+        reference: false,
         points: frames.map(|f| (f.step as i64, drift(&f.columns))).collect(),
     });
     lines.push(Line {
         kind: ORTHOGONALITY,
         method: Some(Method::Exact),
         label: "exponential map R·Exp(ωdt)".to_owned(),
+        reference: false,
         points: steps_of(e, name)
             .map(|n| {
                 (
@@ -195,10 +274,14 @@ pub(super) fn plots<G: LieGroup<N>, const N: usize>(
     order.sort_by_key(|(first, ..)| *first);
     for (_, name, op) in order {
         match op {
-            OpKind::Odometry => trace_lines(e, name, &mut lines),
+            OpKind::Odometry => {
+                trace_lines(e, name, &mut lines);
+                consistency_lines(e, name, &mut lines);
+            }
             OpKind::Compound => {
                 trace_lines(e, name, &mut lines);
                 lines.extend(along_track_lines(e, name));
+                consistency_lines(e, name, &mut lines);
             }
             _ => orthogonality_lines(e, name, &mut lines),
         }
@@ -216,6 +299,7 @@ pub(super) fn plots<G: LieGroup<N>, const N: usize>(
         };
         let (segment, color) = match line.method {
             Some(m) => (m.slug().to_owned(), m.color()),
+            None if line.reference => (slug(&line.label), scene::REFERENCE),
             None => (slug(&line.label), scene::NOMINAL),
         };
         series.push(ScalarSeries {

@@ -7,10 +7,10 @@ use std::fmt::Write as _;
 use super::DrawSettings;
 use super::plots::along_track_lines;
 use super::shapes::chi2_radius;
-use crate::eval::{Evaluation, Finding, Node, Role};
+use crate::eval::{Consistency, Evaluation, Finding, Node, Role};
 use crate::lie::{GroupKind, LieGroup};
 use crate::plan::OpKind;
-use crate::uncertain::Method;
+use crate::uncertain::{Coverage, Method, Region};
 
 /// The Markdown of the text panel.
 pub(super) fn description<G: LieGroup<N>, const N: usize>(
@@ -95,39 +95,127 @@ fn compounds<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Vec<&str> 
     names
 }
 
-/// Each final node's methods and their error against Monte Carlo.
+/// Each final node's methods: their error against Monte Carlo and how many Monte Carlo
+/// samples their regions hold ([`crate::eval::consistency`]): the banana (tangent region) and
+/// the Cartesian (or vector-space) ellipse, and the ANEES against its band.
 fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G, N>) {
     let finals = final_nodes(e);
     let with_errors: Vec<_> = finals
         .iter()
-        .filter(|n| n.estimates.iter().any(|x| x.error_vs_monte_carlo.is_some()))
+        .filter(|n| {
+            n.estimates
+                .iter()
+                .any(|x| x.error_vs_monte_carlo.is_some() || x.consistency.is_some())
+        })
         .collect();
     if with_errors.is_empty() {
         return;
     }
-    let _ = writeln!(
+    let measured: Vec<&Consistency> = with_errors
+        .iter()
+        .flat_map(|n| &n.estimates)
+        .filter_map(|x| x.consistency.as_ref())
+        .collect();
+    let ellipse = |c: &Consistency| {
+        c.region(Region::Cartesian)
+            .or(c.region(Region::VectorSpace))
+            .copied()
+    };
+    let has_ellipse = measured.iter().any(|c| ellipse(c).is_some());
+    let _ = write!(
         s,
-        "**Error against Monte Carlo** (‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F, right side):\n"
+        "**Against Monte Carlo**: the error ‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F (right side)"
     );
-    let _ = writeln!(s, "| pose | method | error |\n|---|---|---|");
+    if let Some(first) = measured.first() {
+        let worst = measured
+            .iter()
+            .flat_map(|c| &c.coverage)
+            .map(|c| c.stderr)
+            .fold(0.0, f64::max);
+        let region = if G::KIND.is_rotation_only() {
+            "the **tangent** region (d = {N})".replace("{N}", &N.to_string())
+        } else {
+            format!(
+                "the **banana** (the tangent region, d = {N}) and the **ellipse** (Cartesian, k = {})",
+                G::KIND.position_dims()
+            )
+        };
+        let _ = write!(
+            s,
+            "; the share of the {} samples inside {region}, both drawn at {:.1} % (standard error ≤ {:.1} %)",
+            first.samples,
+            first.confidence * 100.0,
+            worst * 100.0
+        );
+        if let Some(a) = measured.iter().find_map(|c| c.anees) {
+            let _ = write!(
+                s,
+                "; and the ANEES, the samples' average εᵗΣ⁻¹ε: {} when Σ is right, 95 % band {:.2}–{:.2}",
+                a.dof, a.band[0], a.band[1]
+            );
+        }
+    }
+    s.push_str(".\n\n");
+    let mut header = "| pose | method | error |".to_owned();
+    let mut rule = "|---|---|---|".to_owned();
+    if !measured.is_empty() {
+        header.push_str(if G::KIND.is_rotation_only() {
+            " tangent |"
+        } else {
+            " banana |"
+        });
+        rule.push_str("---|");
+        if has_ellipse {
+            header.push_str(" ellipse |");
+            rule.push_str("---|");
+        }
+        header.push_str(" ANEES |");
+        rule.push_str("---|");
+    }
+    let _ = writeln!(s, "{header}\n{rule}");
+    let percent =
+        |c: Option<Coverage>| c.map_or("–".to_owned(), |c| format!("{:.1} %", 100.0 * c.inside));
     for node in with_errors {
         let label = node
             .step
             .map_or(node.name.clone(), |k| format!("{} (step {k})", node.name));
-        for est in node
-            .estimates
-            .iter()
-            .filter(|x| x.result.method != Method::MonteCarlo)
-        {
-            let Some(err) = est.error_vs_monte_carlo else {
+        for est in &node.estimates {
+            let c = est.consistency.as_ref();
+            if est.result.method == Method::MonteCarlo && c.is_none() {
                 continue;
-            };
-            let method = if node.role == Role::Input {
+            }
+            let method = if node.role == Role::Input && est.result.method == Method::Exact {
                 "given Σ (sampling noise floor)"
             } else {
                 est.result.method.label()
             };
-            let _ = writeln!(s, "| {label} | {method} | {:.1} % |", 100.0 * err);
+            let error = match (est.result.method, est.error_vs_monte_carlo) {
+                (Method::MonteCarlo, _) | (_, None) => "–".to_owned(),
+                (_, Some(err)) => format!("{:.1} %", 100.0 * err),
+            };
+            let mut row = format!("| {label} | {method} | {error} |");
+            if !measured.is_empty() {
+                let _ = write!(
+                    row,
+                    " {} |",
+                    percent(c.and_then(|c| c.region(Region::Tangent).copied()))
+                );
+                if has_ellipse {
+                    let _ = write!(row, " {} |", percent(c.and_then(ellipse)));
+                }
+                let anees = c.and_then(|c| c.anees).map_or("–".to_owned(), |a| {
+                    let verdict = if a.value > a.band[1] {
+                        " **overconfident**"
+                    } else if a.value < a.band[0] {
+                        " *underconfident*"
+                    } else {
+                        ""
+                    };
+                    format!("{:.2}{verdict}", a.value)
+                });
+                let _ = write!(row, " {anees} |");
+            }
+            let _ = writeln!(s, "{row}");
         }
     }
     s.push('\n');

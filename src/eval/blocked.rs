@@ -6,7 +6,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::model::{Evaluation, McSummary, Node};
+use super::consistency::ConsistencySums;
+use super::groups::EvalGroup;
+use super::model::{Estimate, Evaluation, McSummary, Node};
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::sample::{LieMeanAccumulator, MeanError, tangent_moments};
 use crate::uncertain::{Method, Side};
@@ -20,6 +22,9 @@ struct NodeSums<G: LieGroup<N>, const N: usize> {
     /// Positions are summed relative to `shift` (block 0's mean) to avoid cancellation.
     shift: Vector3<f64>,
     position_sum: Option<Vector3<f64>>,
+    /// Coverage counts of the node's analytic estimates (Monte Carlo's own Gaussian is
+    /// known only after every block, so it is not counted in a blocked run).
+    consistency: Option<ConsistencySums<G, N>>,
 }
 
 /// Running sums of 3-vectors relative to a shift: mean and 1/(n−1) covariance.
@@ -82,6 +87,7 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
                     left_outer: mc.uncentred_left.map(|_| TangentMatrix::<N>::zeros()),
                     shift: mc.position_mean.unwrap_or_else(Vector3::zeros),
                     position_sum: mc.position_mean.map(|_| Vector3::zeros()),
+                    consistency: None,
                 })
             })
             .collect();
@@ -140,6 +146,42 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
     pub(super) fn finish_pass(&mut self) {
         for sums in self.nodes.iter_mut().flatten() {
             sums.mean.finish_pass();
+        }
+    }
+
+    /// Adds one block's particles of node `index` to the coverage counts of its estimates
+    /// (the first pass only; the counts start with the first block).
+    pub(super) fn add_consistency(
+        &mut self,
+        index: usize,
+        estimates: &[Estimate<G, N>],
+        particles: &[G],
+        confidence: f64,
+    ) where
+        G: EvalGroup<N>,
+    {
+        let Some(Some(sums)) = self.nodes.get_mut(index) else {
+            return;
+        };
+        if sums.consistency.is_none() {
+            sums.consistency = ConsistencySums::new(estimates, confidence);
+        }
+        if let Some(c) = sums.consistency.as_mut() {
+            c.add(particles);
+        }
+    }
+
+    /// Writes node `index`'s coverage over every block into its estimates.
+    pub(super) fn finish_consistency(&self, index: usize, estimates: &mut [Estimate<G, N>])
+    where
+        G: EvalGroup<N>,
+    {
+        if let Some(Some(NodeSums {
+            consistency: Some(c),
+            ..
+        })) = self.nodes.get(index)
+        {
+            c.finish(estimates);
         }
     }
 

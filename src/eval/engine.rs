@@ -7,6 +7,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen, Vector3};
 
 use super::blocked::{BlockedStats, VectorSums};
+use super::consistency::ConsistencySums;
 use super::groups::EvalGroup;
 use super::model::{Estimate, Evaluation, Finding, McSummary, Node, PointNode, Role};
 use super::{EvalError, EvalSettings};
@@ -355,6 +356,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             estimates.push(Estimate {
                 result,
                 error_vs_monte_carlo: None,
+                consistency: None,
             });
         }
         let nominal = estimates
@@ -378,6 +380,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             Particles::Step(p) => Some(p),
         };
         if let Some(p) = particles.filter(|_| self.monte_carlo) {
+            self.blocked_consistency(index, &mut node, p);
             let summary = self.summary(index, &node, p, draft.extras);
             let overflow = summary.as_ref().is_some_and(|r| {
                 r.as_ref().is_ok_and(|mc| {
@@ -408,7 +411,17 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                             method: Method::MonteCarlo,
                         },
                         error_vs_monte_carlo: Some(0.0),
+                        consistency: None,
                     });
+                    if matches!(self.stats, StatsMode::Own)
+                        && let Some(mut sums) =
+                            ConsistencySums::new(&node.estimates, self.settings.confidence)
+                    {
+                        // Every estimate, Monte Carlo's own Gaussian too (how Gaussian the
+                        // cloud is in the tangent).
+                        sums.add(p);
+                        sums.finish(&mut node.estimates);
+                    }
                     self.check_psd(name, draft.step, Method::MonteCarlo, &mc.stats.cov);
                     node.monte_carlo = Some(mc);
                 }
@@ -432,6 +445,23 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
         };
         self.out.nodes.push(node);
         Ok(())
+    }
+
+    /// In a blocked run, the coverage and ANEES of `node`'s analytic estimates against its
+    /// particles ([`consistency`](super::consistency)): added to the sums in the first pass,
+    /// written from them in the last run. (A whole sample is counted once Monte Carlo's
+    /// statistics stand, in [`push`](Self::push).)
+    fn blocked_consistency(&mut self, index: usize, node: &mut Node<G, N>, particles: &[G]) {
+        let confidence = self.settings.confidence;
+        match &mut self.stats {
+            StatsMode::Own | StatsMode::Skip => {}
+            StatsMode::Collect(stats, first_pass) => {
+                if *first_pass {
+                    stats.add_consistency(index, &node.estimates, particles, confidence);
+                }
+            }
+            StatsMode::Blocked(stats) => stats.finish_consistency(index, &mut node.estimates),
+        }
     }
 
     /// Monte Carlo statistics of node `index` from the current [`StatsMode`].

@@ -2,9 +2,9 @@
 //! (differential drive on SE(2), Euler vs Exp on SO(3), compounding and the vector-space
 //! baseline on SE(2)/SE(3)), behind one trait the generic engine calls.
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, SVector, Vector3};
 
-use crate::interop::VectorChart;
+use crate::interop::{VectorChart, to_coordinates};
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, TangentMatrix};
 use crate::plan::DiffDriveMotion;
 use crate::propagate::Propagated;
@@ -62,6 +62,19 @@ pub trait EvalGroup<const N: usize>: LieGroup<N> {
         _first_chunk: u64,
         _seed: u64,
     ) -> Option<crate::Result<DiffDriveOutcome<Self, N>>> {
+        None
+    }
+
+    /// The vector-space coordinates φ(X) ([`VectorChart`]), where the group has them.
+    fn coordinates(_x: &Self) -> Option<SVector<f64, N>> {
+        None
+    }
+
+    /// An uncertain pose in vector-space coordinates, first order: (φ(μ), J Σ_right Jᵀ)
+    /// ([`to_coordinates`]), where the group has them and the chart is regular there.
+    fn coordinates_gaussian(
+        _pose: &UncertainPose<Self, N>,
+    ) -> Option<(SVector<f64, N>, TangentMatrix<N>)> {
         None
     }
 
@@ -194,6 +207,14 @@ macro_rules! pose_group_ops {
             y: &UncertainPose<Self, $N>,
         ) -> Option<crate::Result<Propagated<Self, $N>>> {
             Some(ssc_compose_in(x, y))
+        }
+        fn coordinates(x: &Self) -> Option<SVector<f64, $N>> {
+            Some(x.to_coordinates())
+        }
+        fn coordinates_gaussian(
+            pose: &UncertainPose<Self, $N>,
+        ) -> Option<(SVector<f64, $N>, TangentMatrix<$N>)> {
+            to_coordinates(pose).ok()
         }
         fn ssc_odometry(
             start: &UncertainPose<Self, $N>,

@@ -38,11 +38,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 pub mod bag;
 mod blocked;
+pub mod consistency;
 mod engine;
 pub mod groups;
 mod model;
 mod ops;
 
+pub use consistency::{Anees, Consistency, CoverageSummary};
 pub use model::{
     AnyEvaluation, Estimate, Evaluation, Finding, MatrixFrame, McSummary, MonteCarloRecord, Node,
     PathKind, PointNode, PosePath, Role,
@@ -67,6 +69,9 @@ pub const MIN_BLOCK_SAMPLES: usize = 4 * CHUNK_SIZE;
 /// Monte Carlo samples of [`EvalSettings::default`] (and of a scenario that names none).
 pub const DEFAULT_SAMPLES: usize = 2000;
 
+/// The probability inside drawn regions when neither the command line nor the file says.
+pub const DEFAULT_CONFIDENCE: f64 = 0.95;
+
 /// What an evaluation needs besides the plan, resolved once by the caller.
 #[derive(Debug, Clone)]
 pub struct EvalSettings {
@@ -81,6 +86,9 @@ pub struct EvalSettings {
     pub block_samples: Option<usize>,
     /// Which steps of long propagations keep numbers and particles.
     pub steps: StepPolicy,
+    /// The probability p of the regions whose coverage is measured against Monte Carlo
+    /// ([`consistency`]), 0 < p < 1 (default [`DEFAULT_CONFIDENCE`]).
+    pub confidence: f64,
     /// Sigma-point parameters α, β, κ (default 1, 2, 0).
     pub unscented: crate::propagate::sigma_point::Unscented,
     /// Set to stop early (Ctrl-C): the evaluation returns what it has, with
@@ -96,6 +104,7 @@ impl Default for EvalSettings {
             methods: Vec::new(),
             block_samples: None,
             steps: StepPolicy::default(),
+            confidence: DEFAULT_CONFIDENCE,
             unscented: Default::default(),
             cancel: None,
         }

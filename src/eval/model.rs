@@ -11,6 +11,8 @@ use crate::propagate::{MatrixRows, Propagated, ResultRecord};
 use crate::sample::SampleStatistics;
 use crate::uncertain::Method;
 
+use super::consistency::Consistency;
+
 /// Where a node comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -23,13 +25,17 @@ pub enum Role {
     Output,
 }
 
-/// One method's estimate of a node, with its error against Monte Carlo where that ran.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// One method's estimate of a node, with its error against Monte Carlo and the coverage of
+/// its regions where that ran.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Estimate<G: LieGroup<N>, const N: usize> {
     /// Mean, covariance, side and method.
     pub result: Propagated<G, N>,
     /// ‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F with both on the right side, where Monte Carlo ran.
     pub error_vs_monte_carlo: Option<f64>,
+    /// How many Monte Carlo samples its regions hold, and their ANEES, where Monte Carlo ran
+    /// ([`consistency`](super::consistency)).
+    pub consistency: Option<Consistency>,
 }
 
 /// Monte Carlo statistics of a node beyond its Lie mean and covariance.
@@ -293,9 +299,16 @@ where
                     Some(k) => format!("{}@{k}", node.name),
                     None => node.name.clone(),
                 };
-                node.estimates
-                    .iter()
-                    .map(move |e| ResultRecord::new(&label, &e.result, e.error_vs_monte_carlo))
+                node.estimates.iter().map(move |e| {
+                    let record = ResultRecord::new(&label, &e.result, e.error_vs_monte_carlo);
+                    match &e.consistency {
+                        Some(c) => record.with_consistency(
+                            c.coverage.clone(),
+                            c.anees.map(|a| (a.value, a.dof, a.band)),
+                        ),
+                        None => record,
+                    }
+                })
             })
             .collect()
     }
@@ -402,6 +415,21 @@ impl AnyEvaluation {
     /// ```
     pub fn monte_carlo_records(&self) -> Vec<MonteCarloRecord> {
         with_evaluation!(self, e => e.monte_carlo_records())
+    }
+
+    /// The coverage of the last output's estimates against Monte Carlo (empty where Monte
+    /// Carlo did not run): what a one-line status shows.
+    ///
+    /// ```
+    /// use posecov::app::{Overrides, load, pipeline};
+    /// let loaded = load("camera_on_robot").unwrap();
+    /// let (e, _) = pipeline(&loaded, &Overrides { samples: Some(256), ..Default::default() }, None).unwrap();
+    /// let summary = e.coverage_summary();
+    /// assert_eq!(summary[0].output, "map_from_camera");
+    /// assert_eq!(summary[0].method, "exact"); // a change of frame by a known mount
+    /// ```
+    pub fn coverage_summary(&self) -> Vec<super::consistency::CoverageSummary> {
+        with_evaluation!(self, e => super::consistency::last_output_summary(&e.nodes))
     }
 
     /// The findings.

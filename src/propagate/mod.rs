@@ -17,7 +17,7 @@ pub mod vector_space;
 use serde::{Deserialize, Serialize};
 
 use crate::lie::{LieGroup, TangentMatrix};
-use crate::uncertain::{Method, Side, UncertainPose};
+use crate::uncertain::{Coverage, Method, Side, UncertainPose};
 
 /// An uncertain pose together with the method that computed it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,6 +69,22 @@ pub struct ResultRecord {
     /// ‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F against the Monte Carlo result of the same quantity, on the
     /// same side, where Monte Carlo ran.
     pub relative_error_vs_monte_carlo: Option<f64>,
+    /// Per region this result draws (`tangent`, `tangent_position`, `cartesian`,
+    /// `vector_space`), the fraction of the Monte Carlo samples inside it at the run's
+    /// confidence, with its binomial standard error; empty where Monte Carlo did not run.
+    #[serde(default)]
+    pub coverage: Vec<Coverage>,
+    /// The average NEES of the Monte Carlo samples under this result's Gaussian (expectation
+    /// `anees_dof`), where Monte Carlo ran and Σ is regular.
+    #[serde(default)]
+    pub anees: Option<f64>,
+    /// The dimension d of the NEES: the ANEES's expectation.
+    #[serde(default)]
+    pub anees_dof: Option<usize>,
+    /// The 95 % band of the ANEES for the sample size: outside it, Σ is too small (above) or
+    /// too large (below).
+    #[serde(default)]
+    pub anees_band: Option<[f64; 2]>,
 }
 
 impl ResultRecord {
@@ -102,7 +118,37 @@ impl ResultRecord {
             mean_tangent: pose.mean().log().iter().copied().collect(),
             covariance: pose.cov().to_rows(),
             relative_error_vs_monte_carlo,
+            coverage: Vec::new(),
+            anees: None,
+            anees_dof: None,
+            anees_band: None,
         }
+    }
+
+    /// The record with the coverage of its regions and its ANEES (value, d, band) against
+    /// Monte Carlo.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::propagate::{Propagated, ResultRecord};
+    /// use posecov::uncertain::{Coverage, Method, Region, UncertainPose};
+    /// let p = Propagated { pose: UncertainPose::certain(Se2::identity()), method: Method::Exact };
+    /// let r = ResultRecord::new("a", &p, None)
+    ///     .with_consistency(vec![Coverage::from_counts(Region::Tangent, 3, 95, 100)], Some((3.1, 3, [2.4, 3.7])));
+    /// assert_eq!((r.coverage[0].inside, r.anees, r.anees_dof), (0.95, Some(3.1), Some(3)));
+    /// ```
+    pub fn with_consistency(
+        mut self,
+        coverage: Vec<Coverage>,
+        anees: Option<(f64, usize, [f64; 2])>,
+    ) -> Self {
+        self.coverage = coverage;
+        if let Some((value, dof, band)) = anees {
+            self.anees = Some(value);
+            self.anees_dof = Some(dof);
+            self.anees_band = Some(band);
+        }
+        self
     }
 }
 

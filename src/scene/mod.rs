@@ -42,7 +42,7 @@ mod validate;
 mod view;
 
 pub use mesh::unit_sphere_mesh;
-pub use palette::{LINK, NOMINAL};
+pub use palette::{LINK, NOMINAL, REFERENCE};
 pub use view::{Camera, View3d, grid_columns, rotate};
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.

@@ -12,6 +12,9 @@ use crate::uncertain::Method;
 pub const NOMINAL: Color = Color::rgb(0, 114, 178);
 /// Lines between poses (a pose graph's loop closures): neutral grey.
 pub const LINK: Color = Color::rgb(110, 110, 110);
+/// What a plot's lines are judged against (the confidence claimed, a χ² band): Okabe–Ito
+/// yellow, apart from every method's colour.
+pub const REFERENCE: Color = Color::rgb(240, 228, 66);
 
 impl Method {
     /// Every method, in legend order.

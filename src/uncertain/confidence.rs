@@ -3,6 +3,7 @@
 //!
 //! [CONVENTIONS §7]: crate::conventions#7-drawing-uncertainty
 
+use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 use crate::error::{Error, Result};
@@ -88,4 +89,107 @@ pub fn sigma_probability(k: f64) -> Result<f64> {
 /// ```
 pub fn sigma_radius(k: f64, dof: usize) -> Result<f64> {
     chi2_radius(sigma_probability(k)?, dof)
+}
+
+/// The two-sided `probability` band of the average NEES of `samples` independent d-dimensional
+/// Gaussian errors, each NEES ε̃ᵀ Σ⁻¹ ε̃ ~ χ²_d when Σ is the errors' true covariance: n · ANEES
+/// ~ χ²_{n·d}, so the band is \[χ²_{nd}((1 − p)/2), χ²_{nd}((1 + p)/2)\] / n, about the
+/// expectation d (Bar-Shalom, Li & Kirubarajan 2001, *Estimation with Applications to
+/// Tracking and Navigation*, §5.4.2). ANEES above the band: the covariance is too small
+/// (overconfident); below: too large. Errors: p ∉ (0, 1), no samples, d = 0.
+///
+/// ```
+/// use posecov::uncertain::anees_band;
+/// let [low, high] = anees_band(1000, 3, 0.95).unwrap();
+/// assert!((low - 2.8506).abs() < 1e-3 && (high - 3.1543).abs() < 1e-3);
+/// let [low, high] = anees_band(1, 2, 0.95).unwrap(); // one sample: χ²_2's own 95 % interval
+/// assert!((low - 0.0506).abs() < 1e-3 && (high - 7.3778).abs() < 1e-3);
+/// ```
+pub fn anees_band(samples: usize, dof: usize, probability: f64) -> Result<[f64; 2]> {
+    if samples == 0 {
+        return Err(Error::OutOfRange {
+            what: "samples n",
+            value: 0.0,
+            expected: "n ≥ 1",
+        });
+    }
+    let total = dof.saturating_mul(samples);
+    let tail = (1.0 - probability) / 2.0;
+    let low = chi2_radius(tail, total)?;
+    let high = chi2_radius(1.0 - tail, total)?;
+    let n = samples as f64;
+    Ok([low * low / n, high * high / n])
+}
+
+/// A confidence region whose coverage is measured against Monte Carlo samples (the
+/// `region` of a [`Coverage`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Region {
+    /// The full tangent ellipsoid of a Gaussian on the group, on its own side:
+    /// Log(μ⁻¹X)ᵀ Σ⁻¹ Log(μ⁻¹X) ≤ χ²_d(p), d the group's degrees of freedom. The banana is its
+    /// picture.
+    Tangent,
+    /// The position block of the right-form tangent: ρᵀ Σ_ρρ⁻¹ ρ ≤ χ²_k(p), ρ the first k = 2
+    /// or 3 entries of Log(μ⁻¹X).
+    TangentPosition,
+    /// The world-frame Cartesian ellipse (ellipsoid) of a tangent Gaussian's position:
+    /// (p − p̄)ᵀ Σ_p⁻¹ (p − p̄) ≤ χ²_k(p), Σ_p = R Σ_ρρ Rᵀ, p̄ the mean's position.
+    Cartesian,
+    /// The vector-space (Smith–Self–Cheeseman) method's position ellipse: the same test with
+    /// the position block of its Gaussian in (x, y, θ) / (x, y, z, roll, pitch, yaw).
+    VectorSpace,
+}
+
+impl Region {
+    /// The region's name in `report --json` and in the text (`tangent`, `tangent_position`,
+    /// `cartesian`, `vector_space`).
+    ///
+    /// ```
+    /// use posecov::uncertain::Region;
+    /// assert_eq!(Region::TangentPosition.name(), "tangent_position");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            Region::Tangent => "tangent",
+            Region::TangentPosition => "tangent_position",
+            Region::Cartesian => "cartesian",
+            Region::VectorSpace => "vector_space",
+        }
+    }
+}
+
+/// The fraction of samples inside a confidence region, with its binomial standard error
+/// √(q (1 − q) / n) (q the fraction, n the samples): a region drawn at confidence p is honest
+/// when q is within a few standard errors of p.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Coverage {
+    /// Which region.
+    pub region: Region,
+    /// Its degrees of freedom: the χ² that sets its radius.
+    pub dof: usize,
+    /// The fraction of the samples inside, q.
+    pub inside: f64,
+    /// The binomial standard error of q.
+    pub stderr: f64,
+}
+
+impl Coverage {
+    /// The coverage of `inside` samples out of `samples` (`samples` ≥ 1).
+    ///
+    /// ```
+    /// use posecov::uncertain::{Coverage, Region};
+    /// let c = Coverage::from_counts(Region::Tangent, 3, 950, 1000);
+    /// assert!((c.inside - 0.95).abs() < 1e-15 && (c.stderr - 0.0068920).abs() < 1e-6);
+    /// ```
+    pub fn from_counts(region: Region, dof: usize, inside: usize, samples: usize) -> Self {
+        let n = samples.max(1) as f64;
+        let q = inside as f64 / n;
+        Self {
+            region,
+            dof,
+            inside: q,
+            stderr: (q * (1.0 - q) / n).sqrt(),
+        }
+    }
 }

@@ -17,6 +17,7 @@ use serde::Serialize;
 use super::document::{Edit, EditError, LiveDocument};
 use crate::app::run::PlanRun;
 use crate::app::{AppError, Loaded, Overrides, resolve};
+use crate::eval::CoverageSummary;
 use crate::plan::StepPolicy;
 use crate::sample::CHUNK_SIZE;
 use crate::sink::{LogOutcome, Restream, SinkError, SinkGuard};
@@ -78,6 +79,9 @@ pub struct Status {
     pub final_picture_ms: Option<f64>,
     /// Entity items in the picture sent last.
     pub items: usize,
+    /// How many Monte Carlo samples the last output's regions hold, per method, in the
+    /// picture sent last (empty without Monte Carlo).
+    pub coverage: Vec<CoverageSummary>,
     /// Why the newest generation could not be drawn (the last good picture stays).
     pub error: Option<String>,
 }
@@ -422,6 +426,7 @@ fn show(
             0
         };
         status.items = items;
+        status.coverage = session.evaluation.coverage_summary();
         if i == 0 {
             status.first_picture_ms = Some(ms);
             status.final_picture_ms = None;
