@@ -9,19 +9,20 @@
 //!
 //! | source | order | side | conversion | exact? |
 //! |---|---|---|---|---|
-//! | ROS `PoseWithCovariance` | x y z rotX rotY rotZ | position additive in parent axes, rotation local | Σ_ros = B Σ_right Bᵀ, B = blkdiag(R, I₃) | first order |
+//! | ROS `PoseWithCovariance`, tf2's reading (default) | x y z rotX rotY rotZ | both errors in parent axes: p̃ = p + δp, R̃ = Exp(δφ) R | Σ_ros = B Σ_right Bᵀ, B = blkdiag(R, R) | first order |
+//! | ROS `PoseWithCovariance`, body reading | x y z rotX rotY rotZ | position in parent axes, rotation local: R̃ = R Exp(δθ) | Σ_ros = B Σ_right Bᵀ, B = blkdiag(R, I₃) | first order |
 //! | GTSAM Pose3, sophus-rs | [θ; ρ] | right | Σ' = P Σ Pᵀ | exact |
 //! | EEME E6911 slides | [ω; v] | left | Σ' = P Σ_left Pᵀ | exact |
 //! | (x, y, θ) | x y θ | additive | Σ_xyθ = J Σ_right Jᵀ, J = blkdiag(R, 1) | first order |
 //! | (x, y, z, roll, pitch, yaw) | x y z r p y | additive | Σ_e = J Σ_right Jᵀ, J = blkdiag(R, E_b⁻¹) | first order |
 //!
 //! ```
-//! use posecov::interop::RosPoseWithCovariance;
+//! use posecov::interop::{RosPoseWithCovariance, RosReading};
 //! let mut covariance = vec![0.0; 36];
 //! for i in 0..6 { covariance[i * 7] = 0.01; }
 //! let msg = RosPoseWithCovariance { position: [1.0, 2.0, 0.0], orientation_xyzw: [0.0, 0.0, 0.0, 1.0], covariance };
-//! let pose = msg.try_to_uncertain().unwrap();
-//! assert_eq!(RosPoseWithCovariance::from_uncertain(&pose), msg);
+//! let pose = msg.try_to_uncertain(RosReading::Tf2).unwrap();
+//! assert_eq!(RosPoseWithCovariance::from_uncertain(&pose, RosReading::Tf2), msg);
 //! ```
 
 use nalgebra::{Matrix3, Matrix6, SVector, Vector3, Vector6};
@@ -31,124 +32,11 @@ use crate::error::{Error, Result, check_finite};
 use crate::lie::{LieGroup, Se2, Se3, So3, TangentMatrix};
 use crate::uncertain::{Side, UncertainPose, validate_covariance};
 
-// --------------------------------------------------------------------------------------------
-// ROS PoseWithCovariance (docs/CONVENTIONS.md §6).
-
-/// Number of entries of a ROS `PoseWithCovariance.covariance` (6 × 6, row-major).
-pub const ROS_COVARIANCE_LEN: usize = 36;
-
-/// A ROS `geometry_msgs/PoseWithCovariance` as plain data (e.g. from rosbridge JSON):
-/// position, orientation as a quaternion in ROS order (x, y, z, w), and 36 row-major covariance
-/// entries in the order (x, y, z, rotX, rotY, rotZ).
-///
-/// Meaning ([CONVENTIONS §6]): the position error is additive in the **parent** frame's axes,
-/// the rotation error is local: p̃ = p + δp, R̃ = R · Exp(δθ).
-///
-/// [CONVENTIONS §6]: crate::conventions#6-ros-posewithcovariance
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RosPoseWithCovariance {
-    /// `pose.position` (x, y, z) in the parent frame.
-    pub position: [f64; 3],
-    /// `pose.orientation` as (x, y, z, w).
-    pub orientation_xyzw: [f64; 4],
-    /// `covariance`, 36 numbers, row-major 6 × 6, (x, y, z, rotX, rotY, rotZ).
-    pub covariance: Vec<f64>,
-}
-
-/// B = blkdiag(R, I₃), the first-order map from the right-form tangent [ρ; θ] to the ROS error
-/// [δp; δθ]: μ Exp([ρ; θ]) has position t + R Jl(θ) ρ ≈ t + R ρ (Solà et al. 2018 eq. 172) and
-/// rotation R Exp(θ).
-///
-/// ```
-/// use posecov::{interop::ros_error_jacobian, lie::So3};
-/// let b = ros_error_jacobian(&So3::from_rpy(0.0, 0.0, 0.5));
-/// assert_eq!(b.fixed_view::<3, 3>(3, 3).into_owned(), nalgebra::Matrix3::identity());
-/// ```
-pub fn ros_error_jacobian(rotation: &So3) -> Matrix6<f64> {
-    let mut b = Matrix6::identity();
-    b.fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&rotation.to_matrix());
-    b
-}
-
-/// A ROS covariance (position error in the parent's axes, rotation error local) in posecov's
-/// right form at a pose with rotation R: Σ_right = B⁻¹ Σ_ros B⁻ᵀ, B = [`ros_error_jacobian`]
-/// (first order; [CONVENTIONS §6]). The one conversion every ROS input
-/// uses.
-///
-/// ```
-/// use posecov::{interop::ros_cov_to_right, lie::So3};
-/// use nalgebra::Matrix6;
-/// let yaw90 = So3::from_rpy(0.0, 0.0, std::f64::consts::FRAC_PI_2);
-/// let mut ros = Matrix6::zeros();
-/// ros[(1, 1)] = 0.01; // parent y
-/// assert!((ros_cov_to_right(&ros, &yaw90)[(0, 0)] - 0.01).abs() < 1e-15); // body x
-/// ```
-///
-/// [CONVENTIONS §6]: crate::conventions#6-ros-posewithcovariance
-pub fn ros_cov_to_right(cov_ros: &Matrix6<f64>, rotation: &So3) -> Matrix6<f64> {
-    let b_inv = ros_error_jacobian(&rotation.inverse());
-    b_inv * cov_ros * b_inv.transpose()
-}
-
-impl RosPoseWithCovariance {
-    /// The message as a right-form uncertain pose: Σ_right = B⁻¹ Σ_ros B⁻ᵀ with
-    /// B = [`ros_error_jacobian`] (first order: the ROS position error is additive, posecov's
-    /// is R Jl(θ) ρ; the two agree to first order in the perturbation).
-    ///
-    /// Errors, each naming the field: position or orientation not finite, quaternion norm not
-    /// within 1e-3 of 1, covariance length ≠ 36, an entry NaN/∞ (with its row-major index),
-    /// asymmetric, or not positive semi-definite.
-    ///
-    /// ```
-    /// use posecov::{Error, interop::RosPoseWithCovariance};
-    /// let msg = RosPoseWithCovariance { position: [0.0; 3], orientation_xyzw: [0.0, 0.0, 0.0, 1.0], covariance: vec![0.0; 35] };
-    /// assert!(matches!(msg.try_to_uncertain(), Err(Error::WrongLength { expected: 36, got: 35, .. })));
-    /// ```
-    pub fn try_to_uncertain(&self) -> Result<UncertainPose<Se3, 6>> {
-        check_finite("PoseWithCovariance.pose.position", self.position)?;
-        let rotation = So3::try_from_quaternion_xyzw(self.orientation_xyzw)?;
-        if self.covariance.len() != ROS_COVARIANCE_LEN {
-            return Err(Error::WrongLength {
-                what: "PoseWithCovariance.covariance",
-                expected: ROS_COVARIANCE_LEN,
-                got: self.covariance.len(),
-            });
-        }
-        let cov_ros = Matrix6::from_row_slice(&self.covariance);
-        let cov_ros = validate_covariance("PoseWithCovariance.covariance", &cov_ros)?;
-        let mean = Se3::from_parts(Vector3::from(self.position), rotation);
-        Ok(UncertainPose::new_unchecked(
-            mean,
-            ros_cov_to_right(&cov_ros, &rotation),
-            Side::Right,
-        ))
-    }
-
-    /// An uncertain pose as a ROS message: Σ_ros = B Σ_right Bᵀ (converting to the right side
-    /// first; first order, see [`try_to_uncertain`](Self::try_to_uncertain)). The quaternion
-    /// has w ≥ 0.
-    ///
-    /// ```
-    /// use posecov::{interop::RosPoseWithCovariance, lie::Se3, uncertain::{Side, UncertainPose}};
-    /// let yaw90 = Se3::from_xyz_rpy([0.0; 3], [0.0, 0.0, std::f64::consts::FRAC_PI_2]);
-    /// let p = UncertainPose::try_from_std_devs(yaw90, [0.1, 0.0, 0.0, 0.0, 0.0, 0.0], Side::Right).unwrap();
-    /// let msg = RosPoseWithCovariance::from_uncertain(&p);
-    /// assert!((msg.covariance[7] - 0.01).abs() < 1e-15); // body x is parent y
-    /// ```
-    pub fn from_uncertain(pose: &UncertainPose<Se3, 6>) -> Self {
-        let mean = pose.mean();
-        let b = ros_error_jacobian(mean.rotation());
-        let cov = b * pose.cov_right() * b.transpose();
-        let cov = (cov + cov.transpose()) * 0.5;
-        let t = mean.translation();
-        Self {
-            position: [t.x, t.y, t.z],
-            orientation_xyzw: mean.rotation().to_quaternion_xyzw(),
-            covariance: cov.transpose().iter().copied().collect(),
-        }
-    }
-}
+mod ros;
+pub use ros::{
+    ROS_COVARIANCE_LEN, RosPoseWithCovariance, RosReading, ros_cov_from_right, ros_cov_to_right,
+    ros_error_jacobian,
+};
 
 // --------------------------------------------------------------------------------------------
 // Rotation-first tangent orders (docs/CONVENTIONS.md §2).
@@ -433,6 +321,44 @@ impl VectorChart<6> for Se3 {
         let r = So3::from_rpy(v[3], v[4], v[5]).to_matrix();
         block_diag3(&r.transpose(), &euler_rates_to_body_rates(v[3], v[4]))
     }
+}
+
+/// The order of the six coordinates of an Euler-angle pose covariance. Both libraries build
+/// the rotation as R = Rz(yaw) Ry(pitch) Rx(roll) with positions in the parent axes; they list
+/// the angles in opposite orders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EulerOrder {
+    /// (x, y, z, roll, pitch, yaw): robot_localization's state.
+    XyzRpy,
+    /// (x, y, z, yaw, pitch, roll): MRPT's `CPose3D` / `CPose3DPDFGaussian`.
+    XyzYpr,
+}
+
+/// An Euler-angle covariance at `mean` in posecov's right form, to first order: the angles are
+/// put in (roll, pitch, yaw) order (a swap of yaw and roll for [`EulerOrder::XyzYpr`]), then
+/// Σ_right = J⁻¹ Σ_e J⁻ᵀ with J = blkdiag(R, E_b⁻¹) the chart Jacobian of
+/// (x, y, z, roll, pitch, yaw) at the mean ([`VectorChart`], [`from_coordinates`]). Valid also
+/// at gimbal lock (J⁻¹ is finite there).
+///
+/// ```
+/// use posecov::interop::{EulerOrder, se3_cov_from_euler};
+/// use posecov::lie::Se3;
+/// use nalgebra::{Matrix6, Vector6};
+/// let mean = Se3::from_xyz_rpy([1.0, 2.0, 3.0], [0.0; 3]);
+/// let ypr = Matrix6::from_diagonal(&Vector6::new(1.0, 1.0, 1.0, 0.09, 0.04, 0.01));
+/// let right = se3_cov_from_euler(&mean, &ypr, EulerOrder::XyzYpr);
+/// assert!((right[(3, 3)] - 0.01).abs() < 1e-15 && (right[(5, 5)] - 0.09).abs() < 1e-15); // roll, yaw
+/// ```
+pub fn se3_cov_from_euler(mean: &Se3, cov: &Matrix6<f64>, order: EulerOrder) -> Matrix6<f64> {
+    let mut rpy = *cov;
+    if order == EulerOrder::XyzYpr {
+        rpy.swap_rows(3, 5);
+        rpy.swap_columns(3, 5);
+    }
+    let j_inv = Se3::coordinates_jacobian_inverse(&mean.to_coordinates());
+    let right = j_inv * rpy * j_inv.transpose();
+    (right + right.transpose()) * 0.5
 }
 
 /// An uncertain pose in vector-space coordinates (first order): v = φ(μ),

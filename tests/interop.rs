@@ -8,7 +8,7 @@ use common::{assert_close, numeric_jacobian, random_spd};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use posecov::Error;
 use posecov::interop::{
-    RosPoseWithCovariance, RotationFirstSource, VectorChart, body_rates_to_euler_rates,
+    RosPoseWithCovariance, RosReading, RotationFirstSource, VectorChart, body_rates_to_euler_rates,
     from_rotation_first, ros_error_jacobian, se2_from_xytheta, se2_to_xytheta, se3_from_xyz_rpy,
     se3_to_xyz_rpy, to_rotation_first,
 };
@@ -27,7 +27,7 @@ fn poses() -> Vec<Se3> {
 fn ros_msg() -> RosPoseWithCovariance {
     let pose =
         UncertainPose::try_new(poses()[1], random_spd::<6>(5, 0.01), Side::Right).expect("valid");
-    RosPoseWithCovariance::from_uncertain(&pose)
+    RosPoseWithCovariance::from_uncertain(&pose, RosReading::Tf2)
 }
 
 #[test]
@@ -37,20 +37,20 @@ fn ros_round_trips_both_ways() {
             let pose = UncertainPose::try_new(mean, random_spd::<6>(i as u64, 0.01), Side::Right)
                 .expect("valid")
                 .to_side(side);
-            let msg = RosPoseWithCovariance::from_uncertain(&pose);
+            let msg = RosPoseWithCovariance::from_uncertain(&pose, RosReading::Tf2);
             assert_eq!(msg.covariance.len(), 36);
-            let back = msg.try_to_uncertain().expect("valid");
+            let back = msg.try_to_uncertain(RosReading::Tf2).expect("valid");
             assert_eq!(back.side(), Side::Right);
             assert!(back.mean().is_approx(&mean, 1e-14));
             assert_close(back.cov(), &pose.cov_right(), 1e-14, "Σ_right");
             // and message → pose → message
             assert_eq!(
-                RosPoseWithCovariance::from_uncertain(&back)
+                RosPoseWithCovariance::from_uncertain(&back, RosReading::Tf2)
                     .covariance
                     .len(),
                 36
             );
-            let again = RosPoseWithCovariance::from_uncertain(&back);
+            let again = RosPoseWithCovariance::from_uncertain(&back, RosReading::Tf2);
             let d = again
                 .covariance
                 .iter()
@@ -62,21 +62,27 @@ fn ros_round_trips_both_ways() {
     }
 }
 
-/// B is the Jacobian of the ROS error (δp = p̃ − p in parent axes, δθ = Log(Rᵀ R̃)) with
-/// respect to the right-form tangent, by finite differences.
+/// B is the Jacobian of the ROS error with respect to the right-form tangent, by finite
+/// differences: δp = p̃ − p in parent axes in both readings; δφ = Log(R̃ Rᵀ) (parent axes, tf2)
+/// or δθ = Log(Rᵀ R̃) (body).
 #[test]
 fn ros_b_is_the_jacobian_of_the_ros_error() {
     for mean in poses() {
-        let j: Matrix6<f64> = numeric_jacobian(
-            |e| {
-                let x = mean.rplus(e);
-                let dp = x.translation() - mean.translation();
-                let dth = x.rotation().rminus(mean.rotation());
-                Vector6::new(dp.x, dp.y, dp.z, dth.x, dth.y, dth.z)
-            },
-            1e-6,
-        );
-        assert_close(&j, &ros_error_jacobian(mean.rotation()), 1e-8, "B");
+        for reading in [RosReading::Tf2, RosReading::Body] {
+            let j: Matrix6<f64> = numeric_jacobian(
+                |e| {
+                    let x = mean.rplus(e);
+                    let dp = x.translation() - mean.translation();
+                    let dth = match reading {
+                        RosReading::Tf2 => x.rotation().lminus(mean.rotation()),
+                        RosReading::Body => x.rotation().rminus(mean.rotation()),
+                    };
+                    Vector6::new(dp.x, dp.y, dp.z, dth.x, dth.y, dth.z)
+                },
+                1e-6,
+            );
+            assert_close(&j, &ros_error_jacobian(mean.rotation(), reading), 1e-8, "B");
+        }
     }
 }
 
@@ -97,7 +103,7 @@ fn ros_json_is_plain_data() {
         close(&back.position, &msg.position)
             && close(&back.orientation_xyzw, &msg.orientation_xyzw)
     );
-    assert!(back.try_to_uncertain().is_ok());
+    assert!(back.try_to_uncertain(RosReading::Tf2).is_ok());
 }
 
 #[test]
@@ -107,14 +113,14 @@ fn ros_invalid_inputs_name_the_field() {
         let mut m = good.clone();
         m.covariance.resize(len, 0.0);
         assert!(matches!(
-            m.try_to_uncertain(),
+            m.try_to_uncertain(RosReading::Tf2),
             Err(Error::WrongLength { what: "PoseWithCovariance.covariance", expected: 36, got }) if got == len
         ));
     }
     let mut m = good.clone();
     m.covariance[7] = f64::NAN;
     assert!(matches!(
-        m.try_to_uncertain(),
+        m.try_to_uncertain(RosReading::Tf2),
         Err(Error::NonFinite {
             what: "PoseWithCovariance.covariance",
             index: 7,
@@ -124,7 +130,7 @@ fn ros_invalid_inputs_name_the_field() {
     let mut m = good.clone();
     m.covariance[1] += 0.5; // (0, 1) ≠ (1, 0)
     assert!(matches!(
-        m.try_to_uncertain(),
+        m.try_to_uncertain(RosReading::Tf2),
         Err(Error::NotSymmetric {
             what: "PoseWithCovariance.covariance",
             row: 0,
@@ -135,7 +141,7 @@ fn ros_invalid_inputs_name_the_field() {
     let mut m = good.clone();
     m.covariance[0] = -1.0; // ROS's "unknown" marker is not a covariance
     assert!(matches!(
-        m.try_to_uncertain(),
+        m.try_to_uncertain(RosReading::Tf2),
         Err(Error::NotPositiveSemiDefinite {
             what: "PoseWithCovariance.covariance",
             ..
@@ -144,7 +150,7 @@ fn ros_invalid_inputs_name_the_field() {
     let mut m = good.clone();
     m.position[2] = f64::INFINITY;
     assert!(matches!(
-        m.try_to_uncertain(),
+        m.try_to_uncertain(RosReading::Tf2),
         Err(Error::NonFinite {
             what: "PoseWithCovariance.pose.position",
             index: 2,
@@ -154,7 +160,7 @@ fn ros_invalid_inputs_name_the_field() {
     let mut m = good.clone();
     m.orientation_xyzw = [0.0, 0.0, 1.0, 1.0];
     assert!(matches!(
-        m.try_to_uncertain(),
+        m.try_to_uncertain(RosReading::Tf2),
         Err(Error::QuaternionNotUnit { .. })
     ));
 }

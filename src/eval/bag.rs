@@ -19,7 +19,7 @@
 
 use nalgebra::{Matrix3, Matrix6, Vector2};
 
-use crate::interop::ros_cov_to_right;
+use crate::interop::{RosReading, ros_cov_to_right};
 use crate::lie::{Se2, Se3, So2, So3};
 use crate::plan::bag::{BagPlan, Issue, SeriesPoint, TopicPlan};
 use crate::sample::{Sampler, chunk_rng};
@@ -35,6 +35,8 @@ pub struct BagEvalSettings {
     pub seed: u64,
     /// Samples per drawn message.
     pub cloud_samples: usize,
+    /// How each message's 6×6 covariance is read ([`RosReading`], CONVENTIONS §6).
+    pub reading: RosReading,
 }
 
 impl Default for BagEvalSettings {
@@ -42,6 +44,7 @@ impl Default for BagEvalSettings {
         Self {
             seed: 0,
             cloud_samples: DEFAULT_CLOUD_SAMPLES,
+            reading: RosReading::default(),
         }
     }
 }
@@ -118,6 +121,9 @@ pub struct TopicEvaluation {
     pub pose_dof: usize,
     /// Drawn messages.
     pub poses: Vec<PoseEvaluation>,
+    /// How far apart the two ROS readings put the drawn messages' right-form covariances:
+    /// the largest ‖Σ_tf2 − Σ_body‖_F / ‖Σ_tf2‖_F (0 for planar topics, where they coincide).
+    pub reading_difference: f64,
     /// Trajectory (stamp ns, position).
     pub trajectory: Vec<(i64, [f64; 3])>,
     /// Time series.
@@ -129,6 +135,8 @@ pub struct TopicEvaluation {
 pub struct BagEvaluation {
     /// Per topic, in the plan's order.
     pub topics: Vec<TopicEvaluation>,
+    /// The ROS reading every covariance was read in.
+    pub reading: RosReading,
 }
 
 /// Evaluates every topic of a log.
@@ -142,10 +150,12 @@ pub fn evaluate_bag(plan: &BagPlan, settings: &BagEvalSettings) -> BagEvaluation
             .enumerate()
             .map(|(k, t)| evaluate_topic(k as u64, t, settings))
             .collect(),
+        reading: settings.reading,
     }
 }
 
 fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) -> TopicEvaluation {
+    let mut reading_difference: f64 = 0.0;
     let poses = topic
         .drawn
         .iter()
@@ -165,11 +175,23 @@ fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) ->
                     && m.covariance[28] <= 0.0,
             });
             let state = match (mean, d.unusable.is_empty()) {
-                (Some(mean), true) => meaning(&mean, &cov_ros, &d.unestimated, topic.planar)
+                (Some(mean), true) => {
+                    if !topic.planar && finite {
+                        reading_difference =
+                            reading_difference.max(readings_apart(&mean, &cov_ros));
+                    }
+                    meaning(
+                        &mean,
+                        &cov_ros,
+                        &d.unestimated,
+                        topic.planar,
+                        settings.reading,
+                    )
                     .map_or_else(
                         |issues| PoseState::Invalid { issues },
                         |state| with_cloud(state, settings, family, d.index),
-                    ),
+                    )
+                }
                 _ => PoseState::Invalid {
                     issues: if d.unusable.is_empty() {
                         vec![Issue::BadOrientation]
@@ -193,6 +215,7 @@ fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) ->
         position_dof: if topic.planar { 2 } else { 3 },
         pose_dof: if topic.planar { 3 } else { 6 },
         poses,
+        reading_difference,
         trajectory: topic.trajectory.clone(),
         series: topic.series.clone(),
     }
@@ -208,6 +231,7 @@ fn meaning(
     cov_ros: &Matrix6<f64>,
     unestimated: &[bool; 6],
     planar: bool,
+    reading: RosReading,
 ) -> Result<PoseState, Vec<Issue>> {
     let invalid = |_| vec![Issue::NotPsd];
     if planar {
@@ -217,7 +241,7 @@ fn meaning(
             cov.row_mut(i).fill(0.0);
             cov.column_mut(i).fill(0.0);
         }
-        let right = ros_cov_to_right(&cov, &So3::from_rpy(0.0, 0.0, yaw));
+        let right = ros_cov_to_right(&cov, &So3::from_rpy(0.0, 0.0, yaw), reading);
         let keep = [0, 1, 5];
         let cov2 = Matrix3::from_fn(|r, c| right[(keep[r], keep[c])]);
         let t = mean.translation();
@@ -236,13 +260,25 @@ fn meaning(
         {
             return Err(vec![Issue::Placeholder]);
         }
-        let right = ros_cov_to_right(cov_ros, mean.rotation());
+        let right = ros_cov_to_right(cov_ros, mean.rotation(), reading);
         UncertainPose::try_new(*mean, right, Side::Right)
             .map(|pose| PoseState::Spatial {
                 pose: Box::new(pose),
                 cloud: Vec::new(),
             })
             .map_err(invalid)
+    }
+}
+
+/// ‖Σ_tf2 − Σ_body‖_F / ‖Σ_tf2‖_F of one message's right-form covariances (0 for Σ = 0).
+fn readings_apart(mean: &Se3, cov_ros: &Matrix6<f64>) -> f64 {
+    let tf2 = ros_cov_to_right(cov_ros, mean.rotation(), RosReading::Tf2);
+    let body = ros_cov_to_right(cov_ros, mean.rotation(), RosReading::Body);
+    let scale = tf2.norm();
+    if scale > 0.0 {
+        (tf2 - body).norm() / scale
+    } else {
+        0.0
     }
 }
 
@@ -293,7 +329,8 @@ mod tests {
             with_placeholders[(i, i)] = 1e6;
         }
         let un = [false, false, true, true, true, false];
-        let PoseState::Planar { pose, .. } = meaning(&mean, &with_placeholders, &un, true).unwrap()
+        let PoseState::Planar { pose, .. } =
+            meaning(&mean, &with_placeholders, &un, true, RosReading::Tf2).unwrap()
         else {
             panic!()
         };
@@ -307,7 +344,7 @@ mod tests {
             orientation_xyzw: mean.rotation().to_quaternion_xyzw(),
             covariance: full.transpose().iter().copied().collect(),
         };
-        let right = msg.try_to_uncertain().unwrap().cov_right();
+        let right = msg.try_to_uncertain(RosReading::Tf2).unwrap().cov_right();
         let keep = [0, 1, 5];
         for r in 0..3 {
             for c in 0..3 {
@@ -329,7 +366,7 @@ mod tests {
         let mut un = [false; 6];
         un[3] = true;
         assert_eq!(
-            meaning(&mean, &cov, &un, false).unwrap_err(),
+            meaning(&mean, &cov, &un, false, RosReading::Tf2).unwrap_err(),
             vec![Issue::Placeholder]
         );
     }

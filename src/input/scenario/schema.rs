@@ -7,6 +7,7 @@
 use serde::Deserialize;
 use toml::Spanned;
 
+use crate::interop::{EulerOrder, RosReading};
 use crate::uncertain::{Method, Side};
 
 /// A whole scenario file.
@@ -160,9 +161,20 @@ pub struct CovSpec {
     pub std_deg: Option<Vec<f64>>,
     /// Full matrix, row-major rows.
     pub matrix: Option<Vec<Vec<f64>>>,
-    /// ROS `PoseWithCovariance.covariance`: 36 numbers, row-major, (x, y, z, rotX, rotY, rotZ),
-    /// position error in the parent frame's axes, rotation error local (SE(3) only).
+    /// A ROS covariance, row-major: SE(3) `PoseWithCovariance.covariance`, 36 numbers over
+    /// (x, y, z, rotX, rotY, rotZ); SE(2) 9 numbers over (x, y, yaw) (tf2_2d, MRPT's
+    /// `CPosePDFGaussian`). Position error in the parent frame's axes; the rotation error as
+    /// `reading` says.
     pub ros: Option<Vec<f64>>,
+    /// How `ros` is read: `tf2` (default; rotation error in the parent axes, as tf2 moves it)
+    /// or `body` (rotation error local).
+    pub reading: Option<RosReading>,
+    /// An Euler-angle covariance (SE(3)), 36 numbers row-major over (x, y, z) and three angles
+    /// in the order `euler_order` names; positions in the parent axes.
+    pub euler: Option<Vec<f64>>,
+    /// The order of `euler`: `xyz_rpy` (robot_localization's state) or `xyz_ypr` (MRPT's
+    /// `CPose3DPDFGaussian`); required with `euler`.
+    pub euler_order: Option<EulerOrder>,
     /// Which side the perturbation is on (default `right`: X = μ · Exp(ε)).
     #[serde(default)]
     pub side: Side,

@@ -2,10 +2,13 @@
 //! validated matrices. Errors are [`ValueError`]s in the file's vocabulary; the lowering
 //! attaches the location and the key.
 
-use nalgebra::{Matrix4, Matrix6, SMatrix, Vector3};
+use nalgebra::{Matrix4, SMatrix, Vector3};
 
 use super::schema::{CovSpec, MeanSpec, Order};
-use crate::interop::{ros_cov_to_right, rotation_first_permutation};
+use crate::interop::{
+    EulerOrder, RosReading, VectorChart, ros_cov_to_right, rotation_first_permutation,
+    se2_from_xytheta, se3_cov_from_euler,
+};
 use crate::lie::{GroupKind, LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 use crate::plan::{Control, limits};
 use crate::uncertain::{Side, validate_covariance};
@@ -87,12 +90,19 @@ pub enum ValueError {
         /// The limit.
         limit: f64,
     },
-    /// A ROS covariance in a group other than SE(3).
-    #[error("`ros` covariances are 6×6 (SE(3)); this scenario's group is {group}")]
-    RosNeedsSe3 {
+    /// A covariance key for other groups than the scenario's.
+    #[error("`{key}` covariances are for {groups}; this scenario's group is {group}")]
+    CovKeyNotForGroup {
+        /// The key.
+        key: &'static str,
+        /// The groups it is for.
+        groups: &'static str,
         /// The scenario's group.
         group: &'static str,
     },
+    /// A modifier given without the key it modifies, or a key without its required modifier.
+    #[error("{0}")]
+    Modifier(&'static str),
     /// The value is not a valid group element or covariance (the library's reason).
     #[error("{0}")]
     Invalid(#[from] crate::Error),
@@ -129,6 +139,38 @@ fn mean_keys(kind: GroupKind) -> &'static [&'static str] {
 pub trait SpecGroup<const N: usize>: LieGroup<N> {
     /// Builds the mean from the keys that are set (already checked to be allowed).
     fn mean_from_spec(spec: &MeanSpec) -> Result<Self>;
+
+    /// A ROS covariance (row-major numbers) at `mean` in the right form (SE(2), SE(3)).
+    fn ros_cov(_ros: &[f64], _mean: &Self, _reading: RosReading) -> Result<TangentMatrix<N>> {
+        Err(ValueError::CovKeyNotForGroup {
+            key: "ros",
+            groups: "SE(2) (9 numbers over x, y, yaw) and SE(3) (36 numbers)",
+            group: Self::NAME,
+        })
+    }
+
+    /// An Euler-angle covariance (row-major numbers) at `mean` in the right form (SE(3)).
+    fn euler_cov(_euler: &[f64], _mean: &Self, _order: EulerOrder) -> Result<TangentMatrix<N>> {
+        Err(ValueError::CovKeyNotForGroup {
+            key: "euler",
+            groups: "SE(3) (36 numbers)",
+            group: Self::NAME,
+        })
+    }
+}
+
+/// `numbers` as an N×N row-major matrix, N² of them, each finite.
+fn row_major<const N: usize>(key: &str, numbers: &[f64]) -> Result<TangentMatrix<N>> {
+    check_values(key, numbers)?;
+    if numbers.len() != N * N {
+        return Err(ValueError::WrongCount {
+            what: key.to_owned(),
+            expected: N * N,
+            why: format!("{N}×{N} row-major"),
+            got: numbers.len(),
+        });
+    }
+    Ok(TangentMatrix::<N>::from_row_slice(numbers))
 }
 
 /// The names of the keys set in a mean specification.
@@ -275,6 +317,15 @@ impl SpecGroup<1> for So2 {
 }
 
 impl SpecGroup<3> for Se2 {
+    /// (x, y, yaw) with the position error in the parent axes: Σ_right = J⁻¹ Σ J⁻ᵀ,
+    /// J = blkdiag(R, 1) ([`se2_from_xytheta`]). Both ROS readings agree in the plane (a yaw
+    /// error is the same about the parent's z and the body's).
+    fn ros_cov(ros: &[f64], mean: &Self, _reading: RosReading) -> Result<TangentMatrix<3>> {
+        let ros = row_major::<3>("ros", ros)?;
+        let ros = validate_covariance("ros", &ros)?;
+        Ok(*se2_from_xytheta(&mean.to_coordinates(), &ros)?.cov())
+    }
+
     fn mean_from_spec(spec: &MeanSpec) -> Result<Self> {
         if let Some(m) = &spec.matrix {
             return Ok(Se2::try_from_matrix(&fixed_matrix::<3, 3>("matrix", m)?)?);
@@ -298,6 +349,19 @@ impl SpecGroup<3> for So3 {
 }
 
 impl SpecGroup<6> for Se3 {
+    /// [`ros_cov_to_right`]: Σ_right = B⁻¹ Σ_ros B⁻ᵀ, B = blkdiag(R, R) (tf2) or
+    /// blkdiag(R, I₃) (body).
+    fn ros_cov(ros: &[f64], mean: &Self, reading: RosReading) -> Result<TangentMatrix<6>> {
+        let ros = row_major::<6>("ros", ros)?;
+        Ok(ros_cov_to_right(&ros, mean.rotation(), reading))
+    }
+
+    /// [`se3_cov_from_euler`].
+    fn euler_cov(euler: &[f64], mean: &Self, order: EulerOrder) -> Result<TangentMatrix<6>> {
+        let euler = row_major::<6>("euler", euler)?;
+        Ok(se3_cov_from_euler(mean, &euler, order))
+    }
+
     fn mean_from_spec(spec: &MeanSpec) -> Result<Self> {
         if let Some(m) = &spec.matrix {
             let m: Matrix4<f64> = fixed_matrix::<4, 4>("matrix", m)?;
@@ -319,6 +383,7 @@ pub(crate) fn cov_for<G: SpecGroup<N>, const N: usize>(
         ("std_deg", spec.std_deg.is_some()),
         ("matrix", spec.matrix.is_some()),
         ("ros", spec.ros.is_some()),
+        ("euler", spec.euler.is_some()),
     ];
     let set: Vec<&str> = given.iter().filter(|g| g.1).map(|g| g.0).collect();
     if set.len() != 1 {
@@ -329,7 +394,7 @@ pub(crate) fn cov_for<G: SpecGroup<N>, const N: usize>(
             } else {
                 set.join(" + ")
             },
-            allowed: "std, std_deg, matrix, ros".to_owned(),
+            allowed: "std, std_deg, matrix, ros, euler".to_owned(),
         });
     }
     let rot = G::rotation_range();
@@ -359,8 +424,13 @@ pub(crate) fn cov_for<G: SpecGroup<N>, const N: usize>(
         from_std(std, true)?
     } else if let Some(rows) = &spec.matrix {
         fixed_matrix::<N, N>("matrix", rows)?
+    } else if let Some(ros) = &spec.ros {
+        G::ros_cov(ros, mean, spec.reading.unwrap_or_default())?
     } else {
-        ros_covariance::<G, N>(spec.ros.as_deref().unwrap_or(&[]), mean)?
+        let order = spec.euler_order.ok_or(ValueError::Modifier(
+            "`euler` needs `euler_order`: \"xyz_rpy\" (robot_localization) or \"xyz_ypr\" (MRPT)",
+        ))?;
+        G::euler_cov(spec.euler.as_deref().unwrap_or(&[]), mean, order)?
     };
     // NaN too: an entry that overflowed in a conversion.
     if let Some(value) = cov
@@ -374,39 +444,32 @@ pub(crate) fn cov_for<G: SpecGroup<N>, const N: usize>(
             limit: limits::MAX_VARIANCE,
         });
     }
-    if spec.order == Order::RotationFirst && spec.ros.is_none() {
+    let converted = spec.ros.is_some() || spec.euler.is_some();
+    if spec.order == Order::RotationFirst && converted {
+        return Err(ValueError::Modifier(
+            "`order` applies to `std`, `std_deg` and `matrix`; `ros` and `euler` name their own order",
+        ));
+    }
+    if spec.side == Side::Left && converted {
+        return Err(ValueError::Modifier(
+            "`side` applies to `std`, `std_deg` and `matrix`; `ros` and `euler` are read in the parent axes",
+        ));
+    }
+    if spec.reading.is_some() && spec.ros.is_none() {
+        return Err(ValueError::Modifier("`reading` applies to `ros` only"));
+    }
+    if spec.euler_order.is_some() && spec.euler.is_none() {
+        return Err(ValueError::Modifier(
+            "`euler_order` applies to `euler` only",
+        ));
+    }
+    if spec.order == Order::RotationFirst {
         let p = rotation_first_permutation::<G, N>();
         cov = p.transpose() * cov * p;
     }
     let cov = validate_covariance("covariance", &cov)?;
-    let side = if spec.ros.is_some() {
-        Side::Right
-    } else {
-        spec.side
-    };
+    let side = if converted { Side::Right } else { spec.side };
     Ok((cov, side))
-}
-
-/// ROS (x, y, z, rotX, rotY, rotZ), position error in parent axes, to the right form
-/// ([`ros_cov_to_right`]).
-fn ros_covariance<G: SpecGroup<N>, const N: usize>(
-    ros: &[f64],
-    mean: &G,
-) -> Result<TangentMatrix<N>> {
-    if N != 6 {
-        return Err(ValueError::RosNeedsSe3 { group: G::NAME });
-    }
-    check_values("ros", ros)?;
-    if ros.len() != 36 {
-        return Err(ValueError::WrongCount {
-            what: "ros".to_owned(),
-            expected: 36,
-            why: "6×6 row-major".to_owned(),
-            got: ros.len(),
-        });
-    }
-    let right = ros_cov_to_right(&Matrix6::from_row_slice(ros), mean.to_se3().rotation());
-    Ok(TangentMatrix::<N>::from_iterator(right.iter().copied()))
 }
 
 /// An odometry control: the `increment` model reads the numbers as the group's natural
