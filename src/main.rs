@@ -18,6 +18,7 @@ use posecov::app::commands;
 use posecov::app::live::{self, LiveOptions};
 use posecov::app::sinks::{EXIT_INTERRUPTED, ServeOptions, ViewOptions};
 use posecov::app::view::view;
+use posecov::interop::RosReading;
 use posecov::sink::Sink;
 
 /// See robot pose uncertainty: Lie-group poses with covariances, propagated and drawn in Rerun.
@@ -134,6 +135,10 @@ struct ScenarioArgs {
     /// Robot logs: draw every N-th message (default: at most ~200 per topic, evenly spaced).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     every: Option<u64>,
+    /// Robot logs: how a PoseWithCovariance's 36 numbers are read: `tf2` (default: both errors
+    /// in the parent frame's axes, as tf2 moves them) or `body` (the rotation error local).
+    #[arg(long = "ros-reading", value_name = "tf2|body")]
+    ros_reading: Option<RosReading>,
 }
 
 /// How to evaluate: values that override the file's.
@@ -164,6 +169,7 @@ impl EvalArgs {
             block_samples: self.block_samples,
             topics: Vec::new(),
             every: None,
+            ros_reading: None,
             steps: None,
         }
     }
@@ -251,6 +257,7 @@ impl ScenarioArgs {
         Overrides {
             topics: self.topics.clone(),
             every: self.every,
+            ros_reading: self.ros_reading,
             ..self.settings.overrides()
         }
     }

@@ -307,3 +307,42 @@ fn cov_key_modifiers_are_refused_where_they_do_not_apply() {
         assert!(e.starts_with("t.toml:"), "located: {e}");
     }
 }
+
+/// `--ros-reading` on a log: every JSON says which reading it used; the planar log's readings
+/// coincide (0 apart); a scenario refuses the flag and says where its reading goes instead.
+#[test]
+fn every_log_report_says_which_reading_and_scenarios_refuse_the_flag() {
+    let bin = env!("CARGO_BIN_EXE_posecov");
+    let log = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/robot_localization/test2.bag"
+    );
+    for (flag, expected) in [(None, "tf2"), (Some("body"), "body"), (Some("tf2"), "tf2")] {
+        let mut args = vec!["report", "--json", log];
+        if let Some(reading) = flag {
+            args.extend(["--ros-reading", reading]);
+        }
+        let out = std::process::Command::new(bin).args(&args).output().expect("runs");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+        assert_eq!(v["meta"]["ros_reading"], expected);
+        let topic = &v["topics"][0];
+        assert_eq!(topic["ros_reading"], expected);
+        assert_eq!(topic["ros_readings_apart"], 0.0, "planar: the readings coincide");
+    }
+    let out = std::process::Command::new(bin)
+        .args(["report", "ros_pose_with_covariance", "--ros-reading", "body"])
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("--ros-reading body: applies to robot logs") && err.contains("`reading`"),
+        "{err}"
+    );
+    let out = std::process::Command::new(bin)
+        .args(["report", log, "--ros-reading", "sideways"])
+        .output()
+        .expect("runs");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("use `tf2` or `body`"));
+}

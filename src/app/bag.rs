@@ -161,6 +161,8 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 "health": health,
                 "min_eigenvalue": t.health.min_eigenvalue,
                 "twist_sigma_last": t.twist_sigmas(),
+                "ros_reading": run.evaluation.reading,
+                "ros_readings_apart": e.reading_difference,
             })
         })
         .collect();
@@ -172,6 +174,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
             "seed": run.settings.eval.seed,
             "samples": run.settings.eval.cloud_samples,
             "confidence": run.settings.confidence,
+            "ros_reading": run.evaluation.reading,
             "messages": plan.messages_total,
             "cancelled": plan.cancelled,
         },

@@ -9,6 +9,7 @@ use crate::eval::EvalSettings;
 use crate::eval::bag::{BagEvalSettings, DEFAULT_CLOUD_SAMPLES};
 use crate::input::bag::BagOptions;
 use crate::input::{Input, InputKind};
+use crate::interop::RosReading;
 use crate::plan::{StepPolicy, limits};
 
 /// Monte Carlo samples when neither the command line nor the file says.
@@ -33,6 +34,9 @@ pub struct Overrides {
     pub topics: Vec<String>,
     /// `--every N` (robot logs only): draw every N-th message.
     pub every: Option<u64>,
+    /// `--ros-reading` (robot logs only): how a PoseWithCovariance's 6×6 is read
+    /// ([`RosReading`], CONVENTIONS §6); `None`: tf2's.
+    pub ros_reading: Option<RosReading>,
     /// Which steps of long propagations are kept (no flag: live mode's quick preview thins
     /// them); `None`: [`StepPolicy::default`].
     pub steps: Option<StepPolicy>,
@@ -71,7 +75,7 @@ pub enum SettingsError {
 /// table every input's flags are checked against.
 fn kind_flags(
     overrides: &Overrides,
-) -> [(&'static str, InputKind, &'static str, Option<String>); 3] {
+) -> [(&'static str, InputKind, &'static str, Option<String>); 4] {
     [
         (
             "--topic",
@@ -84,6 +88,12 @@ fn kind_flags(
             InputKind::Log,
             "it draws every N-th message of a log",
             overrides.every.map(|n| n.to_string()),
+        ),
+        (
+            "--ros-reading",
+            InputKind::Log,
+            "it says how a log's PoseWithCovariance covariances are read (a scenario says it with `reading` in a pose's `cov`)",
+            overrides.ros_reading.map(|r| r.name().to_owned()),
         ),
         (
             "--block-samples",
@@ -239,6 +249,7 @@ pub fn resolve_log(overrides: &Overrides) -> Result<LogSettings, SettingsError> 
         eval: BagEvalSettings {
             seed: overrides.seed.unwrap_or(0),
             cloud_samples: samples as usize,
+            reading: overrides.ros_reading.unwrap_or_default(),
         },
         confidence: overrides.confidence.unwrap_or(DEFAULT_CONFIDENCE),
     })

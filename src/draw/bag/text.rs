@@ -5,6 +5,7 @@ use std::fmt::Write;
 
 use crate::eval::bag::{BagEvaluation, PoseState};
 use crate::input::Format;
+use crate::interop::RosReading;
 use crate::plan::bag::{BagPlan, Issue, TopicPlan};
 use crate::uncertain::chi2_radius;
 
@@ -55,7 +56,7 @@ pub fn description(plan: &BagPlan, format: Format, e: &BagEvaluation, confidence
         );
     }
     for (t, te) in plan.topics.iter().zip(&e.topics) {
-        topic(&mut s, t, te, confidence);
+        topic(&mut s, t, te, confidence, e.reading);
     }
     if !plan.skipped.is_empty() {
         let _ = writeln!(s, "\n---\n\n**Skipped** (other message types):\n");
@@ -82,18 +83,41 @@ pub fn description(plan: &BagPlan, format: Format, e: &BagEvaluation, confidence
          (tan of the angular spread, bounded at 89°) — a yaw fan when RViz takes the pose as \
          2-D (Σzz, Σroll, Σpitch ≤ 0; a 1e6 placeholder makes it draw a 3-D shape kilometres \
          tall, clipped here at half the scene's size).\n\
-         - **What the numbers mean** (`meaning/`): ROS's covariance (position error in the \
-         parent's axes, rotation error local) converted to posecov's body-frame right form, \
-         X = μ · Exp(ε); its Exp-mapped banana, Cartesian ellipsoid and a seeded sample cloud \
-         (3-D: sampled axis tips).\n\
+         - **What the numbers mean** (`meaning/`): ROS's covariance, read {}, converted to \
+         posecov's body-frame right form, X = μ · Exp(ε); its Exp-mapped banana, Cartesian \
+         ellipsoid and a seeded sample cloud (3-D: sampled axis tips).\n\
          - Regions at {:.1} %; the `stamp` timeline is the message stamp (a date, or the time \
          since the clock's zero when the stamps are simulated time).",
+        reading_words(e.reading),
         confidence * 100.0
     );
     s
 }
 
-fn topic(s: &mut String, t: &TopicPlan, e: &crate::eval::bag::TopicEvaluation, p: f64) {
+/// How a reading reads a message, in words ([CONVENTIONS §6](crate::conventions)).
+fn reading_words(reading: RosReading) -> &'static str {
+    match reading {
+        RosReading::Tf2 => {
+            "as tf2 reads it (`--ros-reading tf2`, the default: position and rotation errors both \
+             in the parent frame's axes, p̃ = p + δp, R̃ = Exp(δφ) · R)"
+        }
+        RosReading::Body => {
+            "in the body reading (`--ros-reading body`: position error in the parent's axes, \
+             rotation error local, R̃ = R · Exp(δθ); tf2 reads it otherwise)"
+        }
+    }
+}
+
+/// Readings further apart than this (relative Frobenius) are worth a sentence.
+const READINGS_APART: f64 = 0.01;
+
+fn topic(
+    s: &mut String,
+    t: &TopicPlan,
+    e: &crate::eval::bag::TopicEvaluation,
+    p: f64,
+    reading: RosReading,
+) {
     let _ = writeln!(s, "\n---\n\n**{}** ({})\n", t.name, t.kind.ros1_name());
     if !t.frame_id.is_empty() || !t.child_frame_id.is_empty() {
         let child = if t.child_frame_id.is_empty() {
@@ -180,6 +204,19 @@ fn topic(s: &mut String, t: &TopicPlan, e: &crate::eval::bag::TopicEvaluation, p
             r2(6)
         )
     };
+    if e.reading_difference > READINGS_APART {
+        let _ = writeln!(
+            s,
+            "\n**The ROS reading matters here**: with 3-D attitudes, tf2's reading and the body \
+             reading give right-form covariances up to {:.0} % apart (‖Σ_tf2 − Σ_body‖_F / ‖Σ_tf2‖_F); \
+             this view uses {}.",
+            e.reading_difference * 100.0,
+            match reading {
+                RosReading::Tf2 => "tf2's (`--ros-reading body` for the other)",
+                RosReading::Body => "the body reading (`--ros-reading tf2` for tf2's)",
+            }
+        );
+    }
     let _ = writeln!(
         s,
         "\n{shape}. Drawn: {} message(s), one in {}{}.",
