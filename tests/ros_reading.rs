@@ -322,16 +322,31 @@ fn every_log_report_says_which_reading_and_scenarios_refuse_the_flag() {
         if let Some(reading) = flag {
             args.extend(["--ros-reading", reading]);
         }
-        let out = std::process::Command::new(bin).args(&args).output().expect("runs");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let out = std::process::Command::new(bin)
+            .args(&args)
+            .output()
+            .expect("runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
         assert_eq!(v["meta"]["ros_reading"], expected);
         let topic = &v["topics"][0];
         assert_eq!(topic["ros_reading"], expected);
-        assert_eq!(topic["ros_readings_apart"], 0.0, "planar: the readings coincide");
+        assert_eq!(
+            topic["ros_readings_apart"], 0.0,
+            "planar: the readings coincide"
+        );
     }
     let out = std::process::Command::new(bin)
-        .args(["report", "ros_pose_with_covariance", "--ros-reading", "body"])
+        .args([
+            "report",
+            "ros_pose_with_covariance",
+            "--ros-reading",
+            "body",
+        ])
         .output()
         .expect("runs");
     let err = String::from_utf8_lossy(&out.stderr);

@@ -151,6 +151,18 @@ struct Counts {
     nees: f64,
 }
 
+impl Counts {
+    /// Adds `parts` to `totals`, estimate by estimate.
+    fn add_all(totals: &mut [Counts], parts: &[Counts]) {
+        for (total, part) in totals.iter_mut().zip(parts) {
+            for (t, p) in total.inside.iter_mut().zip(part.inside) {
+                *t += p;
+            }
+            total.nees += part.nees;
+        }
+    }
+}
+
 /// Running counts of every estimate of one node over the samples seen so far (all of them at
 /// once, or block by block in a blocked run).
 pub(super) struct ConsistencySums<G: LieGroup<N>, const N: usize> {
@@ -200,20 +212,10 @@ impl<G: EvalGroup<N>, const N: usize> ConsistencySums<G, N> {
                 counts
             })
             .reduce(zero, |mut a, b| {
-                for (a, b) in a.iter_mut().zip(b) {
-                    for r in 0..3 {
-                        a.inside[r] += b.inside[r];
-                    }
-                    a.nees += b.nees;
-                }
+                Counts::add_all(&mut a, &b);
                 a
             });
-        for (total, part) in self.counts.iter_mut().zip(sums) {
-            for r in 0..3 {
-                total.inside[r] += part.inside[r];
-            }
-            total.nees += part.nees;
-        }
+        Counts::add_all(&mut self.counts, &sums);
         self.samples += samples.len();
     }
 
