@@ -209,3 +209,31 @@ fn without_monte_carlo_no_coverage_is_claimed() {
     assert_eq!(r["coverage"], Value::Array(Vec::new()));
     assert!(r["anees"].is_null() && r["anees_band"].is_null());
 }
+
+/// A sample simulated in blocks counts every block: the analytic estimates' coverage and ANEES
+/// equal the whole sample's; Monte Carlo's own Gaussian, known only after every block, has none.
+#[test]
+fn a_blocked_sample_counts_the_same_as_a_whole_one() {
+    let loaded = load("camera_on_robot").expect("bundled");
+    let run = |block_samples| {
+        let overrides = Overrides {
+            samples: Some(9000),
+            block_samples,
+            ..Default::default()
+        };
+        let (evaluation, _) = pipeline(&loaded, &overrides, None).expect("evaluates");
+        report_json("t", &loaded, &evaluation, 0.95)
+    };
+    let (whole, blocked) = (run(None), run(Some(2048)));
+    for method in ["exact", "sigma_points", "vector_space"] {
+        let (a, b) = (
+            result(&whole, "map_from_camera", method),
+            result(&blocked, "map_from_camera", method),
+        );
+        assert_eq!(a["coverage"], b["coverage"], "{method}");
+        let (x, y) = (a["anees"].as_f64().unwrap(), b["anees"].as_f64().unwrap());
+        assert!((x - y).abs() < 1e-9 * x, "{method}: {x} vs {y}");
+    }
+    let mc = result(&blocked, "map_from_camera", "monte_carlo");
+    assert_eq!(mc["coverage"], Value::Array(Vec::new()));
+}
