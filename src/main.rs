@@ -18,6 +18,7 @@ use posecov::app::commands;
 use posecov::app::live::{self, LiveOptions};
 use posecov::app::sinks::{EXIT_INTERRUPTED, ServeOptions, ViewOptions};
 use posecov::app::view::view;
+use posecov::eval::graph::{GraphReading, Optimizer};
 use posecov::interop::RosReading;
 use posecov::sink::Sink;
 
@@ -158,6 +159,14 @@ struct EvalArgs {
     /// stays bounded, statistics use every sample, and each block's cloud is logged in turn.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     block_samples: Option<u64>,
+    /// Pose graphs: how the file's information matrices are read. `g2o` (default) as g2o
+    /// defines them; `gtsam` as GTSAM's readG2o does (3-D edges without the half-angle
+    /// factor), for a like-for-like comparison with GTSAM.
+    #[arg(long, value_name = "READING", value_parser = ["g2o", "gtsam"])]
+    graph_reading: Option<String>,
+    /// Pose graphs: the optimiser, `lm` (Levenberg–Marquardt, default) or `gn` (Gauss–Newton).
+    #[arg(long, value_name = "NAME", value_parser = ["lm", "gn"])]
+    optimizer: Option<String>,
 }
 
 impl EvalArgs {
@@ -171,6 +180,14 @@ impl EvalArgs {
             every: None,
             ros_reading: None,
             steps: None,
+            graph_reading: self.graph_reading.as_deref().map(|r| match r {
+                "gtsam" => GraphReading::Gtsam,
+                _ => GraphReading::G2o,
+            }),
+            optimizer: self.optimizer.as_deref().map(|o| match o {
+                "gn" => Optimizer::GaussNewton,
+                _ => Optimizer::LevenbergMarquardt,
+            }),
         }
     }
 }

@@ -27,6 +27,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 pub mod bag;
+pub mod graph;
 
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 pub use crate::propagate::odometry::StepNoise;
@@ -300,6 +301,9 @@ pub struct Plan<G: LieGroup<N>, const N: usize> {
     pub poses: Vec<PoseDef<G, N>>,
     /// Definitions `poses.len() ..`, evaluated in order.
     pub operations: Vec<Operation<G, N>>,
+    /// A pose graph to optimise (g2o / GTSAM files), with its marginals
+    /// ([`crate::eval::graph`]).
+    pub graph: Option<graph::PoseGraph<G, N>>,
 }
 
 impl<G: LieGroup<N>, const N: usize> Default for Plan<G, N> {
@@ -307,6 +311,7 @@ impl<G: LieGroup<N>, const N: usize> Default for Plan<G, N> {
         Self {
             poses: Vec::new(),
             operations: Vec::new(),
+            graph: None,
         }
     }
 }

@@ -359,7 +359,13 @@ const BAD: &[(&str, &str)] = &[
      "g.g2o:2:1: VERTEX_SE3:QUAT: a 3D (SE(3)) record in a planar (SE(2)) graph (line 1 is planar (SE(2)))"),
     ("", "g.g2o:1:1: file: no vertices or edges: a pose graph needs"),
     ("# only a comment\n\n", "g.g2o:1:1: file: no vertices or edges"),
-    ("FIX 0\n", "g.g2o:1:1: file: no vertices or edges (only 1 FIX)"),
+    ("FIX 0\n", "g.g2o:1:1: FIX: the file has no vertices and no edges"),
+    ("VERTEX_SE2 0 0 0 0\nFIX\n", "g.g2o:2:1: FIX: expected the ids of the vertices to hold fixed"),
+    ("VERTEX_SE2 0 0 0 0\nFIX 0 x\n", "g.g2o:2:7: FIX: id = `x` is not a vertex id"),
+    ("VERTEX_SE2 0 0 0 0\nFIX 3\n", "g.g2o:2:5: FIX: vertex 3 is not defined"),
+    ("VERTEX_SE2 0 0 0 0\nEDGE_PRIOR_SE2 2 0 0 0 1 0 0 1 0 1\n", "g.g2o:2:16: EDGE_PRIOR_SE2: vertex 2 is not defined"),
+    ("VERTEX_SE2 0 0 0 0\nEDGE_PRIOR_SE2 0 0 0 0 1 0 0 1 0 0\n",
+     "g.g2o:2:24: EDGE_PRIOR_SE2 0 information: the information matrix over (x, y, θ) is not positive definite"),
     ("VERTEX_SE2 0 0 0 0\nFOO 1 2\n", "g.g2o:2:1: record: `FOO` is not a g2o record posecov reads"),
     ("VERTEX_SE2 0 0 0\n", "g.g2o:1:1: VERTEX_SE2: expected 4 values after the tag (id x y θ), found 3"),
     ("VERTEX_SE2 0 0 0 0 5\n", "g.g2o:1:20: VERTEX_SE2: expected 4 values after the tag (id x y θ), found 5"),
@@ -367,7 +373,7 @@ const BAD: &[(&str, &str)] = &[
     ("VERTEX_SE2 0 1e13 0 0\n", "g.g2o:1:14: VERTEX_SE2 0: coordinate 10000000000000 is beyond ±1e12 m"),
     ("VERTEX_SE3:QUAT 0 0 0 0 0 0 0 2\n", "g.g2o:1:19: VERTEX_SE3:QUAT 0: quaternion (x, y, z, w) = [0.0, 0.0, 0.0, 2.0] has norm 2"),
     ("VERTEX_SE3:QUAT 0 0 0 0 0 0 0 0\n", "g.g2o:1:19: VERTEX_SE3:QUAT 0: quaternion (x, y, z, w) = [0.0, 0.0, 0.0, 0.0] has norm 0"),
-    ("EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n", "g.g2o:1:1: EDGE_SE2: the file has edges but no vertices"),
+    ("EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\nVERTEX_SE2 0 0 0 0\n", "g.g2o:1:12: EDGE_SE2 0 1: vertex 1 is not defined"),
 ];
 
 #[test]

@@ -181,7 +181,7 @@ pub fn report_json(
 ) -> serde_json::Value {
     let (seed, samples, block_samples, methods) = evaluation.run();
     let sigma = loaded.input.defaults.sigma_points.unwrap_or_default();
-    serde_json::json!({
+    let mut report = serde_json::json!({
         "scenario": name,
         "format": loaded.source.format(),
         "input": loaded.source.facts(),
@@ -200,5 +200,13 @@ pub fn report_json(
         "results": evaluation.records(),
         "monte_carlo": evaluation.monte_carlo_records(),
         "findings": evaluation.findings(),
-    })
+    });
+    // A pose graph's optimisation: poses, marginals, loop closures (eval::graph).
+    if let (Some(optimized), Some(object)) = (evaluation.optimized(), report.as_object_mut()) {
+        object.insert(
+            "optimized".to_owned(),
+            serde_json::to_value(optimized).unwrap_or_default(),
+        );
+    }
+    report
 }

@@ -7,6 +7,7 @@ use std::sync::atomic::AtomicBool;
 use crate::draw::DrawSettings;
 use crate::eval::EvalSettings;
 use crate::eval::bag::{BagEvalSettings, DEFAULT_CLOUD_SAMPLES};
+use crate::eval::graph::{GraphReading, GraphSettings, Optimizer};
 use crate::input::bag::BagOptions;
 use crate::input::{Input, InputKind};
 use crate::interop::RosReading;
@@ -40,6 +41,10 @@ pub struct Overrides {
     /// Which steps of long propagations are kept (no flag: live mode's quick preview thins
     /// them); `None`: [`StepPolicy::default`].
     pub steps: Option<StepPolicy>,
+    /// `--graph-reading` (pose graphs).
+    pub graph_reading: Option<GraphReading>,
+    /// `--optimizer` (pose graphs).
+    pub optimizer: Option<Optimizer>,
 }
 
 /// A command-line value the input cannot take: names the flag, the value and why.
@@ -201,6 +206,11 @@ pub fn resolve(
             confidence,
             unscented: file.sigma_points.unwrap_or_default(),
             cancel,
+            graph: GraphSettings {
+                optimizer: overrides.optimizer.unwrap_or_default(),
+                reading: overrides.graph_reading.unwrap_or_default(),
+                confidence,
+            },
         },
         draw: DrawSettings {
             about: input.about.clone(),

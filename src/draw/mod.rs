@@ -42,6 +42,7 @@ use crate::scene::{
 use crate::uncertain::Method;
 
 pub mod bag;
+mod graph;
 mod plots;
 mod shapes;
 mod text;
@@ -313,6 +314,9 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         }
     }
     links(&mut p, e);
+    if let Some(g) = &e.graph {
+        graph::draw_optimized(&mut p, g);
+    }
     for point in &e.points {
         for (method, mean, cov) in &point.estimates {
             let shape = shapes::ellipsoid_of(mean, cov, chi2_radius(p.confidence(), 3));
@@ -374,7 +378,11 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         layout: p.layout,
         camera: choices.camera,
     };
-    p.scene.views = views::views(&p.scene, &plan);
+    p.scene.views = if e.graph.is_some() {
+        views::before_after(&p.scene, &plan, graph::AFTER)
+    } else {
+        views::views(&p.scene, &plan)
+    };
     if let Some(note) = views::note(&p.scene.views) {
         p.scene.description_markdown.push_str(&note);
     }

@@ -22,7 +22,11 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
     if !about.source.is_empty() {
         let _ = writeln!(s, "*Source: {}*\n", about.source);
     }
-    let _ = writeln!(s, "{}\n", about.description.trim());
+    let _ = writeln!(s, "{}", about.description.trim());
+    if let Some(g) = &e.graph {
+        s.push_str(&super::graph::describe(g));
+    }
+    s.push('\n');
     let _ = writeln!(
         s,
         "**Convention:** {} with tangent order {}; covariances are read as X = μ · Exp(ε) (right / body) unless marked left. \
@@ -314,6 +318,7 @@ fn finding_text(f: &Finding) -> String {
         Finding::Interrupted => {
             "*Evaluation interrupted: later operations or steps were not evaluated.*".to_owned()
         }
+        other => super::graph::finding_text(other).unwrap_or_default(),
     }
 }
 

@@ -116,6 +116,29 @@ pub(super) fn views(scene: &Scene, plan: &ViewPlan) -> Vec<View3d> {
     views
 }
 
+/// A pose graph's two views side by side: "before" (the file's estimates and the odometry
+/// chain, everything but `after`) and "after" (the subtree `after`: optimised poses and
+/// marginals), each with its own camera.
+pub(super) fn before_after(scene: &Scene, plan: &ViewPlan, after: &str) -> Vec<View3d> {
+    let mut views = vec![
+        View3d {
+            name: "before: file estimates, odometry chain".to_owned(),
+            exclude: vec![after.to_owned()],
+            ..Default::default()
+        },
+        View3d {
+            name: "after: optimised, marginals".to_owned(),
+            include: vec![after.to_owned()],
+            ..Default::default()
+        },
+    ];
+    let aspect = ASPECT / 2.0;
+    for view in &mut views {
+        view.camera = camera(&points_of(scene, view), plan, aspect);
+    }
+    views
+}
+
 /// A sentence for the text panel on what the views leave out or hide, if anything.
 pub(super) fn note(views: &[View3d]) -> Option<String> {
     let hidden: Vec<String> = views

@@ -118,6 +118,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 paths: Vec::new(),
                 matrix_frames: Vec::new(),
                 findings: Vec::new(),
+                graph: None,
             },
             families: 0,
             block,

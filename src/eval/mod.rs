@@ -40,6 +40,7 @@ pub mod bag;
 mod blocked;
 pub mod consistency;
 mod engine;
+pub mod graph;
 pub mod groups;
 mod model;
 mod ops;
@@ -94,6 +95,8 @@ pub struct EvalSettings {
     /// Set to stop early (Ctrl-C): the evaluation returns what it has, with
     /// [`Finding::Interrupted`].
     pub cancel: Option<Arc<AtomicBool>>,
+    /// How a plan's pose graph is optimised and its loop closures measured.
+    pub graph: graph::GraphSettings,
 }
 
 impl Default for EvalSettings {
@@ -107,6 +110,7 @@ impl Default for EvalSettings {
             confidence: DEFAULT_CONFIDENCE,
             unscented: Default::default(),
             cancel: None,
+            graph: Default::default(),
         }
     }
 }
@@ -127,6 +131,9 @@ impl EvalSettings {
 /// (`operation[k]` in a scenario file), `output` the name it defines.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EvalError {
+    /// A pose graph that cannot be solved here (too large, or the linear algebra failed).
+    #[error("pose graph: {0}")]
+    Graph(String),
     /// A setting is out of range (the caller validates its own flags first).
     #[error("{what} = {value} is out of range: {expected}")]
     Setting {
@@ -237,7 +244,7 @@ impl EvalError {
     /// ```
     pub fn operation(&self) -> Option<usize> {
         match self {
-            EvalError::Setting { .. } | EvalError::Pose { .. } => None,
+            EvalError::Setting { .. } | EvalError::Pose { .. } | EvalError::Graph(_) => None,
             EvalError::Undefined { operation, .. }
             | EvalError::WrongGroup { operation, .. }
             | EvalError::TooMuchWork { operation, .. }
@@ -364,10 +371,76 @@ fn run<G: EvalGroup<N>, const N: usize>(
         0
     };
     let b = block_samples(plan, settings)?.min(n);
-    if b >= n {
-        return Engine::run(plan, settings, 0..n, StatsMode::Own);
+    let mut out = if b >= n {
+        Engine::run(plan, settings, 0..n, StatsMode::Own)?
+    } else {
+        run_blocked(plan, settings, n, b)?
+    };
+    if let Some(g) = &plan.graph {
+        let evaluation =
+            graph::evaluate_graph(g, &settings.graph, settings.cancel.clone(), &mut |_| {})
+                .map_err(|e| EvalError::Graph(e.to_string()))?;
+        out.findings.extend(graph_findings(&evaluation));
+        out.graph = Some(evaluation);
     }
-    run_blocked(plan, settings, n, b)
+    Ok(out)
+}
+
+/// Most loop-closure outliers listed one by one in the findings.
+pub const MAX_LISTED_OUTLIERS: usize = 50;
+
+/// What a graph's evaluation has to tell besides its numbers.
+fn graph_findings<G: EvalGroup<N>, const N: usize>(
+    g: &graph::GraphEvaluation<G, N>,
+) -> Vec<Finding> {
+    let s = &g.solution;
+    let mut out = Vec::new();
+    if !s.converged() {
+        out.push(Finding::GraphNotConverged {
+            stop: s.stop,
+            optimizer: s.optimizer,
+            iterations: s.iterations,
+            chi2_before: s.chi2_before,
+            chi2_after: s.chi2_after,
+            log: s.log[s.log.len().saturating_sub(50)..].to_vec(),
+        });
+    }
+    if let Some(reason) = &s.marginals_error {
+        out.push(Finding::GraphMarginalsFailed {
+            reason: reason.clone(),
+        });
+    }
+    if s.parts.len() > 1 {
+        out.push(Finding::GraphParts {
+            parts: s.parts.clone(),
+        });
+    }
+    if !g.duplicates.is_empty() {
+        out.push(Finding::DuplicateEdges {
+            count: g.duplicates.len(),
+            lines: g.duplicates.iter().take(10).copied().collect(),
+        });
+    }
+    let outliers = g.outliers();
+    for l in outliers.iter().take(MAX_LISTED_OUTLIERS) {
+        out.push(Finding::LoopClosureOutlier {
+            from: l.from,
+            to: l.to,
+            line: l.line,
+            mahalanobis: l.mahalanobis,
+            mahalanobis_before: l.mahalanobis_before,
+            radius: g.radius,
+            confidence: g.confidence,
+        });
+    }
+    if outliers.len() > MAX_LISTED_OUTLIERS {
+        out.push(Finding::MoreLoopClosureOutliers {
+            more: outliers.len() - MAX_LISTED_OUTLIERS,
+            outliers: outliers.len(),
+            loop_closures: g.loop_closures.len(),
+        });
+    }
+    out
 }
 
 /// Particles per block: the settings', else as many as fit the budget given how many

@@ -251,6 +251,67 @@ pub enum Finding {
     },
     /// Ctrl-C stopped the evaluation: later operations or steps are missing.
     Interrupted,
+    /// A pose graph's optimiser stopped without meeting its stop criteria: the iteration log,
+    /// and the estimate kept (the last that lowered χ²).
+    GraphNotConverged {
+        /// Why it stopped.
+        stop: super::graph::Stop,
+        /// The optimiser.
+        optimizer: super::graph::Optimizer,
+        /// Accepted steps.
+        iterations: usize,
+        /// χ² of the initial guess.
+        chi2_before: f64,
+        /// χ² of the estimate kept.
+        chi2_after: f64,
+        /// Every step tried (the last 50).
+        log: Vec<super::graph::Iteration>,
+    },
+    /// A loop closure whose residual after the optimisation lies outside its edge's own region
+    /// at the confidence: d = √(rᵀ Λ r) beyond √χ²_N(confidence).
+    LoopClosureOutlier {
+        /// Vertex i.
+        from: u64,
+        /// Vertex j.
+        to: u64,
+        /// The edge's line.
+        line: usize,
+        /// d after the optimisation.
+        mahalanobis: f64,
+        /// d at the file's estimates.
+        mahalanobis_before: f64,
+        /// √χ²_N(confidence).
+        radius: f64,
+        /// The confidence.
+        confidence: f64,
+    },
+    /// More loop-closure outliers than are listed one by one.
+    MoreLoopClosureOutliers {
+        /// Outliers not listed.
+        more: usize,
+        /// Outliers in all.
+        outliers: usize,
+        /// Loop closures in all.
+        loop_closures: usize,
+    },
+    /// The graph falls into several unconnected parts (or has vertices no edge reaches): each
+    /// is anchored on its own.
+    GraphParts {
+        /// Every part with its anchor.
+        parts: Vec<super::graph::Part>,
+    },
+    /// Edges joining the same two vertices more than once: all kept and counted.
+    DuplicateEdges {
+        /// How many edges repeat an earlier pair.
+        count: usize,
+        /// (line, line of the first edge of the pair), the first 10.
+        lines: Vec<(usize, usize)>,
+    },
+    /// The marginals could not be computed (the estimate stands).
+    GraphMarginalsFailed {
+        /// Why.
+        reason: String,
+    },
 }
 
 /// Everything a plan evaluates to, for one group: numbers, no drawing.
@@ -276,6 +337,8 @@ pub struct Evaluation<G: LieGroup<N>, const N: usize> {
     pub matrix_frames: Vec<MatrixFrame>,
     /// What the user should know besides the estimates.
     pub findings: Vec<Finding>,
+    /// A pose graph's optimisation and marginals (g2o / GTSAM inputs).
+    pub graph: Option<super::graph::GraphEvaluation<G, N>>,
 }
 
 impl<G: LieGroup<N>, const N: usize> Evaluation<G, N>
@@ -441,6 +504,18 @@ impl AnyEvaluation {
     /// ```
     pub fn findings(&self) -> &[Finding] {
         with_evaluation!(self, e => &e.findings)
+    }
+
+    /// A pose graph's optimisation as `report --json`'s `optimized` object (None for other
+    /// inputs).
+    ///
+    /// ```
+    /// use posecov::{eval::{EvalSettings, evaluate}, plan::{AnyPlan, Plan}};
+    /// let e = evaluate(&AnyPlan::So3(Plan::default()), &EvalSettings::default()).unwrap();
+    /// assert!(e.optimized().is_none());
+    /// ```
+    pub fn optimized(&self) -> Option<super::graph::OptimizedReport> {
+        with_evaluation!(self, e => e.graph.as_ref().map(|g| g.report()))
     }
 
     /// (seed, samples, block samples, methods) the evaluation ran with.

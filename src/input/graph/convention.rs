@@ -95,6 +95,22 @@ pub fn se3_cov_from_g2o_error_cov(cov_error: &Matrix6<f64>) -> Matrix6<f64> {
     d * cov_error * d
 }
 
+/// The information over posecov's [ρ; θ] of an `EDGE_SE3:QUAT` whose information over g2o's
+/// (t, q.xyz) is `information` = Ω: Λ = (D Ω⁻¹ D)⁻¹ = D⁻¹ Ω D⁻¹, D = diag(1, 1, 1, 2, 2, 2)
+/// (the inverse of [`se3_cov_from_g2o_error_cov`] of Ω⁻¹).
+///
+/// ```
+/// use posecov::input::graph::convention::se3_information_from_g2o;
+/// use nalgebra::Matrix6;
+/// let lambda = se3_information_from_g2o(&(Matrix6::identity() * 1e4));
+/// assert_eq!(lambda[(0, 0)], 1e4);
+/// assert_eq!(lambda[(3, 3)], 2.5e3); // σ_θ = 2 σ_q: a quarter of the information
+/// ```
+pub fn se3_information_from_g2o(information: &Matrix6<f64>) -> Matrix6<f64> {
+    let d_inv = Matrix6::from_diagonal(&nalgebra::Vector6::new(1.0, 1.0, 1.0, 0.5, 0.5, 0.5));
+    d_inv * information * d_inv
+}
+
 /// The covariance GTSAM's `readG2o` gives an `EDGE_SE3:QUAT` of information `information`
 /// (g2o order), in GTSAM's own order [ω; v]: (P Ω Pᵀ)⁻¹ with P swapping the translation and
 /// rotation blocks, no half-angle factor. `None` if Ω is not invertible.

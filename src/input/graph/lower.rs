@@ -5,8 +5,11 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use nalgebra::SMatrix;
 
-use super::convention::{from_upper_triangle, se3_cov_from_g2o_error_cov};
+use super::convention::{
+    from_upper_triangle, se3_cov_from_g2o_error_cov, se3_information_from_g2o,
+};
 use super::parse::{Dimension, Kind, Record, Records, information_axes};
+use super::problem::{Edge, Prior, chain_initial_guess, pose_graph};
 use super::{InputError, Locator, Residual, Summary};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
@@ -22,15 +25,14 @@ pub const MAX_LOOP_CLOSURES: usize = 30;
 /// Most vertex estimates drawn as axes (evenly chosen, plus the loop closures' ends).
 pub const MAX_DRAWN_VERTICES: usize = 300;
 
-/// Frames carry their names only up to this many vertices and loop closures.
-const MAX_LABELLED: usize = 40;
-
 /// What the two pose-graph groups need besides being Lie groups.
 trait GraphGroup<const N: usize>: LieGroup<N> {
     /// A pose from the file's values (x y θ, or x y z qx qy qz qw).
     fn from_values(values: &[f64]) -> crate::Result<Self>;
     /// posecov's [ρ; θ] covariance from g2o's error covariance Ω⁻¹ ([`super::convention`]).
     fn cov_from_error_cov(cov_error: &TangentMatrix<N>) -> TangentMatrix<N>;
+    /// The information over [ρ; θ] of g2o's Ω (the inverse of `cov_from_error_cov(Ω⁻¹)`).
+    fn information_from_g2o(information: &TangentMatrix<N>) -> TangentMatrix<N>;
     /// The plan of this group.
     fn any(plan: Plan<Self, N>) -> AnyPlan;
 }
@@ -41,6 +43,9 @@ impl GraphGroup<3> for Se2 {
     }
     fn cov_from_error_cov(cov_error: &TangentMatrix<3>) -> TangentMatrix<3> {
         *cov_error
+    }
+    fn information_from_g2o(information: &TangentMatrix<3>) -> TangentMatrix<3> {
+        *information
     }
     fn any(plan: Plan<Self, 3>) -> AnyPlan {
         AnyPlan::Se2(plan)
@@ -54,26 +59,20 @@ impl GraphGroup<6> for Se3 {
     fn cov_from_error_cov(cov_error: &TangentMatrix<6>) -> TangentMatrix<6> {
         se3_cov_from_g2o_error_cov(cov_error)
     }
+    fn information_from_g2o(information: &TangentMatrix<6>) -> TangentMatrix<6> {
+        se3_information_from_g2o(information)
+    }
     fn any(plan: Plan<Self, 6>) -> AnyPlan {
         AnyPlan::Se3(plan)
     }
-}
-
-/// A checked edge.
-struct Edge<G: LieGroup<N>, const N: usize> {
-    from: u64,
-    to: u64,
-    line: usize,
-    measurement: G,
-    /// Right-perturbation covariance over [ρ; θ] in the frame of X_from · Z.
-    cov: TangentMatrix<N>,
 }
 
 /// The plan, the line of each operation's edge, and the counts.
 pub(super) type Lowered = (Input, Vec<usize>, Summary);
 
 pub(super) fn lower(locator: &Locator, records: &Records) -> Result<Lowered, InputError> {
-    match records.records.first().map(|r| r.tag.dimension) {
+    let first = records.records.iter().find(|r| r.tag.kind != Kind::Fix);
+    match first.map(|r| r.tag.dimension) {
         Some(Dimension::Spatial) => build::<Se3, 6>(locator, records),
         _ => build::<Se2, 3>(locator, records),
     }
@@ -84,11 +83,12 @@ fn label(r: &Record) -> String {
     format!("{} {}", r.tag.name, ids.join(" "))
 }
 
-/// Σ = conversion(Ω⁻¹) of an edge, with every failure at the information's first number.
+/// (Σ = conversion(Ω⁻¹), Ω) of an edge or prior, with every failure at the information's
+/// first number.
 fn edge_cov<G: GraphGroup<N>, const N: usize>(
     locator: &Locator,
     r: &Record,
-) -> Result<TangentMatrix<N>, InputError> {
+) -> Result<(TangentMatrix<N>, TangentMatrix<N>), InputError> {
     let values: Vec<f64> = r.information.iter().map(|v| v.value).collect();
     let information: SMatrix<f64, N, N> = from_upper_triangle::<N>(&values);
     let at = r.information.first().map_or(r.at, |v| v.at);
@@ -113,7 +113,7 @@ fn edge_cov<G: GraphGroup<N>, const N: usize>(
             limits::MAX_VARIANCE
         )));
     }
-    Ok(cov)
+    Ok((cov, information))
 }
 
 fn build<G: GraphGroup<N>, const N: usize>(
@@ -122,7 +122,14 @@ fn build<G: GraphGroup<N>, const N: usize>(
 ) -> Result<Lowered, InputError> {
     let mut vertices: BTreeMap<u64, (G, usize)> = BTreeMap::new();
     let mut edges: Vec<Edge<G, N>> = Vec::new();
+    let mut priors: Vec<Prior<G, N>> = Vec::new();
+    // (id, offset of the id, line) of every FIX record's ids.
+    let mut fixes: Vec<(u64, usize, usize)> = Vec::new();
     for r in &records.records {
+        if r.tag.kind == Kind::Fix {
+            fixes.extend(r.ids.iter().map(|&(id, at)| (id, at, r.line)));
+            continue;
+        }
         let values: Vec<f64> = r.pose.iter().map(|v| v.value).collect();
         let pose_at = r.pose.first().map_or(r.at, |v| v.at);
         let pose = G::from_values(&values)
@@ -149,23 +156,41 @@ fn build<G: GraphGroup<N>, const N: usize>(
                         format!("an edge from vertex {from} to itself says nothing"),
                     ));
                 }
+                let (cov, information) = edge_cov::<G, N>(locator, r)?;
                 edges.push(Edge {
                     from,
                     to,
                     line: r.line,
                     measurement: pose,
-                    cov: edge_cov::<G, N>(locator, r)?,
+                    cov,
+                    information_g2o: G::information_from_g2o(&information),
+                    information_gtsam: information,
+                });
+            }
+            Kind::Prior | Kind::Fix => {
+                let (_, information) = edge_cov::<G, N>(locator, r)?;
+                priors.push(Prior {
+                    vertex: r.ids[0],
+                    line: r.line,
+                    measurement: pose,
+                    information_g2o: G::information_from_g2o(&information),
+                    information_gtsam: information,
                 });
             }
         }
     }
-    if vertices.is_empty() {
-        let r = &records.records[0];
-        return Err(locator.error(
-            r.at..r.at,
-            r.tag.name,
-            "the file has edges but no vertices: posecov draws the vertex estimates and starts the chain at the first one",
-        ));
+    let chained = vertices.is_empty();
+    if chained {
+        if edges.is_empty() {
+            let r = &records.records[0];
+            return Err(locator.error(
+                r.at..r.at,
+                r.tag.name,
+                "the file has no vertices and no edges: a pose graph needs VERTEX_SE2 / EDGE_SE2 or VERTEX_SE3:QUAT / EDGE_SE3:QUAT lines",
+            ));
+        }
+        // No VERTEX lines (M3500, CSAIL): the initial guess is chained from the edges.
+        vertices = chain_initial_guess(&edges);
     }
     if vertices.len() as u64 > limits::MAX_STEPS + 1 {
         return Err(locator.error(
@@ -197,7 +222,27 @@ fn build<G: GraphGroup<N>, const N: usize>(
             }
         }
     }
-    Ok(assemble(locator, records, &vertices, &edges))
+    let undefined = priors
+        .iter()
+        .map(|p| (p.vertex, p.line))
+        .chain(fixes.iter().map(|&(id, at, line)| ((id, at), line)))
+        .find(|((id, _), _)| !vertices.contains_key(id));
+    if let Some(((id, at), line)) = undefined {
+        let tag = records
+            .records
+            .iter()
+            .find(|r| r.line == line)
+            .map_or("record", |r| r.tag.name);
+        return Err(locator.error(
+            at..at,
+            tag,
+            format!("vertex {id} is not defined (no VERTEX line has id {id})"),
+        ));
+    }
+    let graph = pose_graph(&vertices, &edges, &priors, &fixes);
+    Ok(assemble(
+        locator, records, &vertices, &edges, graph, chained,
+    ))
 }
 
 /// Positions beyond [`limits::MAX_COORDINATE`] cannot be drawn.
@@ -305,6 +350,8 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
     records: &Records,
     vertices: &BTreeMap<u64, (G, usize)>,
     edges: &[Edge<G, N>],
+    graph: crate::plan::graph::PoseGraph<G, N>,
+    chained: bool,
 ) -> Lowered {
     let chain = chain(vertices, edges);
     let in_chain: BTreeSet<usize> = chain.iter().map(|c| c.0).collect();
@@ -324,12 +371,16 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
             .flat_map(|&i| [edges[i].from, edges[i].to]),
     );
 
-    let mut plan = Plan::<G, N>::default();
+    let mut plan = Plan::<G, N> {
+        graph: Some(graph),
+        ..Plan::default()
+    };
     let mut choices = DrawChoices {
         sample_axes: false,
         ..DrawChoices::default()
     };
-    choices.labels = drawn_ids.len() + drawn_loops.len() <= MAX_LABELLED;
+    // Labels are drawn where they do not collide, by draw::graph.
+    choices.labels = false;
     let mut operation_lines = Vec::new();
     for id in &drawn_ids {
         let name = vertex_name(*id);
@@ -421,7 +472,14 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
             summary.chain_edges,
             summary.loop_closures
         ),
-        description: describe(G::KIND.is_planar(), &summary, first, chain_end, records),
+        description: describe(
+            G::KIND.is_planar(),
+            &summary,
+            first,
+            chain_end,
+            records,
+            chained,
+        ),
         source: String::new(),
     };
     let input = Input {
@@ -436,7 +494,14 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
     (input, operation_lines, summary)
 }
 
-fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Records) -> String {
+fn describe(
+    planar: bool,
+    s: &Summary,
+    first: u64,
+    chain_end: u64,
+    records: &Records,
+    chained: bool,
+) -> String {
     let chain = if s.chain_edges == 0 {
         format!(
             "- **No odometry chain**: no edge joins v{first} to v{}, so nothing is propagated.\n",
@@ -505,6 +570,13 @@ fn describe(planar: bool, s: &Summary, first: u64, chain_end: u64, records: &Rec
             })
             .collect();
         d.push_str(&format!(" Largest: {}.\n", worst.join("; ")));
+    }
+    if chained {
+        d.push_str(
+            "\nThe file has no VERTEX lines: the estimates are chained from the edges (the \
+             odometry edges first, then the others, each placing a vertex not yet placed), as \
+             GTSAM's reader does.\n",
+        );
     }
     for (tag, n) in &records.skipped {
         d.push_str(&format!("\nSkipped {n} `{tag}` record(s) (not drawn).\n"));

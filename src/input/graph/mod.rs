@@ -32,6 +32,7 @@ pub mod bundled;
 pub mod convention;
 mod lower;
 pub mod parse;
+mod problem;
 
 pub use lower::MAX_LOOP_CLOSURES;
 

@@ -5,8 +5,11 @@
 //! information matrix's upper triangle (xx xy xθ yy yθ θθ), TORO's `EDGE2 i j x y θ` + the same
 //! 6 numbers in TORO's order (xx xy yy θθ xθ yθ; [`InformationOrder::Toro`]),
 //! `VERTEX_SE3:QUAT id x y z qx qy qz qw`, `EDGE_SE3:QUAT i j x y z qx qy qz qw` + 21 numbers
-//! (the upper triangle over (x, y, z, qx, qy, qz)). Other g2o records posecov does not draw
-//! (landmarks, `FIX`, parameters) are counted and skipped; any other first token is an error.
+//! (the upper triangle over (x, y, z, qx, qy, qz)); the priors `EDGE_PRIOR_SE2 id x y θ` + 6
+//! and `EDGE_SE3_PRIOR id param x y z qx qy qz qw` + 21 (g2o's `EdgeSE2Prior`,
+//! `EdgeSE3Prior`: `param` names a `PARAMS_SE3OFFSET`, read as the identity offset), and
+//! `FIX id …` (vertices held at their estimates). Other g2o records posecov does not draw
+//! (landmarks, parameters) are counted and skipped; any other first token is an error.
 
 use super::super::{InputError, Locator};
 
@@ -26,6 +29,11 @@ pub enum Kind {
     Vertex,
     /// An edge: two ids, measurement and information.
     Edge,
+    /// A prior on one vertex (g2o's `EDGE_PRIOR_SE2`; `EDGE_SE3_PRIOR` also names its offset
+    /// parameter): id, measurement and information.
+    Prior,
+    /// g2o's `FIX id …`: vertices held at their estimates.
+    Fix,
 }
 
 /// How an edge writes its information matrix's entries.
@@ -107,18 +115,35 @@ pub const TAGS: &[Tag] = &[
         dimension: Dimension::Spatial,
         order: InformationOrder::UpperTriangle,
     },
+    Tag {
+        name: "EDGE_PRIOR_SE2",
+        kind: Kind::Prior,
+        dimension: Dimension::Planar,
+        order: InformationOrder::UpperTriangle,
+    },
+    Tag {
+        name: "EDGE_SE3_PRIOR",
+        kind: Kind::Prior,
+        dimension: Dimension::Spatial,
+        order: InformationOrder::UpperTriangle,
+    },
 ];
+
+/// g2o's `FIX id …` record (either dimension).
+pub const FIX: Tag = Tag {
+    name: "FIX",
+    kind: Kind::Fix,
+    dimension: Dimension::Planar,
+    order: InformationOrder::UpperTriangle,
+};
 
 /// g2o records that are valid but not drawn: counted and skipped.
 pub const SKIPPED_TAGS: &[&str] = &[
-    "FIX",
     "VERTEX_XY",
     "EDGE_SE2_XY",
     "EDGE_BEARING_SE2_XY",
-    "EDGE_SE2_PRIOR",
     "VERTEX_TRACKXYZ",
     "EDGE_SE3_TRACKXYZ",
-    "EDGE_SE3_PRIOR",
     "PARAMS_SE3OFFSET",
     "VERTEX3",
     "EDGE3",
@@ -209,6 +234,11 @@ pub fn read_records(locator: &Locator) -> Result<Records, InputError> {
             continue;
         };
         let line = index + 1;
+        if tag_text == FIX.name {
+            out.records
+                .push(fix_record(locator, line, tag_at, &tokens[1..])?);
+            continue;
+        }
         let Some(tag) = TAGS.iter().find(|t| t.name == tag_text).copied() else {
             if SKIPPED_TAGS.contains(&tag_text) {
                 match out.skipped.iter_mut().find(|(t, _)| t == tag_text) {
@@ -306,20 +336,25 @@ fn record(
     at: usize,
     values: &[(&str, usize)],
 ) -> Result<Record, InputError> {
-    let id_count = match tag.kind {
-        Kind::Vertex => 1,
-        Kind::Edge => 2,
+    let id_count = match (tag.kind, tag.dimension) {
+        (Kind::Edge, _) | (Kind::Prior, Dimension::Spatial) => 2,
+        _ => 1,
     };
     let pose_names = pose_names(tag.dimension);
     let axes = information_axes(tag.dimension);
     let info_count = match tag.kind {
-        Kind::Vertex => 0,
-        Kind::Edge => axes.len() * (axes.len() + 1) / 2,
+        Kind::Vertex | Kind::Fix => 0,
+        Kind::Edge | Kind::Prior => axes.len() * (axes.len() + 1) / 2,
     };
     let expected = id_count + pose_names.len() + info_count;
     if values.len() != expected {
         let what = match tag.kind {
-            Kind::Vertex => format!("id {}", pose_names.join(" ")),
+            Kind::Vertex | Kind::Fix => format!("id {}", pose_names.join(" ")),
+            Kind::Prior => format!(
+                "id{} {} and the {info_count} numbers of the information matrix's upper triangle",
+                if id_count == 2 { " param" } else { "" },
+                pose_names.join(" ")
+            ),
             Kind::Edge => format!(
                 "i j {} and the {info_count} numbers of the information matrix{}",
                 pose_names.join(" "),
@@ -342,7 +377,8 @@ fn record(
     let mut ids = Vec::with_capacity(id_count);
     for (k, &(token, token_at)) in values[..id_count].iter().enumerate() {
         let name = match (tag.kind, k) {
-            (Kind::Vertex, _) => "id",
+            (Kind::Vertex | Kind::Fix, _) | (Kind::Prior, 0) => "id",
+            (Kind::Prior, _) => "param (offset parameter id)",
             (_, 0) => "i (from)",
             _ => "j (to)",
         };
@@ -394,5 +430,40 @@ fn record(
         ids,
         pose,
         information,
+    })
+}
+
+/// `FIX id …`: one or more vertex ids.
+fn fix_record(
+    locator: &Locator,
+    line: usize,
+    at: usize,
+    values: &[(&str, usize)],
+) -> Result<Record, InputError> {
+    if values.is_empty() {
+        return Err(locator.error(
+            at..at,
+            FIX.name,
+            "expected the ids of the vertices to hold fixed after FIX, found none",
+        ));
+    }
+    let mut ids = Vec::with_capacity(values.len());
+    for &(token, token_at) in values {
+        let id = token.parse::<u64>().map_err(|_| {
+            locator.error(
+                token_at..token_at,
+                FIX.name,
+                format!("id = `{token}` is not a vertex id (a whole number ≥ 0)"),
+            )
+        })?;
+        ids.push((id, token_at));
+    }
+    Ok(Record {
+        tag: FIX,
+        line,
+        at,
+        ids,
+        pose: Vec::new(),
+        information: Vec::new(),
     })
 }

@@ -1,0 +1,180 @@
+//! A graph evaluation as plain records for `report --json` (`optimized`).
+
+use crate::lie::{LieGroup, TangentMatrix};
+
+use super::{GraphEvaluation, GraphReading, Iteration, Optimizer, Part, Stop};
+
+/// One optimised pose.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PoseRecord {
+    /// The vertex id.
+    pub id: u64,
+    /// As g2o writes it: [x, y, θ] (2-D) or [x, y, z, qx, qy, qz, qw] (3-D).
+    pub pose: Vec<f64>,
+    /// The marginal covariance, posecov's right form [ρ; θ], row by row (`null`: held fixed,
+    /// isolated, or no marginals).
+    pub covariance: Option<Vec<Vec<f64>>>,
+}
+
+/// One loop closure.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LoopClosureRecord {
+    /// Vertex i.
+    pub from: u64,
+    /// Vertex j.
+    pub to: u64,
+    /// The edge's line.
+    pub line: usize,
+    /// r = Log(Z⁻¹ X_i⁻¹ X_j) at the optimised poses, [ρ; θ].
+    pub residual: Vec<f64>,
+    /// d = √(rᵀ Λ r) at the optimised poses.
+    pub mahalanobis: f64,
+    /// r at the file's estimates.
+    pub residual_before: Vec<f64>,
+    /// d at the file's estimates.
+    pub mahalanobis_before: f64,
+    /// √χ²_N(confidence).
+    pub radius: f64,
+    /// d > radius.
+    pub outlier: bool,
+    /// The covariance of X_i⁻¹ X_j from the joint marginal of the two poses (right form).
+    pub relative_covariance: Option<Vec<Vec<f64>>>,
+}
+
+/// `report --json`'s `optimized` object.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct OptimizedReport {
+    /// `levenberg_marquardt` or `gauss_newton`.
+    pub optimizer: Optimizer,
+    /// How the information matrices were read (`g2o` or `gtsam`).
+    pub reading: GraphReading,
+    /// Accepted steps.
+    pub iterations: usize,
+    /// Why it stopped.
+    pub stop: Stop,
+    /// Whether a stop criterion was met.
+    pub converged: bool,
+    /// χ² = Σ rᵀ Λ r over the edges and priors at the file's estimates (GTSAM's `error()`
+    /// is half of it).
+    pub chi2_before: f64,
+    /// χ² at the optimised poses.
+    pub chi2_after: f64,
+    /// The stop criteria: relative and absolute decrease of χ²/2, most iterations.
+    pub stop_criteria: StopCriteria,
+    /// Every step tried.
+    pub log: Vec<Iteration>,
+    /// The connected parts and their anchors.
+    pub parts: Vec<Part>,
+    /// Every vertex, optimised, with its marginal.
+    pub poses: Vec<PoseRecord>,
+    /// Every loop closure.
+    pub loop_closures: Vec<LoopClosureRecord>,
+    /// The confidence of `radius`.
+    pub confidence: f64,
+    /// χ² of each edge at the optimised poses, in file order.
+    pub edge_chi2: Vec<f64>,
+    /// Scalar unknowns.
+    pub unknowns: usize,
+    /// Non-zeros of the sparse Cholesky factor.
+    pub factor_nonzeros: usize,
+    /// Seconds to optimise and to compute every marginal.
+    pub seconds: Seconds,
+}
+
+/// The stop criteria used.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct StopCriteria {
+    /// Relative decrease of χ²/2.
+    pub relative: f64,
+    /// Absolute decrease of χ²/2.
+    pub absolute: f64,
+    /// Most iterations.
+    pub max_iterations: usize,
+}
+
+/// Timings.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Seconds {
+    /// The optimisation.
+    pub optimize: f64,
+    /// Every pose's marginal.
+    pub marginals: f64,
+}
+
+fn rows<const N: usize>(m: &TangentMatrix<N>) -> Vec<Vec<f64>> {
+    (0..N)
+        .map(|r| (0..N).map(|c| m[(r, c)]).collect())
+        .collect()
+}
+
+/// A pose as g2o writes it.
+fn g2o_values<G: LieGroup<N>, const N: usize>(x: &G) -> Vec<f64> {
+    let se3 = x.to_se3();
+    let t = se3.translation();
+    if G::KIND.is_planar() {
+        let r = se3.rotation().to_euler_zyx();
+        vec![t.x, t.y, r[0]]
+    } else {
+        let q = se3.rotation().to_quaternion_xyzw();
+        vec![t.x, t.y, t.z, q[0], q[1], q[2], q[3]]
+    }
+}
+
+impl<G: LieGroup<N>, const N: usize> GraphEvaluation<G, N> {
+    /// The plain records of `report --json`'s `optimized` object.
+    pub fn report(&self) -> OptimizedReport {
+        let s = &self.solution;
+        let defaults = super::SolverSettings::default();
+        OptimizedReport {
+            optimizer: s.optimizer,
+            reading: s.reading,
+            iterations: s.iterations,
+            stop: s.stop,
+            converged: s.converged(),
+            chi2_before: s.chi2_before,
+            chi2_after: s.chi2_after,
+            stop_criteria: StopCriteria {
+                relative: defaults.relative_tolerance,
+                absolute: defaults.absolute_tolerance,
+                max_iterations: defaults.max_iterations,
+            },
+            log: s.log.clone(),
+            parts: s.parts.clone(),
+            poses: self
+                .ids
+                .iter()
+                .zip(&s.poses)
+                .zip(&s.covariances)
+                .map(|((&id, x), cov)| PoseRecord {
+                    id,
+                    pose: g2o_values(x),
+                    covariance: cov.as_ref().map(rows),
+                })
+                .collect(),
+            loop_closures: self
+                .loop_closures
+                .iter()
+                .map(|l| LoopClosureRecord {
+                    from: l.from,
+                    to: l.to,
+                    line: l.line,
+                    residual: l.residual.iter().copied().collect(),
+                    mahalanobis: l.mahalanobis,
+                    residual_before: l.residual_before.iter().copied().collect(),
+                    mahalanobis_before: l.mahalanobis_before,
+                    radius: self.radius,
+                    outlier: l.mahalanobis > self.radius,
+                    relative_covariance: l.relative_cov.as_ref().map(rows),
+                })
+                .collect(),
+            confidence: self.confidence,
+            edge_chi2: self.edge_chi2.clone(),
+            unknowns: s.unknowns,
+            factor_nonzeros: s.factor_nonzeros,
+            seconds: Seconds {
+                optimize: s.optimize_seconds,
+                marginals: s.marginals_seconds,
+            },
+        }
+    }
+}

@@ -1,0 +1,183 @@
+//! A pose graph as the evaluation receives it: vertices with their initial estimates, relative
+//! measurements (edges) and absolute ones (priors), each with its information matrix in
+//! posecov's right form [ρ; θ], and the vertices the file holds fixed. Plain data: the reading
+//! of a file's numbers (g2o's or GTSAM's, [CONVENTIONS §10]) is done by `input::graph`;
+//! [`crate::eval::graph`] optimises it and computes the marginals.
+//!
+//! An edge i → j with measurement Z and information Λ says X_j = X_i · Z · Exp(ξ),
+//! ξ ~ N(0, Λ⁻¹): its residual is r = Log(Z⁻¹ · X_i⁻¹ · X_j) and its cost rᵀ Λ r. A prior on
+//! vertex i says X_i = Z · Exp(ξ): r = Log(Z⁻¹ · X_i).
+//!
+//! ```
+//! use posecov::lie::{LieGroup, Se2};
+//! use posecov::plan::graph::{GraphEdge, GraphVertex, PoseGraph};
+//! let mut graph = PoseGraph::<Se2, 3>::default();
+//! graph.vertices.push(GraphVertex { id: 0, estimate: Se2::identity(), line: 1 });
+//! graph.vertices.push(GraphVertex { id: 1, estimate: Se2::from_xy_theta(1.0, 0.0, 0.0), line: 2 });
+//! graph.edges.push(GraphEdge { from: 0, to: 1, measurement: Se2::from_xy_theta(1.0, 0.0, 0.0),
+//!     information: nalgebra::Matrix3::identity() * 100.0, information_gtsam: nalgebra::Matrix3::identity() * 100.0, line: 3 });
+//! assert_eq!(graph.chi2(&[Se2::identity(), Se2::from_xy_theta(1.0, 0.0, 0.0)], false), 0.0);
+//! ```
+//!
+//! [CONVENTIONS §10]: crate::conventions#10-pose-graphs-g2o-and-gtsam
+
+use crate::lie::{LieGroup, TangentMatrix};
+
+/// A vertex: its id in the file and the file's estimate (the optimiser's initial guess).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GraphVertex<G> {
+    /// The file's vertex id.
+    pub id: u64,
+    /// The initial estimate (the file's, or chained from the edges when the file has none).
+    pub estimate: G,
+    /// The vertex's line (0 when the estimate was chained from the edges).
+    pub line: usize,
+}
+
+/// A relative measurement between two vertices (indices into [`PoseGraph::vertices`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GraphEdge<G: LieGroup<N>, const N: usize> {
+    /// Index of vertex i.
+    pub from: usize,
+    /// Index of vertex j.
+    pub to: usize,
+    /// Z, with X_j ≈ X_i · Z.
+    pub measurement: G,
+    /// Λ over [ρ; θ] as g2o defines the file's numbers (for `EDGE_SE3:QUAT`, the half-angle
+    /// factor applied: Λ = D⁻¹ Ω D⁻¹, D = diag(1, 1, 1, 2, 2, 2)).
+    pub information: TangentMatrix<N>,
+    /// Λ over [ρ; θ] as GTSAM's `readG2o` reads the same numbers (no half-angle factor; in
+    /// 2-D the same as `information`).
+    pub information_gtsam: TangentMatrix<N>,
+    /// The edge's line.
+    pub line: usize,
+}
+
+/// An absolute measurement of one vertex (g2o's `EDGE_PRIOR_SE2`, `EDGE_SE3_PRIOR`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GraphPrior<G: LieGroup<N>, const N: usize> {
+    /// Index of the vertex.
+    pub vertex: usize,
+    /// Z, with X ≈ Z.
+    pub measurement: G,
+    /// Λ over [ρ; θ], g2o's reading (see [`GraphEdge::information`]).
+    pub information: TangentMatrix<N>,
+    /// Λ over [ρ; θ], GTSAM's reading.
+    pub information_gtsam: TangentMatrix<N>,
+    /// The prior's line.
+    pub line: usize,
+}
+
+/// A pose graph (see the [module docs](self)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseGraph<G: LieGroup<N>, const N: usize> {
+    /// Vertices, in increasing id order.
+    pub vertices: Vec<GraphVertex<G>>,
+    /// Edges in file order.
+    pub edges: Vec<GraphEdge<G, N>>,
+    /// Priors in file order.
+    pub priors: Vec<GraphPrior<G, N>>,
+    /// Vertices (indices) the file holds fixed (g2o's `FIX id`), with the record's line.
+    pub fixed: Vec<(usize, usize)>,
+}
+
+impl<G: LieGroup<N>, const N: usize> Default for PoseGraph<G, N> {
+    fn default() -> Self {
+        Self {
+            vertices: Vec::new(),
+            edges: Vec::new(),
+            priors: Vec::new(),
+            fixed: Vec::new(),
+        }
+    }
+}
+
+impl<G: LieGroup<N>, const N: usize> GraphEdge<G, N> {
+    /// r = Log(Z⁻¹ · X_i⁻¹ · X_j), the edge's residual at `poses` ([ρ; θ]).
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::plan::graph::GraphEdge;
+    /// let z = Se2::from_xy_theta(1.0, 0.0, 0.0);
+    /// let e = GraphEdge { from: 0, to: 1, measurement: z, information: nalgebra::Matrix3::identity(), information_gtsam: nalgebra::Matrix3::identity(), line: 1 };
+    /// let r = e.residual(&[Se2::identity(), Se2::from_xy_theta(1.0, 0.5, 0.0)]);
+    /// assert!((r - nalgebra::Vector3::new(0.0, 0.5, 0.0)).norm() < 1e-12);
+    /// ```
+    pub fn residual(&self, poses: &[G]) -> crate::lie::Tangent<N> {
+        self.measurement
+            .inverse()
+            .compose(&poses[self.from].inverse().compose(&poses[self.to]))
+            .log()
+    }
+
+    /// Λ in the chosen reading (`gtsam`: GTSAM's `readG2o`).
+    pub fn information_in(&self, gtsam: bool) -> &TangentMatrix<N> {
+        if gtsam {
+            &self.information_gtsam
+        } else {
+            &self.information
+        }
+    }
+}
+
+impl<G: LieGroup<N>, const N: usize> GraphPrior<G, N> {
+    /// r = Log(Z⁻¹ · X), the prior's residual at `poses`.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::plan::graph::GraphPrior;
+    /// let p = GraphPrior { vertex: 0, measurement: Se2::identity(), information: nalgebra::Matrix3::identity(), information_gtsam: nalgebra::Matrix3::identity(), line: 1 };
+    /// assert!((p.residual(&[Se2::from_xy_theta(0.0, 0.0, 0.1)])[2] - 0.1).abs() < 1e-15);
+    /// ```
+    pub fn residual(&self, poses: &[G]) -> crate::lie::Tangent<N> {
+        self.measurement
+            .inverse()
+            .compose(&poses[self.vertex])
+            .log()
+    }
+
+    /// Λ in the chosen reading (`gtsam`: GTSAM's `readG2o`).
+    pub fn information_in(&self, gtsam: bool) -> &TangentMatrix<N> {
+        if gtsam {
+            &self.information_gtsam
+        } else {
+            &self.information
+        }
+    }
+}
+
+impl<G: LieGroup<N>, const N: usize> PoseGraph<G, N> {
+    /// χ² = Σ rᵀ Λ r over the edges and priors at `poses` (one per vertex); GTSAM's
+    /// `graph.error(values)` is half of it. `gtsam` picks GTSAM's reading of Λ.
+    ///
+    /// See the [module docs](self) for an example.
+    pub fn chi2(&self, poses: &[G], gtsam: bool) -> f64 {
+        let edges: f64 = self
+            .edges
+            .iter()
+            .map(|e| {
+                let r = e.residual(poses);
+                (r.transpose() * e.information_in(gtsam) * r)[(0, 0)]
+            })
+            .sum();
+        let priors: f64 = self
+            .priors
+            .iter()
+            .map(|p| {
+                let r = p.residual(poses);
+                (r.transpose() * p.information_in(gtsam) * r)[(0, 0)]
+            })
+            .sum();
+        edges + priors
+    }
+
+    /// The initial estimates, one per vertex.
+    ///
+    /// ```
+    /// let g = posecov::plan::graph::PoseGraph::<posecov::lie::Se2, 3>::default();
+    /// assert!(g.estimates().is_empty());
+    /// ```
+    pub fn estimates(&self) -> Vec<G> {
+        self.vertices.iter().map(|v| v.estimate).collect()
+    }
+}
