@@ -57,9 +57,33 @@ enum Command {
         #[command(flatten)]
         scenario: ScenarioArgs,
     },
+    /// Write a static figure (SVG, PNG or PDF, by the extension of -o) drawn by posecov itself:
+    /// the plane projection of every cloud, region, ellipse and frame, every step at once,
+    /// with a legend, axes in metres, a scale bar and the scenario's plots.
+    Figure(FigureArgs),
     /// Show a scenario with a control page beside the viewer: every pose, noise and setting
     /// as a slider; each change re-evaluates and re-streams in place.
     Live(LiveArgs),
+}
+
+/// Options of `posecov figure`.
+#[derive(Debug, Args)]
+struct FigureArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// The figure file: .svg, .png or .pdf.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg|png|pdf")]
+    output: PathBuf,
+    /// Size in pixels (points for PDF), WIDTHxHEIGHT.
+    #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = parse_size)]
+    size: (u32, u32),
+    /// The plane the world is projected on: xy (from above), xz or yz.
+    #[arg(long, default_value = "xy")]
+    plane: posecov::sink::figure::Plane,
+    /// Which steps of a propagation: `all` at once (numbered), or one step K as the viewer
+    /// shows it there.
+    #[arg(long, value_name = "K|all", default_value = "all")]
+    step: posecov::sink::figure::Steps,
 }
 
 /// Options of `posecov live`.
@@ -357,6 +381,21 @@ fn try_main() -> anyhow::Result<ExitCode> {
         )?),
         Some(Command::Check { scenario }) => {
             emit(&(commands::check(scenario.scenario(), &scenario.overrides())? + "\n"))
+        }
+        Some(Command::Figure(args)) => {
+            let options = posecov::sink::figure::FigureOptions {
+                size: args.size,
+                plane: args.plane,
+                steps: args.step,
+            };
+            posecov::app::figure::figure(
+                args.scenario.scenario(),
+                &args.scenario.overrides(),
+                &options,
+                &args.output,
+            )?;
+            eprintln!("Wrote {}", args.output.display());
+            Ok(ExitCode::SUCCESS)
         }
         Some(Command::Live(args)) => {
             let cancel = install_ctrl_c()?;

@@ -24,6 +24,8 @@ use crate::scene::{Scene, SceneError};
 
 pub mod bag;
 pub mod commands;
+#[cfg(feature = "viewer")]
+pub mod figure;
 pub mod live;
 pub mod run;
 #[cfg(feature = "viewer")]
@@ -57,6 +59,10 @@ pub enum AppError {
     #[cfg(feature = "viewer")]
     #[error(transparent)]
     Sink(#[from] crate::sink::SinkError),
+    /// A figure could not be written.
+    #[cfg(feature = "viewer")]
+    #[error(transparent)]
+    Figure(#[from] crate::sink::figure::FigureError),
     /// `--watch` was given something it cannot watch or a sink it cannot rewrite.
     #[error("--watch {0}")]
     Watch(String),

@@ -37,18 +37,25 @@ use crate::lie::{GroupKind, LieGroup, Se3};
 use crate::plan::StepPolicy;
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, Scene,
-    SceneItem, Timing, Triads, Vec3,
+    SceneItem, Swatch, Timing, Triads, Vec3,
 };
 use crate::uncertain::Method;
 
 pub mod bag;
+<<<<<<< HEAD
 mod graph;
+=======
+mod legend;
+>>>>>>> d2ef265 (figure: posecov figure NAME -o OUT.svg|png|pdf draws static figures in pure Rust (sink/figure: SVG written directly, PNG by resvg, PDF by svg2pdf, bundled Liberation Sans OFL): plane projection of clouds, Exp-mapped regions (union of projected triangles), ellipsoid shadows, frames; every step at once numbered (long propagations thinned to 12 detailed steps) or --step K as the viewer shows it; legend with swatches (Scene::legend, filled in draw/), axes in metres, grid spacing and scale bar, confidence, plots with their own legends; same seed same bytes (PDF resource order sorted); docs/gallery from examples/gallery.rs and the README gallery from it; the vector-space ellipse that coincides with a first-order Cartesian one is said (legend, text panel); bundled descriptions state no number the run computes (Barfoot's 1.68/1.69, 15-25 %, 33 % removed), with a test)
 mod plots;
 mod shapes;
 mod text;
 mod views;
 
 use shapes::chi2_radius;
+
+/// Colour of the Monte Carlo heading arrows of planar poses (light red).
+const HEADING_COLOR: Color = Color::rgb(255, 120, 120);
 
 /// At most this many Monte Carlo particles get a small axis triad.
 const TRIAD_SUBSAMPLE: usize = 60;
@@ -247,6 +254,11 @@ impl<'s> Painter<'s> {
         self.settings.confidence
     }
 
+    /// Adds a legend entry (once per label and colour).
+    fn legend(&mut self, label: String, color: Color, swatch: Swatch) {
+        self.scene.add_legend(legend::entry(label, color, swatch));
+    }
+
     /// Whether a node's step is drawn in full (clouds, surfaces), not only its ellipsoid.
     fn detailed<G: LieGroup<N>, const N: usize>(&self, node: &Node<G, N>) -> bool {
         node.step
@@ -261,6 +273,7 @@ impl<'s> Painter<'s> {
 
 fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSettings) -> Scene {
     let mut p = Painter::new(e, settings, text::description(e, settings));
+    p.scene.confidence = Some(settings.confidence);
     let choices = &settings.choices;
     p.scene.planar = choices.top_view.unwrap_or(G::KIND.is_planar());
     let shown = Shown::new(e, choices);
@@ -290,13 +303,19 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     if choices.trajectories {
         let radius = 0.004 * p.extent.max(0.25);
         for path in &e.paths {
-            let (name, color) = match path.kind {
-                PathKind::Nominal => (format!("world/{}/nominal", path.output), scene::NOMINAL),
+            let (name, color, what) = match path.kind {
+                PathKind::Nominal => (
+                    format!("world/{}/nominal", path.output),
+                    scene::NOMINAL,
+                    "nominal path",
+                ),
                 PathKind::Sample(i) => (
                     format!("world/{}/samples/{i}", path.output),
                     Method::MonteCarlo.color(),
+                    "Monte Carlo sample paths",
                 ),
             };
+            p.legend(what.to_owned(), color, Swatch::Line);
             let strip: Vec<Vec3> = path
                 .poses
                 .iter()
@@ -319,6 +338,15 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     }
     for point in &e.points {
         for (method, mean, cov) in &point.estimates {
+            p.legend(
+                format!(
+                    "{}: {} ellipsoid of the point",
+                    method.label(),
+                    legend::percent(p.confidence())
+                ),
+                method.color(),
+                Swatch::Dashed,
+            );
             let shape = shapes::ellipsoid_of(mean, cov, chi2_radius(p.confidence(), 3));
             p.push(
                 format!("world/{}/{}/ellipsoid", point.name, method.slug()),
@@ -333,6 +361,11 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
             );
         }
         if let (Some(particles), true) = (&point.particles, choices.clouds) {
+            p.legend(
+                format!("Monte Carlo points ({})", particles.len()),
+                Method::MonteCarlo.color(),
+                Swatch::Dots,
+            );
             p.push(
                 format!("world/{}/monte_carlo/cloud", point.name),
                 None,
@@ -354,6 +387,8 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         if !settings.steps.detailed(frame.step, last) {
             continue;
         }
+        p.scene
+            .add_legend(legend::axes("Euler-angle frame (rotation matrix columns)"));
         for (k, color) in shapes::AXIS_COLORS.iter().enumerate() {
             let c = frame.columns.column(k);
             p.push(
@@ -406,6 +441,7 @@ fn links<G: LieGroup<N>, const N: usize>(p: &mut Painter, e: &Evaluation<G, N>) 
         .filter_map(|(a, b)| Some(vec![position(a)?, position(b)?]))
         .collect();
     if !strips.is_empty() {
+        p.legend("links between poses".to_owned(), scene::LINK, Swatch::Line);
         p.push(
             "world/links".to_owned(),
             None,
@@ -488,6 +524,7 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
     );
     let pose3 = node.nominal.to_se3();
     if axes {
+        p.scene.add_legend(legend::axes("pose frames"));
         p.push(
             format!("world/{}/frame", node.name),
             node.step,
@@ -514,6 +551,8 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
             && ellipsoids
             && !rotation_only
         {
+            let who = e.result.method.label().to_owned();
+            cartesian_legend(p, who, e.result.method);
             shapes::position_ellipsoid(
                 p,
                 &format!("world/{}/{}", node.name, e.result.method.slug()),
@@ -532,6 +571,8 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
         .iter()
         .find(|e| Some(e.result.method) == primary)
         .map(|e| e.result.pose.side());
+    // The Cartesian ellipses drawn for this pose: (method, who, centre, covariance).
+    let mut cartesian: Vec<(Method, String, Vec3, nalgebra::Matrix3<f64>)> = Vec::new();
     for estimate in &node.estimates {
         let pose = side.map_or(estimate.result.pose, |s| estimate.result.pose.to_side(s));
         let method = estimate.result.method;
@@ -562,14 +603,31 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
         let color = method.color();
         // The Cartesian ellipsoid: the primary method's (to contrast with its banana) and the
         // vector-space baseline's (a Gaussian in (x, y, θ) is exactly that ellipse).
+        let who = legend::who(segment, method.label());
         if !rotation_only && ellipsoids && (is_primary || method == Method::VectorSpace) {
+            cartesian_legend(p, who.clone(), method);
+            if let Some(cov) = pose.position_cov_in_world_3d() {
+                let centre = v3(pose.mean().to_se3().translation());
+                cartesian.push((method, who.clone(), centre, cov));
+            }
             shapes::position_ellipsoid(p, &base, node.step, &pose, color);
         }
+        let region = legend::percent(p.confidence());
         if bananas && !rotation_only && method != Method::VectorSpace {
             let point_of = |x: &G| *x.to_se3().translation();
             if is_primary || p.layout == Layout::PerMethod {
+                p.legend(
+                    format!("{who}: Exp-mapped {region} region"),
+                    color,
+                    Swatch::Region,
+                );
                 shapes::banana(p, &base, node.step, &pose, color, point_of);
             } else {
+                p.legend(
+                    format!("{who}: Exp-mapped {region} region, principal outlines"),
+                    color,
+                    Swatch::Line,
+                );
                 shapes::outlines(
                     p,
                     &format!("{base}/banana_outline"),
@@ -581,6 +639,11 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
             }
         }
         if orientation && rotation_only {
+            p.legend(
+                format!("{who}: {region} region of each axis tip"),
+                color,
+                Swatch::Line,
+            );
             for (k, axis) in ["axis_x", "axis_y", "axis_z"].iter().enumerate() {
                 let len = p.axis_length;
                 let path = format!("{base}/{axis}");
@@ -591,8 +654,47 @@ fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>)
             }
         }
     }
+    coinciding(p, &node.name, &cartesian);
     if let Some(particles) = &node.particles {
         draw_particles(p, node, particles, None);
+    }
+}
+
+/// Says when the vector-space ellipse and another method's Cartesian ellipse of one pose are
+/// the same (same centre and matrix to 1e-9 relative): one hides the other exactly, and a
+/// reader would conclude the hidden one is missing. Once per pose name, in the legend and the
+/// text panel.
+fn coinciding(
+    p: &mut Painter,
+    pose: &str,
+    drawn: &[(Method, String, Vec3, nalgebra::Matrix3<f64>)],
+) {
+    let Some((_, _, c0, m0)) = drawn.iter().find(|d| d.0 == Method::VectorSpace) else {
+        return;
+    };
+    for (method, who, c, m) in drawn.iter().filter(|d| d.0 != Method::VectorSpace) {
+        let scale = m0.amax().max(f64::MIN_POSITIVE);
+        let same_matrix = (m - m0).amax() <= 1e-9 * scale;
+        let same_centre = (0..3).all(|k| (c[k] - c0[k]).abs() <= 1e-9 * (1.0 + c0[k].abs()));
+        if !(same_matrix && same_centre) {
+            continue;
+        }
+        let region = legend::percent(p.confidence());
+        p.legend(
+            format!(
+                "{who}: Cartesian {region} ellipse = the vector-space one here (same matrix; drawn under it)"
+            ),
+            method.color(),
+            Swatch::Dashed,
+        );
+        let sentence = format!(
+            "**{pose}:** the vector-space ellipse ({}) coincides with the {who} Cartesian one ({}) here: same matrix, so only one line shows.\n\n",
+            Method::VectorSpace.color_name(),
+            method.color_name()
+        );
+        if !p.scene.description_markdown.contains(&sentence) {
+            p.scene.description_markdown.push_str(&sentence);
+        }
     }
 }
 
@@ -609,6 +711,11 @@ fn draw_particles<G: LieGroup<N>, const N: usize>(
     let poses: Vec<Se3> = particles.iter().map(LieGroup::to_se3).collect();
     let rotation_only = p.kind.is_rotation_only();
     if choices.clouds && !rotation_only {
+        p.legend(
+            format!("Monte Carlo samples ({})", particles.len()),
+            Method::MonteCarlo.color(),
+            Swatch::Dots,
+        );
         p.push(
             format!("{base}/cloud{suffix}"),
             node.step,
@@ -625,6 +732,11 @@ fn draw_particles<G: LieGroup<N>, const N: usize>(
         // Triads and headings are a subsample, drawn once from the first block.
     } else if p.kind == GroupKind::Se2 {
         // Planar poses: a heading arrow per subsampled particle (a z axis would only clutter).
+        p.legend(
+            "Monte Carlo headings (a subsample)".to_owned(),
+            HEADING_COLOR,
+            Swatch::Line,
+        );
         p.push(
             format!("{base}/headings"),
             node.step,
@@ -634,11 +746,13 @@ fn draw_particles<G: LieGroup<N>, const N: usize>(
                     .iter()
                     .map(|x| v3(&x.rotation().act(&(Vector3::x() * 0.35 * p.axis_length))))
                     .collect(),
-                color: Color::rgb(255, 120, 120).with_alpha(200),
+                color: HEADING_COLOR.with_alpha(200),
                 radius: 0.0015 * p.axis_length / 0.15,
             }),
         );
     } else {
+        p.scene
+            .add_legend(legend::axes("Monte Carlo samples' axes (a subsample)"));
         p.push(
             format!("{base}/triads"),
             node.step,
@@ -654,6 +768,7 @@ fn draw_particles<G: LieGroup<N>, const N: usize>(
         );
     }
     if choices.orientation && (rotation_only || p.kind == GroupKind::Se3) {
+        p.scene.add_legend(legend::axes("Monte Carlo axis tips"));
         for (k, name) in ["spray_x", "spray_y", "spray_z"].iter().enumerate() {
             let tips = poses
                 .iter()
@@ -673,4 +788,16 @@ fn draw_particles<G: LieGroup<N>, const N: usize>(
             );
         }
     }
+}
+
+/// The legend entry of a method's Cartesian position ellipse (the vector-space baseline's is
+/// its whole Gaussian in (x, y[, z])).
+fn cartesian_legend(p: &mut Painter, who: String, method: Method) {
+    let region = legend::percent(p.confidence());
+    let label = if method == Method::VectorSpace {
+        format!("{who}: {region} ellipse")
+    } else {
+        format!("{who}: Cartesian {region} ellipse (first-order position)")
+    };
+    p.legend(label, method.color(), Swatch::Dashed);
 }

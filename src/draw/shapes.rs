@@ -18,12 +18,8 @@ const OUTLINE_POINTS: usize = 96;
 /// of freedom of a drawn region.
 const RANK_TOLERANCE: f64 = 1e-9;
 
-/// Colours of the x, y, z axes.
-pub(super) const AXIS_COLORS: [Color; 3] = [
-    Color::rgb(255, 90, 90),
-    Color::rgb(90, 220, 90),
-    Color::rgb(100, 140, 255),
-];
+/// Colours of the x, y, z axes ([`scene::AXIS_COLORS`]).
+pub(super) use crate::scene::AXIS_COLORS;
 
 /// The Mahalanobis radius of a p-confidence region in d dimensions,
 /// [`uncertain::chi2_radius`](crate::uncertain::chi2_radius) (the confidence is validated

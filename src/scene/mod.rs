@@ -42,7 +42,7 @@ mod validate;
 mod view;
 
 pub use mesh::unit_sphere_mesh;
-pub use palette::{LINK, NOMINAL, REFERENCE};
+pub use palette::{AXIS_COLORS, LINK, NOMINAL, REFERENCE};
 pub use view::{Camera, View3d, grid_columns, rotate};
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
@@ -352,6 +352,32 @@ pub struct ScalarSeries {
     pub points: Vec<(i64, f64)>,
 }
 
+/// How a legend entry's swatch is drawn: the same mark as the thing it names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Swatch {
+    /// A filled patch: a region (an Exp-mapped banana surface).
+    Region,
+    /// A solid line: an outline, a path or a plot line.
+    Line,
+    /// A dashed line: a Cartesian (first-order position) ellipse.
+    Dashed,
+    /// A few dots: a sample cloud.
+    Dots,
+    /// An x/y/z axis triad in red, green and blue (the colour is not used).
+    Axes,
+}
+
+/// One line of a scene's legend: a swatch in the colour of what it names, and words.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LegendEntry {
+    /// What is drawn in this colour, e.g. "first order: Exp-mapped 95 % region".
+    pub label: String,
+    /// The colour (opaque; sinks choose their own transparency).
+    pub color: Color,
+    /// The mark of the swatch.
+    pub swatch: Swatch,
+}
+
 /// Everything one scenario draws.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Scene {
@@ -373,6 +399,10 @@ pub struct Scene {
     /// The 3-D views, each with its camera; empty: one view of the whole world, framed by the
     /// viewer.
     pub views: Vec<View3d>,
+    /// What each colour and mark means, in drawing order (one entry per label).
+    pub legend: Vec<LegendEntry>,
+    /// The probability inside every drawn region, if the scene draws regions.
+    pub confidence: Option<f64>,
 }
 
 impl Scene {
@@ -392,6 +422,28 @@ impl Scene {
             planar: false,
             timeline: Timeline::Step,
             views: Vec::new(),
+            legend: Vec::new(),
+            confidence: None,
+        }
+    }
+
+    /// Adds a legend entry unless one with the same label and colour is there already.
+    ///
+    /// ```
+    /// use posecov::scene::{Color, LegendEntry, Scene, Swatch};
+    /// let mut scene = Scene::new("t", "");
+    /// let entry = LegendEntry { label: "nominal path".into(), color: Color::rgb(0, 0, 255), swatch: Swatch::Line };
+    /// scene.add_legend(entry.clone());
+    /// scene.add_legend(entry);
+    /// assert_eq!(scene.legend.len(), 1);
+    /// ```
+    pub fn add_legend(&mut self, entry: LegendEntry) {
+        if !self
+            .legend
+            .iter()
+            .any(|e| e.label == entry.label && e.color == entry.color)
+        {
+            self.legend.push(entry);
         }
     }
 

@@ -10,6 +10,13 @@ use crate::uncertain::Method;
 /// Colour of nominal (noise-free) poses and paths: Okabe–Ito blue, readable on the viewer's
 /// dark and light themes.
 pub const NOMINAL: Color = Color::rgb(0, 114, 178);
+/// Colours of the x, y and z axes of every drawn frame, triad and axis-tip spray: red, green,
+/// blue (the light shades that read on the viewer's dark background and on paper).
+pub const AXIS_COLORS: [Color; 3] = [
+    Color::rgb(255, 90, 90),
+    Color::rgb(90, 220, 90),
+    Color::rgb(100, 140, 255),
+];
 /// Lines between poses (a pose graph's loop closures): neutral grey.
 pub const LINK: Color = Color::rgb(110, 110, 110);
 /// What a plot's lines are judged against (the confidence claimed, a χ² band): Okabe–Ito

@@ -8,6 +8,7 @@
 //! - [`restream`]: logging a new scene in place of the last one in the same recording (live
 //!   mode, `--watch`), leaving nothing stale.
 //! - [`viewer`]: finding a native `rerun` 0.36 viewer and rendering PNGs with it.
+//! - [`figure`]: static figures (SVG, PNG, PDF) drawn by posecov itself, no viewer needed.
 //!
 //! # Deterministic content
 //! For a given scene, every run writes the same *content*: the recording id is derived from
@@ -29,6 +30,7 @@
 //! ```
 
 pub mod blueprint;
+pub mod figure;
 pub mod rerun;
 pub mod restream;
 pub mod stream;

@@ -1,0 +1,516 @@
+//! Static figures of a [`Scene`] for slides, papers and notebooks: SVG written directly, PNG
+//! rendered from it by resvg, PDF converted from it by svg2pdf — pure Rust, no viewer, no
+//! system library, text in the bundled Liberation Sans (SIL OFL 1.1, `assets/fonts/`).
+//!
+//! A figure is the scene projected orthographically on a coordinate [`Plane`], at equal scale
+//! on both axes, with every step of a propagation at once ([`Steps::All`], each step's frame
+//! numbered) or the state at one step ([`Steps::At`], what the viewer shows with its time
+//! cursor there). Around it: the title, the confidence of every drawn region, axes in metres
+//! with a grid whose spacing is stated and a scale bar, the legend with colour swatches
+//! ([`Scene::legend`]) and the scene's plots against step or time.
+//!
+//! The same scene gives the same bytes (every number is rounded to 0.01 px and written in
+//! order; PNG and PDF are rendered from that text).
+//!
+//! ```
+//! use posecov::app::{Overrides, load, pipeline};
+//! use posecov::sink::figure::{FigureOptions, svg};
+//! let loaded = load("camera_on_robot").unwrap();
+//! let (_, scene) = pipeline(&loaded, &Overrides { samples: Some(200), ..Default::default() }, None).unwrap();
+//! let text = svg(&scene, &FigureOptions::default());
+//! assert!(text.starts_with("<svg") && text.contains("class=\"legend\""));
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use crate::scene::{ItemKind, Scene, SceneItem, Timeline, Timing};
+
+pub mod chart;
+mod raster;
+pub mod svg;
+pub mod world;
+
+pub use world::Plane;
+
+use chart::{Axes, PlotPanel, Rect};
+use svg::{Anchor, Svg};
+use world::{Mapping, Pen};
+
+/// Which steps of a propagation a figure draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Steps {
+    /// Every step at once, each step's frame labelled with its number.
+    #[default]
+    All,
+    /// The state at this step: per entity, its latest item at or before it (static items
+    /// always), as the viewer shows it with the time cursor there.
+    At(i64),
+}
+
+impl std::str::FromStr for Steps {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s == "all" {
+            return Ok(Self::All);
+        }
+        s.parse::<i64>()
+            .ok()
+            .filter(|k| *k >= 0)
+            .map(Self::At)
+            .ok_or_else(|| format!("{s:?} is not a step: give a step number (0, 1, …) or `all`"))
+    }
+}
+
+/// How a figure is drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FigureOptions {
+    /// Width and height in pixels (SVG and PNG) or points (PDF).
+    pub size: (u32, u32),
+    /// The plane the world is projected on.
+    pub plane: Plane,
+    /// Which steps are drawn.
+    pub steps: Steps,
+}
+
+impl Default for FigureOptions {
+    /// 1280 × 800 (16:10 slides), the x–y plane, every step.
+    fn default() -> Self {
+        Self {
+            size: (1280, 800),
+            plane: Plane::Xy,
+            steps: Steps::All,
+        }
+    }
+}
+
+/// A figure's file format, chosen by the output's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FigureFormat {
+    /// `.svg`: the figure as written.
+    Svg,
+    /// `.png`: rendered by resvg, one pixel per SVG pixel.
+    Png,
+    /// `.pdf`: vector, converted by svg2pdf (text embedded as a font subset).
+    Pdf,
+}
+
+impl FigureFormat {
+    /// The format of `path`'s extension (`.svg`, `.png`, `.pdf`, any case).
+    ///
+    /// # Errors
+    /// [`FigureError::Extension`] for anything else.
+    ///
+    /// ```
+    /// use posecov::sink::figure::FigureFormat;
+    /// assert_eq!(FigureFormat::of(std::path::Path::new("a/b.PNG")).unwrap(), FigureFormat::Png);
+    /// assert!(FigureFormat::of(std::path::Path::new("b.jpg")).is_err());
+    /// ```
+    pub fn of(path: &Path) -> Result<Self, FigureError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("svg") => Ok(Self::Svg),
+            Some("png") => Ok(Self::Png),
+            Some("pdf") => Ok(Self::Pdf),
+            _ => Err(FigureError::Extension(path.to_owned())),
+        }
+    }
+}
+
+/// Why a figure could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum FigureError {
+    /// The output's extension names no figure format.
+    #[error("-o {}: a figure is written as .svg, .png or .pdf (by the file's extension)", .0.display())]
+    Extension(PathBuf),
+    /// The SVG could not be rendered (a bug: posecov wrote it).
+    #[error("rendering the figure: {0}")]
+    Render(String),
+    /// This build has no PNG/PDF renderer.
+    #[error("this posecov was built without the `figure` feature: write an .svg")]
+    NoRenderer,
+    /// Writing the file failed.
+    #[error("writing {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+/// The figure as SVG text. See the [module docs](self).
+pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
+    let (w, h) = (f64::from(options.size.0), f64::from(options.size.1));
+    let pen = Pen {
+        unit: (w.min(h) / 800.0).max(0.6),
+        font: (w.min(h) / 800.0 * 15.0).clamp(8.0, 40.0),
+    };
+    let f = pen.font;
+    let mut out = Svg::new(options.size.0, options.size.1);
+    let items = selected(scene, options.steps);
+    // Title and what the figure shows.
+    out.text(
+        [0.8 * f, 1.9 * f],
+        1.5 * f,
+        Anchor::Start,
+        "#000",
+        &scene.title,
+    );
+    let (right, up) = options.plane.names();
+    let mut about = vec![format!("{right}–{up} plane")];
+    if let Some(p) = scene.confidence {
+        about.insert(0, format!("regions at {} confidence", percent(p)));
+    }
+    let steps = scene.steps();
+    match (options.steps, steps.first(), steps.last()) {
+        (Steps::All, Some(a), Some(b)) if a != b => {
+            let drawn = drawn_steps(scene);
+            if drawn.len() == steps.len() {
+                about.push(format!("steps {a}–{b} at once"));
+            } else {
+                let list: Vec<String> = drawn.iter().map(i64::to_string).collect();
+                about.push(format!("steps {a}–{b}: {} drawn", list.join(", ")));
+            }
+        }
+        (Steps::At(k), Some(_), Some(_)) => about.push(format!("step {k}")),
+        _ => {}
+    }
+    // Body: the world on the left, the legend and the plots on the right.
+    let top = 3.6 * f;
+    let plots: Vec<(usize, &crate::scene::Plot)> = scene.plots.iter().enumerate().collect();
+    let column = if scene.legend.is_empty() && plots.is_empty() {
+        0.0
+    } else {
+        (0.34 * w).max(14.0 * f)
+    };
+    let world_area = Rect {
+        x: 5.0 * f,
+        y: top,
+        w: (w - column - 6.0 * f).max(10.0),
+        h: (h - top - 4.0 * f).max(10.0),
+    };
+    let grid = draw_world(&mut out, &items, options, world_area, pen, steps.len() > 1);
+    about.push(format!("grid {}", chart::length_label(grid)));
+    out.text(
+        [0.8 * f, 3.0 * f],
+        0.9 * f,
+        Anchor::Start,
+        "#444",
+        &about.join(" · "),
+    );
+    if column > 0.0 {
+        let col = Rect {
+            x: w - column + 0.5 * f,
+            y: top,
+            w: column - 1.3 * f,
+            h: h - top - 0.8 * f,
+        };
+        let max_legend = if plots.is_empty() { col.h } else { 0.5 * col.h };
+        let used = chart::legend(
+            &mut out,
+            Rect {
+                h: max_legend,
+                ..col
+            },
+            &scene.legend,
+            pen,
+        );
+        draw_plots(
+            &mut out,
+            scene,
+            options,
+            Rect {
+                y: col.y + used + f,
+                h: col.h - used - f,
+                ..col
+            },
+            pen,
+        );
+    }
+    out.finish()
+}
+
+/// A probability as "95 %".
+fn percent(p: f64) -> String {
+    let text = format!("{:.2}", 100.0 * p);
+    format!("{} %", text.trim_end_matches('0').trim_end_matches('.'))
+}
+
+/// The items a figure draws: geometry only (no text), shown in some view and not hidden in
+/// every view that shows it, at the chosen steps.
+fn selected(scene: &Scene, steps: Steps) -> Vec<&SceneItem> {
+    let visible = |path: &str| {
+        scene.views.is_empty()
+            || scene.views.iter().any(|v| {
+                v.shows(path)
+                    && !v.hidden.iter().any(|h| {
+                        path.strip_prefix(h.as_str())
+                            .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
+                    })
+            })
+    };
+    let drawable = |i: &&SceneItem| !matches!(i.kind, ItemKind::Text(_)) && visible(&i.path);
+    match steps {
+        Steps::All => {
+            let drawn = drawn_steps(scene);
+            scene
+                .items
+                .iter()
+                .filter(|i| match i.timing {
+                    Timing::Step(k) => drawn.contains(&k),
+                    Timing::Static | Timing::Stamp(_) => true,
+                })
+                .filter(drawable)
+                .collect()
+        }
+        Steps::At(k) => {
+            // Per entity, its latest item at or before step k (static first, then by step).
+            let mut order: Vec<usize> = (0..scene.items.len()).collect();
+            order.sort_by_key(|&i| match scene.items[i].timing {
+                Timing::Static => (0, 0),
+                Timing::Step(s) => (1, s),
+                Timing::Stamp(ns) => (2, ns),
+            });
+            let mut latest: std::collections::BTreeMap<&str, usize> = Default::default();
+            for i in order {
+                let item = &scene.items[i];
+                if !matches!(item.timing, Timing::Step(s) if s > k) {
+                    latest.insert(item.path.as_str(), i);
+                }
+            }
+            let keep: std::collections::BTreeSet<usize> = latest.into_values().collect();
+            scene
+                .items
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| keep.contains(i))
+                .map(|(_, item)| item)
+                .filter(drawable)
+                .collect()
+        }
+    }
+}
+
+/// At most this many steps are drawn at once: a longer propagation shows its steps with
+/// clouds and regions (the detailed ones), evenly thinned to this many, always the last.
+pub const MAX_DRAWN_STEPS: usize = 12;
+
+/// The steps an all-steps figure draws: every step when they are few, else the detailed
+/// steps (those with clouds or regions), evenly thinned to [`MAX_DRAWN_STEPS`] with the first
+/// and the last.
+fn drawn_steps(scene: &Scene) -> Vec<i64> {
+    let steps = scene.steps();
+    if steps.len() <= MAX_DRAWN_STEPS {
+        return steps;
+    }
+    let mut detailed: Vec<i64> = scene
+        .items
+        .iter()
+        .filter(|i| matches!(i.kind, ItemKind::Points(_) | ItemKind::Surface(_)))
+        .filter_map(|i| match i.timing {
+            Timing::Step(k) => Some(k),
+            _ => None,
+        })
+        .collect();
+    detailed.sort_unstable();
+    detailed.dedup();
+    let pool = if detailed.len() >= 2 { detailed } else { steps };
+    let stride = (pool.len() - 1).div_ceil(MAX_DRAWN_STEPS - 1).max(1);
+    let mut drawn: Vec<i64> = pool.iter().step_by(stride).copied().collect();
+    if let Some(last) = pool.last().filter(|l| drawn.last() != Some(l)) {
+        drawn.push(*last);
+    }
+    drawn
+}
+
+/// Draws the world panel; returns the grid spacing (metres).
+fn draw_world(
+    out: &mut Svg,
+    items: &[&SceneItem],
+    options: &FigureOptions,
+    area: Rect,
+    pen: Pen,
+    steps: bool,
+) -> f64 {
+    let plane = options.plane;
+    let mut extent = Vec::new();
+    for item in items {
+        world::extent_points(item, plane, &mut extent);
+    }
+    // Clouds count by their central 99.6 % per axis: one far sample does not shrink the rest.
+    for item in items {
+        if let ItemKind::Points(cloud) = &item.kind {
+            for axis in 0..2 {
+                let mut v: Vec<f64> = cloud
+                    .positions
+                    .iter()
+                    .map(|p| plane.project(*p)[axis])
+                    .collect();
+                if v.is_empty() {
+                    continue;
+                }
+                v.sort_by(f64::total_cmp);
+                let lo = v[(v.len() as f64 * 0.002) as usize];
+                let hi = v[((v.len() as f64 * 0.998) as usize).min(v.len() - 1)];
+                let other = extent.first().map_or(0.0, |p: &[f64; 2]| p[1 - axis]);
+                for x in [lo, hi] {
+                    let mut p = [other; 2];
+                    p[axis] = x;
+                    extent.push(p);
+                }
+            }
+        }
+    }
+    let finite = extent
+        .iter()
+        .filter(|p| p[0].is_finite() && p[1].is_finite());
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in finite {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    if !(lo[0].is_finite() && hi[0].is_finite()) {
+        (lo, hi) = ([-1.0; 2], [1.0; 2]);
+    }
+    let span = [(hi[0] - lo[0]).max(1e-6), (hi[1] - lo[1]).max(1e-6)];
+    let biggest = span[0].max(span[1]);
+    let span = span.map(|s| s.max(0.05 * biggest) * 1.1);
+    let scale = (area.w / span[0]).min(area.h / span[1]);
+    let center = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+    let m = Mapping {
+        scale,
+        center,
+        origin: [area.x + 0.5 * area.w, area.y + 0.5 * area.h],
+    };
+    let step = chart::nice_step(area.w.max(area.h) / scale, 8);
+    let bl = m.metres([area.x, area.bottom()]);
+    let tr = m.metres([area.right(), area.y]);
+    let xs: Vec<(f64, f64)> = chart::ticks(bl[0], tr[0], step)
+        .into_iter()
+        .map(|v| (v, m.px([v, 0.0])[0]))
+        .collect();
+    let ys: Vec<(f64, f64)> = chart::ticks(bl[1], tr[1], step)
+        .into_iter()
+        .map(|v| (v, m.px([0.0, v])[1]))
+        .collect();
+    let (right, up) = plane.names();
+    let (xt, yt) = (format!("{right} (m)"), format!("{up} (m)"));
+    let axes = Axes {
+        area,
+        x: (&xs, step),
+        y: (&ys, step),
+        titles: (&xt, &yt),
+    };
+    axes.grid(out, pen);
+    area.clip(out, "world");
+    out.open("class=\"world\" clip-path=\"url(#world)\"");
+    world::draw_regions(out, items, plane, &m, pen);
+    world::draw_clouds(out, items, plane, &m, pen);
+    world::draw_lines(out, items, plane, &m, pen);
+    world::draw_labels(
+        out,
+        items,
+        plane,
+        &m,
+        pen,
+        steps && options.steps == Steps::All,
+    );
+    out.close();
+    axes.frame(out, pen);
+    chart::scale_bar(out, area, step, scale, pen);
+    step
+}
+
+/// Draws the scene's plots stacked in `area` (as many as fit at a readable height).
+fn draw_plots(out: &mut Svg, scene: &Scene, options: &FigureOptions, area: Rect, pen: Pen) {
+    let f = pen.font;
+    let fit = ((area.h / (10.5 * f)).floor() as usize).min(scene.plots.len());
+    if fit == 0 {
+        return;
+    }
+    let first_ns = scene
+        .series
+        .iter()
+        .flat_map(|s| s.points.first())
+        .map(|p| p.0)
+        .min()
+        .unwrap_or(0);
+    let (x_title, x_of): (&str, Box<dyn Fn(i64) -> f64>) = match scene.timeline {
+        Timeline::Step => ("step", Box::new(|k| k as f64)),
+        Timeline::Stamp | Timeline::Elapsed => (
+            "time (s)",
+            Box::new(move |ns| (ns - first_ns) as f64 * 1e-9),
+        ),
+    };
+    let height = area.h / fit as f64;
+    for (i, plot) in scene.plots.iter().take(fit).enumerate() {
+        let prefix = format!("{}/{}", crate::scene::PLOTS, plot.id);
+        let series: Vec<&crate::scene::ScalarSeries> = scene
+            .series
+            .iter()
+            .filter(|s| s.path == prefix || s.path.starts_with(&format!("{prefix}/")))
+            .collect();
+        let panel = PlotPanel {
+            title: plot.label(),
+            series,
+            x_title,
+            x_of: &*x_of,
+            marker: match options.steps {
+                Steps::At(k) if scene.timeline == Timeline::Step => Some(k as f64),
+                _ => None,
+            },
+        };
+        let rect = Rect {
+            y: area.y + height * i as f64,
+            h: height,
+            ..area
+        };
+        panel.draw(out, rect, &format!("plot{i}"), pen);
+    }
+}
+
+/// The figure in `format`.
+///
+/// # Errors
+/// [`FigureError::Render`] if the SVG cannot be rendered (a bug), [`FigureError::NoRenderer`]
+/// for PNG or PDF in a build without the `figure` feature.
+pub fn render(
+    scene: &Scene,
+    options: &FigureOptions,
+    format: FigureFormat,
+) -> Result<Vec<u8>, FigureError> {
+    let text = svg(scene, options);
+    match format {
+        FigureFormat::Svg => Ok(text.into_bytes()),
+        FigureFormat::Png => raster::png(&text),
+        FigureFormat::Pdf => raster::pdf(&text),
+    }
+}
+
+/// Writes the figure to `path` in the format of its extension, whole or not at all (a
+/// temporary file beside it, renamed when complete).
+///
+/// # Errors
+/// [`FigureError`]: the extension, rendering, or the file.
+pub fn write(scene: &Scene, options: &FigureOptions, path: &Path) -> Result<(), FigureError> {
+    let format = FigureFormat::of(path)?;
+    let bytes = render(scene, options, format)?;
+    let io = |source| FigureError::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let mut partial = path.as_os_str().to_owned();
+    partial.push(".partial");
+    let partial = PathBuf::from(partial);
+    std::fs::write(&partial, &bytes).map_err(io)?;
+    std::fs::rename(&partial, path).map_err(|e| {
+        let _ = std::fs::remove_file(&partial);
+        io(e)
+    })
+}

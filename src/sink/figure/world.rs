@@ -1,0 +1,407 @@
+//! The world panel: a scene's 3-D items projected orthographically on a coordinate plane,
+//! with equal scales on both axes so lengths and shapes read true.
+//!
+//! - Point clouds: one dot per sample (at most [`MAX_DOTS`], evenly strided).
+//! - Ellipsoids: their exact shadow on the plane, the ellipse of the projected shape matrix
+//!   P R diag(h)² Rᵀ Pᵀ (P the plane's two rows), dashed.
+//! - Surfaces (Exp-mapped bananas): the union of their projected triangles, filled, with a
+//!   darker outline where the union ends.
+//! - Line strips, arrows, frames (x red, y green, z blue) and sample triads as lines.
+
+use nalgebra::{Matrix2, Matrix3, SymmetricEigen, UnitQuaternion, Vector3};
+
+use super::svg::{Px, Svg, darker, num, on_white, path_data, rgb};
+use crate::scene::{AXIS_COLORS, Ellipsoid, FillMode, ItemKind, QuatXyzw, SceneItem, Vec3};
+
+/// At most this many dots per cloud (a larger cloud is strided evenly; its statistics are
+/// the evaluation's, not the picture's).
+pub const MAX_DOTS: usize = 20_000;
+
+/// Points on a projected ellipse.
+const ELLIPSE_POINTS: usize = 96;
+
+/// A coordinate plane a figure is drawn on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Plane {
+    /// Seen from above: x to the right, y up.
+    #[default]
+    Xy,
+    /// Seen from the side (−y): x to the right, z up.
+    Xz,
+    /// Seen from the front (+x): y to the right, z up.
+    Yz,
+}
+
+impl Plane {
+    /// The world axes shown right and up (0 = x, 1 = y, 2 = z).
+    pub const fn axes(self) -> (usize, usize) {
+        match self {
+            Self::Xy => (0, 1),
+            Self::Xz => (0, 2),
+            Self::Yz => (1, 2),
+        }
+    }
+
+    /// The axes' names, e.g. `("x", "y")`.
+    pub const fn names(self) -> (&'static str, &'static str) {
+        match self {
+            Self::Xy => ("x", "y"),
+            Self::Xz => ("x", "z"),
+            Self::Yz => ("y", "z"),
+        }
+    }
+
+    /// A world point's coordinates on the plane (metres).
+    ///
+    /// ```
+    /// use posecov::sink::figure::Plane;
+    /// assert_eq!(Plane::Xz.project([1.0, 2.0, 3.0]), [1.0, 3.0]);
+    /// ```
+    pub const fn project(self, v: Vec3) -> [f64; 2] {
+        let (a, b) = self.axes();
+        [v[a], v[b]]
+    }
+}
+
+impl std::str::FromStr for Plane {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "xy" => Ok(Self::Xy),
+            "xz" => Ok(Self::Xz),
+            "yz" => Ok(Self::Yz),
+            _ => Err(format!("{s:?} is not a plane: use xy, xz or yz")),
+        }
+    }
+}
+
+/// From plane metres to figure pixels: equal scale on both axes, y up.
+#[derive(Clone, Copy, Debug)]
+pub struct Mapping {
+    /// Pixels per metre.
+    pub scale: f64,
+    /// The plane point at the panel's centre (metres).
+    pub center: [f64; 2],
+    /// The panel's centre (pixels).
+    pub origin: Px,
+}
+
+impl Mapping {
+    /// The pixel of a plane point.
+    pub fn px(&self, p: [f64; 2]) -> Px {
+        [
+            self.origin[0] + self.scale * (p[0] - self.center[0]),
+            self.origin[1] - self.scale * (p[1] - self.center[1]),
+        ]
+    }
+
+    /// The plane point of a pixel (the inverse of [`Mapping::px`]).
+    pub fn metres(&self, px: Px) -> [f64; 2] {
+        [
+            self.center[0] + (px[0] - self.origin[0]) / self.scale,
+            self.center[1] - (px[1] - self.origin[1]) / self.scale,
+        ]
+    }
+}
+
+/// The boundary points of an ellipsoid's shadow on the plane (metres).
+fn shadow(e: &Ellipsoid, plane: Plane) -> Vec<[f64; 2]> {
+    let r = rotation(&e.rotation);
+    let h = Matrix3::from_diagonal(&Vector3::from(e.half_sizes).map(|v| v * v));
+    let m3 = r * h * r.transpose();
+    let (a, b) = plane.axes();
+    let m = Matrix2::new(m3[(a, a)], m3[(a, b)], m3[(b, a)], m3[(b, b)]);
+    let eig = SymmetricEigen::new(m);
+    let c = plane.project(e.center);
+    (0..ELLIPSE_POINTS)
+        .map(|i| {
+            let t = std::f64::consts::TAU * i as f64 / ELLIPSE_POINTS as f64;
+            let (s0, s1) = (
+                eig.eigenvalues[0].max(0.0).sqrt(),
+                eig.eigenvalues[1].max(0.0).sqrt(),
+            );
+            let v = eig.eigenvectors.column(0) * (s0 * t.cos())
+                + eig.eigenvectors.column(1) * (s1 * t.sin());
+            [c[0] + v[0], c[1] + v[1]]
+        })
+        .collect()
+}
+
+fn rotation(q: &QuatXyzw) -> Matrix3<f64> {
+    let q = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[3], q[0], q[1], q[2]));
+    *q.to_rotation_matrix().matrix()
+}
+
+fn rotate(q: &QuatXyzw, v: Vec3) -> Vec3 {
+    crate::scene::rotate(q, v)
+}
+
+fn add(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// Every plane point an item draws (for the panel's extent; clouds separately).
+pub fn extent_points(item: &SceneItem, plane: Plane, out: &mut Vec<[f64; 2]>) {
+    match &item.kind {
+        ItemKind::Frame(f) => {
+            out.push(plane.project(f.translation));
+            for k in 0..3 {
+                let mut axis = [0.0; 3];
+                axis[k] = f.axis_length;
+                out.push(plane.project(add(f.translation, rotate(&f.rotation, axis))));
+            }
+        }
+        ItemKind::Triads(t) => out.extend(t.translations.iter().map(|v| plane.project(*v))),
+        ItemKind::Ellipsoids(e) => {
+            for shape in &e.shapes {
+                out.extend(shadow(shape, plane));
+            }
+        }
+        ItemKind::Surface(s) => out.extend(s.vertices.iter().map(|v| plane.project(*v))),
+        ItemKind::LineStrips(l) => out.extend(l.strips.iter().flatten().map(|v| plane.project(*v))),
+        ItemKind::Arrows(a) => {
+            for (o, v) in a.origins.iter().zip(&a.vectors) {
+                out.push(plane.project(*o));
+                out.push(plane.project(add(*o, *v)));
+            }
+        }
+        ItemKind::Points(_) | ItemKind::Text(_) => {}
+    }
+}
+
+/// How thick lines are: `unit` pixels is a thin line at this figure's size.
+#[derive(Clone, Copy, Debug)]
+pub struct Pen {
+    /// A thin line's width in pixels (grows with the figure).
+    pub unit: f64,
+    /// Text size of labels in pixels.
+    pub font: f64,
+}
+
+/// Draws the filled regions (surfaces) of `items`: first, under everything else.
+pub fn draw_regions(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mapping, pen: Pen) {
+    for item in items {
+        let ItemKind::Surface(s) = &item.kind else {
+            continue;
+        };
+        // Each projected triangle counter-clockwise on screen, so the non-zero fill of one path
+        // is the union of the triangles (no holes where two overlap with opposite windings).
+        let mut d = String::new();
+        for t in &s.triangles {
+            let mut p: Vec<Px> = t
+                .iter()
+                .map(|&i| m.px(plane.project(s.vertices[i as usize])))
+                .collect();
+            let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+            if area.abs() < 1e-9 {
+                continue;
+            }
+            if area < 0.0 {
+                p.swap(1, 2);
+            }
+            d.push_str(&path_data(&p, true));
+        }
+        if d.is_empty() {
+            continue;
+        }
+        let color = s.color;
+        // The outline: the union stroked dark, then the union filled light on top, so only the
+        // outer half of the stroke shows.
+        svg.open("class=\"region\" opacity=\"0.45\"");
+        svg.raw(&format!(
+            "<path d=\"{d}\" fill=\"{dark}\" stroke=\"{dark}\" stroke-width=\"{}\" stroke-linejoin=\"round\"/>",
+            num(2.4 * pen.unit),
+            dark = rgb(darker(color, 0.35)),
+        ));
+        svg.raw(&format!("<path d=\"{d}\" fill=\"{}\"/>", rgb(color)));
+        svg.close();
+    }
+}
+
+/// Draws the clouds of `items`.
+pub fn draw_clouds(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mapping, pen: Pen) {
+    for item in items {
+        let ItemKind::Points(cloud) = &item.kind else {
+            continue;
+        };
+        let stride = cloud.positions.len().div_ceil(MAX_DOTS).max(1);
+        let radius = (cloud.radius * m.scale).clamp(0.6 * pen.unit, 1.6 * pen.unit);
+        let alpha = (f64::from(cloud.color.0[3]) / 255.0).min(0.7);
+        let color = on_white(darker(cloud.color, 0.25), alpha);
+        svg.open(&format!("class=\"cloud\" fill=\"{}\"", rgb(color)));
+        for p in cloud.positions.iter().step_by(stride) {
+            svg.circle(m.px(plane.project(*p)), radius);
+        }
+        svg.close();
+    }
+}
+
+/// Draws the lines of `items`: ellipses, outlines, paths, arrows, triads and frames, with the
+/// frames' labels.
+pub fn draw_lines(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mapping, pen: Pen) {
+    let to_px = |v: Vec3| m.px(plane.project(v));
+    for item in items {
+        match &item.kind {
+            ItemKind::Ellipsoids(e) => {
+                let color = darker(e.color, 0.1);
+                let (fill, dash) = match e.fill {
+                    FillMode::Solid | FillMode::TransparentFillMajorWireframe => (
+                        format!(
+                            " fill=\"{}\" fill-opacity=\"0.15\"",
+                            rgb(e.color.with_alpha(255))
+                        ),
+                        "",
+                    ),
+                    _ => (String::new(), " stroke-dasharray=\"7 4\""),
+                };
+                for shape in &e.shapes {
+                    let points: Vec<Px> =
+                        shadow(shape, plane).into_iter().map(|p| m.px(p)).collect();
+                    svg.raw(&format!(
+                        "<path class=\"ellipse\" d=\"{}\" stroke=\"{}\" stroke-width=\"{}\"{dash}{}/>",
+                        path_data(&points, true),
+                        rgb(color),
+                        num(1.6 * pen.unit),
+                        if fill.is_empty() { " fill=\"none\"" } else { &fill },
+                    ));
+                }
+            }
+            ItemKind::LineStrips(l) => {
+                let width = (2.0 * l.radius * m.scale).clamp(pen.unit, 2.5 * pen.unit);
+                for strip in &l.strips {
+                    let points: Vec<Px> = strip.iter().map(|v| to_px(*v)).collect();
+                    svg.polyline(
+                        &points,
+                        false,
+                        darker(l.color, 0.1),
+                        width,
+                        " class=\"line\"",
+                    );
+                }
+            }
+            ItemKind::Arrows(a) => {
+                for (o, v) in a.origins.iter().zip(&a.vectors) {
+                    arrow(svg, to_px(*o), to_px(add(*o, *v)), a.color, 0.8 * pen.unit);
+                }
+            }
+            ItemKind::Triads(t) => {
+                for (o, q) in t.translations.iter().zip(&t.rotations) {
+                    axes(svg, *o, q, t.axis_length, 0.6 * pen.unit, &to_px);
+                }
+            }
+            ItemKind::Frame(f) => {
+                axes(
+                    svg,
+                    f.translation,
+                    &f.rotation,
+                    f.axis_length,
+                    1.8 * pen.unit,
+                    &to_px,
+                );
+            }
+            ItemKind::Points(_) | ItemKind::Surface(_) | ItemKind::Text(_) => {}
+        }
+    }
+}
+
+/// A frame's three axes, x red, y green, z blue (an axis seen end-on is a dot).
+fn axes(
+    svg: &mut Svg,
+    origin: Vec3,
+    q: &QuatXyzw,
+    length: f64,
+    width: f64,
+    to_px: &impl Fn(Vec3) -> Px,
+) {
+    let o = to_px(origin);
+    for (k, color) in AXIS_COLORS.iter().enumerate() {
+        let mut axis = [0.0; 3];
+        axis[k] = length;
+        let tip = to_px(add(origin, rotate(q, axis)));
+        svg.line(
+            o,
+            tip,
+            darker(*color, 0.15),
+            width,
+            " stroke-linecap=\"round\"",
+        );
+    }
+}
+
+/// An arrow from `a` to `b` (pixels) with a small head.
+fn arrow(svg: &mut Svg, a: Px, b: Px, color: crate::scene::Color, unit: f64) {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len = dx.hypot(dy);
+    if len < 0.5 {
+        return;
+    }
+    let color = on_white(darker(color, 0.1), f64::from(color.0[3]) / 255.0);
+    svg.line(a, b, color, unit, "");
+    let head = (4.0 * unit).min(0.4 * len);
+    let (ux, uy) = (dx / len, dy / len);
+    let left = [b[0] - head * (ux - 0.5 * uy), b[1] - head * (uy + 0.5 * ux)];
+    let right = [b[0] - head * (ux + 0.5 * uy), b[1] - head * (uy - 0.5 * ux)];
+    svg.raw(&format!(
+        "<path d=\"{}\" fill=\"{}\"/>",
+        path_data(&[b, left, right], true),
+        rgb(color)
+    ));
+}
+
+/// Labels: each frame's own label, and in an all-steps figure the step number beside each
+/// step's frame (at most about a dozen, evenly spaced, always the last).
+pub fn draw_labels(
+    svg: &mut Svg,
+    items: &[&SceneItem],
+    plane: Plane,
+    m: &Mapping,
+    pen: Pen,
+    steps: bool,
+) {
+    let frames: Vec<(&SceneItem, &crate::scene::Frame)> = items
+        .iter()
+        .filter_map(|i| match &i.kind {
+            ItemKind::Frame(f) => Some((*i, f)),
+            _ => None,
+        })
+        .collect();
+    let stepped: Vec<i64> = {
+        let mut s: Vec<i64> = frames
+            .iter()
+            .filter_map(|(i, _)| match i.timing {
+                crate::scene::Timing::Step(k) => Some(k),
+                _ => None,
+            })
+            .collect();
+        s.sort_unstable();
+        s.dedup();
+        s
+    };
+    let stride = stepped.len().div_ceil(12).max(1);
+    let last = stepped.last().copied();
+    let labelled = |k: i64| {
+        let index = stepped.iter().position(|s| *s == k).unwrap_or(0);
+        index % stride == 0 || Some(k) == last
+    };
+    let mut named = std::collections::BTreeSet::new();
+    for (item, frame) in frames {
+        let at = m.px(plane.project(frame.translation));
+        let at = [at[0] + 0.5 * pen.font, at[1] - 0.5 * pen.font];
+        let text = match (item.timing, steps) {
+            (crate::scene::Timing::Step(k), true) => labelled(k).then(|| format!("{k}")),
+            _ => frame.label.clone().filter(|l| named.insert(l.clone())),
+        };
+        if let Some(text) = text {
+            svg.raw(&format!(
+                "<text class=\"label\" x=\"{}\" y=\"{}\" font-size=\"{}\" fill=\"#222\" stroke=\"white\" stroke-width=\"{}\" paint-order=\"stroke\">{}</text>",
+                num(at[0]),
+                num(at[1]),
+                num(pen.font),
+                num(0.25 * pen.font),
+                super::svg::escape(&text)
+            ));
+        }
+    }
+}
