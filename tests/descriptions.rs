@@ -12,7 +12,8 @@ fn stated_numbers(text: &str) -> Vec<String> {
     let mut i = 0;
     while i < chars.len() {
         let starts = chars[i].is_ascii_digit()
-            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == '.'));
+            && (i == 0
+                || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == '.'));
         if !starts {
             i += 1;
             continue;
@@ -21,7 +22,11 @@ fn stated_numbers(text: &str) -> Vec<String> {
         while j < chars.len() && (chars[j].is_ascii_digit() || chars[j] == '.') {
             j += 1;
         }
-        let number: String = chars[i..j].iter().collect::<String>().trim_end_matches('.').to_owned();
+        let number: String = chars[i..j]
+            .iter()
+            .collect::<String>()
+            .trim_end_matches('.')
+            .to_owned();
         let rest: String = chars[j..chars.len().min(j + 2)].iter().collect();
         if number.contains('.') || rest.trim_start().starts_with('%') {
             out.push(number);
@@ -50,7 +55,10 @@ fn bundled_descriptions_state_only_their_inputs() {
             .filter_map(|k| scenario.get(*k).and_then(|v| v.as_str()))
             .collect::<Vec<_>>()
             .join("\n");
-        let description = scenario.get("description").and_then(|v| v.as_str()).unwrap_or("");
+        let description = scenario
+            .get("description")
+            .and_then(|v| v.as_str())
+            .unwrap_or("");
         let title = scenario.get("title").and_then(|v| v.as_str()).unwrap_or("");
         let inputs = b.text.replace(description, "").replace(title, "");
         for number in stated_numbers(&words) {

@@ -24,7 +24,7 @@ use crate::lie::{GroupKind, LieGroup, Se3};
 use crate::plan::StepPolicy;
 use crate::scene::{
     Color, Ellipsoid, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, Plot, PointCloud,
-    ScalarSeries, Scene, SceneItem, Timeline, Timing, Vec3,
+    ScalarSeries, Scene, SceneItem, Swatch, Timeline, Timing, Vec3,
 };
 use crate::uncertain::Method;
 
@@ -94,6 +94,7 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
         methods: Vec::new(),
     };
     p.scene.planar = planar;
+    p.scene.confidence = Some(settings.confidence);
     for (k, topic) in e.topics.iter().enumerate() {
         draw_topic(&mut p, k, topic);
     }
@@ -182,6 +183,7 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
         .filter(|q| q.iter().all(|v| v.is_finite()))
         .collect();
     if !strip.is_empty() {
+        p.legend(format!("{}: trajectory", t.name), color, Swatch::Line);
         put(
             p,
             format!("{base}/trajectory"),
@@ -288,6 +290,17 @@ fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
             Some(rviz_position(&flat_rviz, &c, r, p.extent, t.planar).0)
         })
         .collect();
+    let region = super::legend::percent(p.confidence());
+    p.legend(
+        format!("RViz's picture: the {region} ellipse of the numbers as given"),
+        RVIZ,
+        Swatch::Dashed,
+    );
+    p.legend(
+        format!("what the covariance means: Exp-mapped {region} region (outlines)"),
+        MEANING,
+        Swatch::Line,
+    );
     put(
         p,
         format!("{base}/history/rviz"),
@@ -462,6 +475,13 @@ fn rviz_picture(
 }
 
 fn cloud_item(p: &mut Painter, base: &str, at: Timing, positions: Vec<Vec3>) {
+    if !positions.is_empty() {
+        p.legend(
+            "samples of what the covariance means".to_owned(),
+            Method::MonteCarlo.color(),
+            Swatch::Dots,
+        );
+    }
     put(
         p,
         format!("{base}/meaning/cloud"),
@@ -500,6 +520,11 @@ fn sprays(p: &mut Painter, base: &str, at: Timing, cloud: &[Se3]) {
 
 /// An unusable message: a red cross; the meaning's shapes are cleared until the next one.
 fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
+    p.legend(
+        "an unusable message (red cross)".to_owned(),
+        INVALID,
+        Swatch::Line,
+    );
     let s = 0.5 * p.axis_length;
     let [x, y, z] = origin;
     put(
