@@ -42,11 +42,8 @@ use crate::scene::{
 use crate::uncertain::Method;
 
 pub mod bag;
-<<<<<<< HEAD
 mod graph;
-=======
 mod legend;
->>>>>>> d2ef265 (figure: posecov figure NAME -o OUT.svg|png|pdf draws static figures in pure Rust (sink/figure: SVG written directly, PNG by resvg, PDF by svg2pdf, bundled Liberation Sans OFL): plane projection of clouds, Exp-mapped regions (union of projected triangles), ellipsoid shadows, frames; every step at once numbered (long propagations thinned to 12 detailed steps) or --step K as the viewer shows it; legend with swatches (Scene::legend, filled in draw/), axes in metres, grid spacing and scale bar, confidence, plots with their own legends; same seed same bytes (PDF resource order sorted); docs/gallery from examples/gallery.rs and the README gallery from it; the vector-space ellipse that coincides with a first-order Cartesian one is said (legend, text panel); bundled descriptions state no number the run computes (Barfoot's 1.68/1.69, 15-25 %, 33 % removed), with a test)
 mod plots;
 mod shapes;
 mod text;
