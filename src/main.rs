@@ -13,11 +13,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
 use clap::{Args, Parser, Subcommand};
-use posecov::app::Overrides;
 use posecov::app::commands;
 use posecov::app::live::{self, LiveOptions};
 use posecov::app::sinks::{EXIT_INTERRUPTED, ServeOptions, ViewOptions};
 use posecov::app::view::view;
+use posecov::app::{AppError, EXIT_CANNOT, EXIT_CODES_HELP, Overrides};
 use posecov::eval::graph::{GraphReading, Optimizer};
 use posecov::interop::RosReading;
 use posecov::sink::Sink;
@@ -31,7 +31,8 @@ use posecov::sink::Sink;
     name = "posecov",
     version,
     args_conflicts_with_subcommands = true,
-    subcommand_negates_reqs = true
+    subcommand_negates_reqs = true,
+    after_help = EXIT_CODES_HELP
 )]
 struct Cli {
     #[command(subcommand)]
@@ -52,10 +53,17 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Validate a scenario without drawing it.
+    /// Validate a scenario or graph without drawing it; for a robot log, fail (exit 1) on a
+    /// covariance defect, printing the first of each topic on stderr.
+    #[command(after_help = EXIT_CODES_HELP)]
     Check {
         #[command(flatten)]
         scenario: ScenarioArgs,
+        /// Accept this defect class on purpose (repeatable): non_finite, asymmetric, not_psd,
+        /// undecodable, bad_orientation, unknown_marker, all_zero, placeholder_used_axis,
+        /// constant, frozen_stamp.
+        #[arg(long = "allow", value_name = "NAME")]
+        allow: Vec<String>,
     },
     /// Write a static figure (SVG, PNG or PDF, by the extension of -o) drawn by posecov itself:
     /// the plane projection of every cloud, region, ellipse and frame, every step at once,
@@ -352,12 +360,20 @@ impl ViewArgs {
     }
 }
 
-/// Writes to stdout; a closed pipe (`posecov report … | head`) is not an error.
-fn emit(text: &str) -> anyhow::Result<ExitCode> {
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e).context("writing to stdout"),
-        _ => Ok(ExitCode::SUCCESS),
+/// Writes to stdout and says whether the reader got it: a closed pipe (`posecov report … |
+/// head`) is not an error (`Ok(false)`; the run ends quietly with 0).
+fn write_out(text: &str) -> anyhow::Result<bool> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(false),
+        Err(e) => Err(e).context("writing to stdout"),
+        Ok(()) => Ok(true),
     }
+}
+
+/// Writes to stdout: success, also when the reader closed it.
+fn emit(text: &str) -> anyhow::Result<ExitCode> {
+    write_out(text).map(|_| ExitCode::SUCCESS)
 }
 
 fn main() -> ExitCode {
@@ -365,7 +381,12 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(err) => {
             eprintln!("error: {err:#}");
-            ExitCode::FAILURE
+            // The table of `posecov --help`: 1 for an error located in a scenario or graph,
+            // 2 when the input cannot be processed at all.
+            ExitCode::from(
+                err.downcast_ref::<AppError>()
+                    .map_or(EXIT_CANNOT, AppError::exit_code),
+            )
         }
     }
 }
@@ -379,8 +400,15 @@ fn try_main() -> anyhow::Result<ExitCode> {
             &scenario.overrides(),
             json,
         )?),
-        Some(Command::Check { scenario }) => {
-            emit(&(commands::check(scenario.scenario(), &scenario.overrides())? + "\n"))
+        Some(Command::Check { scenario, allow }) => {
+            let allow = commands::allowed(&allow)?;
+            let checked = commands::check(scenario.scenario(), &scenario.overrides(), &allow)?;
+            for defect in &checked.defects {
+                eprintln!("{defect}");
+            }
+            let read = write_out(&(checked.line.clone() + "\n"))?;
+            // A reader that closed stdout (`… | head`) ends the run quietly with 0.
+            Ok(ExitCode::from(if read { checked.exit_code() } else { 0 }))
         }
         Some(Command::Figure(args)) => {
             let options = posecov::sink::figure::FigureOptions {

@@ -291,8 +291,8 @@ fn planar_odometry_numbers_are_exact() {
     let h = &odom.health;
     assert_eq!(h.count(Issue::Placeholder), 50);
     // One drop (k = 25: trace 1.815 → 0.015).
-    assert_eq!(h.count(Issue::SuddenDrop), 1);
-    assert_eq!(h.first(Issue::SuddenDrop), Some(35_500_000_000));
+    assert_eq!(h.count(Issue::Drop), 1);
+    assert_eq!(h.first(Issue::Drop), Some(35_500_000_000));
     // Growth: trace_k = 1.5 (0.01 + 0.05 (k mod 25)) reaches 100 × 0.015 at k mod 25 ≥ 20:
     // k = 20 … 24 and, measured from the drop, 45 … 49.
     assert_eq!(h.count(Issue::Growth), 10);
@@ -316,17 +316,20 @@ fn every_health_case_is_counted_once() {
     for (issue, stamp) in [
         (Issue::AllZero, 101 * s),
         (Issue::UnknownMarker, 102 * s),
-        (Issue::Placeholder, 103 * s),
+        // A placeholder on roll of a 3-D topic: an axis its motion uses.
+        (Issue::PlaceholderUsedAxis, 103 * s),
         (Issue::NonFinite, 104 * s),
         (Issue::Asymmetric, 105 * s),
         (Issue::NotPsd, 106 * s),
         (Issue::BadOrientation, 107 * s),
         (Issue::Undecodable, 111 * s + 500_000_000),
+        (Issue::StampFallback, 108 * s + 500_000_000),
+        (Issue::StampOrder, 50 * s),
     ] {
         assert_eq!(h.count(issue), 1, "{issue:?}: {h:?}");
         assert_eq!(h.first(issue), Some(stamp), "{issue:?}");
     }
-    assert_eq!(h.issues.len(), 8, "{h:?}");
+    assert_eq!(h.issues.len(), 10, "{h:?}");
     let lo = h.min_eigenvalue.unwrap();
     assert!(lo < -0.1, "{lo}");
     // Message 8 had a zero stamp: its log time is used, and said.

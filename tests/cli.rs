@@ -108,7 +108,8 @@ fn missing_file_and_unknown_name() {
         .args(["check", "/no/such/scenario.toml"])
         .output()
         .expect("run");
-    assert_eq!(out.status.code(), Some(1));
+    // Cannot process (the exit-code table): 2.
+    assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains("/no/such/scenario.toml: cannot read input"),
@@ -270,7 +271,7 @@ fn live_refuses_a_taken_page_port_with_a_way_out() {
         .output()
         .expect("run posecov live");
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
         stderr.contains(&format!("--bind 127.0.0.1:{page}: "))
             && stderr.contains("`--bind 127.0.0.1:0` for any free one"),
@@ -297,7 +298,7 @@ fn serve_refuses_a_taken_viewer_port_up_front() {
             .output()
             .expect("run posecov --serve");
         let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{flag}: {stderr}");
+        assert_eq!(out.status.code(), Some(2), "{flag}: {stderr}");
         assert!(
             stderr.contains(&format!("{flag} {busy}: 127.0.0.1:{busy} cannot be served")),
             "{flag}: {stderr}"

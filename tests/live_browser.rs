@@ -183,7 +183,7 @@ fn dragging_a_slider_in_chromium_re_streams_the_viewer() {
     assert_eq!(report["saved"].as_str(), saved.to_str(), "{report}");
     let text = std::fs::read_to_string(&saved).unwrap();
     assert!(text.contains("# x, y in metres; θ in degrees"), "{text}");
-    posecov::app::commands::check(saved.to_str().unwrap(), &Overrides::default()).unwrap();
+    posecov::app::commands::check(saved.to_str().unwrap(), &Overrides::default(), &[]).unwrap();
 
     // What a fresh recording of the edited scenario shows.
     let mut doc = LiveDocument::open("camera_on_robot").unwrap();

@@ -248,7 +248,7 @@ fn png_without_a_viewer_says_what_to_install() {
         .env("POSECOV_RERUN", "/nonexistent/rerun")
         .output()
         .expect("run posecov");
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("pip install rerun-sdk==0.36.3"), "{stderr}");
 }
@@ -268,7 +268,7 @@ fn bad_arguments_fail_with_a_message() {
         .args(["nosuch"])
         .output()
         .expect("run posecov");
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains("nosuch: cannot read input") && stderr.contains("camera_on_robot"),

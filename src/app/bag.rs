@@ -15,12 +15,13 @@ use std::sync::atomic::AtomicBool;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::AppError;
+use super::commands::Checked;
 use super::settings::LogSettings;
-use crate::draw::bag::{BagDrawSettings, bag_scene, description, issue_word};
+use crate::draw::bag::{BagDrawSettings, bag_scene, description, issue_sentence, issue_word};
 use crate::eval::bag::{BagEvaluation, evaluate_bag};
 use crate::input::bag::{BagOptions, bundled, read_located};
 use crate::input::{About, Located, Place};
-use crate::plan::bag::BagPlan;
+use crate::plan::bag::{BagPlan, Class, Issue};
 use crate::scene::Scene;
 
 /// A read, evaluated and drawn log.
@@ -128,14 +129,14 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 .iter()
                 .map(|(issue, c)| {
                     (
-                        serde_json::to_value(issue)
-                            .ok()
-                            .and_then(|v| v.as_str().map(str::to_owned))
-                            .unwrap_or_default(),
+                        issue.name().to_owned(),
                         serde_json::json!({
+                            "class": t.class(*issue),
                             "count": c.count,
                             "first_stamp_s": secs(c.first_stamp_ns),
+                            "first_message": c.first_index,
                             "word": issue_word(*issue),
+                            "sentence": issue_sentence(*issue, t),
                         }),
                     )
                 })
@@ -158,7 +159,15 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 "drawn": e.poses.len(),
                 "drawn_invalid": e.poses.iter().filter(|p| !p.state.is_drawable()).count(),
                 "every": t.stride,
+                "dead_reckoned": t.dead_reckoned(),
                 "health": health,
+                "constant_stretch": t.health.constant.map(|c| serde_json::json!({
+                    "messages": c.messages,
+                    "first_message": c.first_index,
+                    "first_stamp_s": secs(c.first_stamp_ns),
+                    "last_stamp_s": secs(c.last_stamp_ns),
+                    "distance_m": c.distance_m,
+                })),
                 "min_eigenvalue": t.health.min_eigenvalue,
                 "twist_sigma_last": t.twist_sigmas(),
                 "ros_reading": run.evaluation.reading,
@@ -189,8 +198,8 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
 /// ```
 /// use posecov::app::{Overrides, bag, run::{Run, open}};
 /// let Run::Log(run) = Run::start(open("jackal_odometry").unwrap(), &Overrides::default(), None).unwrap() else { panic!() };
-/// assert!(bag::report_text("jackal_odometry", &run).contains("| placeholder (≥ 1e6) | 3060 | 47.584 s |"));
-/// assert!(bag::check_line("jackal_odometry", &run).starts_with("jackal_odometry: ok (1 pose topic(s), 6121 messages"));
+/// let text = bag::report_text("jackal_odometry", &run);
+/// assert!(text.contains("note `placeholder` × 3060, first at 47.584 s (message 0)"), "{text}");
 /// ```
 pub fn report_text(name: &str, run: &LogRun) -> String {
     format!(
@@ -202,24 +211,68 @@ pub fn report_text(name: &str, run: &LogRun) -> String {
     )
 }
 
-/// One line: topics, messages, drawn items, health issues (example at [`report_text`]).
-pub fn check_line(name: &str, run: &LogRun) -> String {
-    let issues: u64 = run
-        .plan
-        .topics
-        .iter()
-        .flat_map(|t| t.health.issues.values())
-        .map(|c| c.count)
-        .sum();
-    format!(
-        "{name}: ok ({} pose topic(s), {} messages, {} drawn items{})",
-        run.plan.topics.len(),
-        run.plan.messages_total,
-        run.scene.items.len(),
-        if issues > 0 {
-            format!(", {issues} covariance health notes (see `posecov report`)")
-        } else {
-            String::new()
+/// What `check` says of a log: one line for stdout (topics, messages, drawn items, defects and
+/// notes) and, for each topic with a defect not in `allow`, its first defect on a line for
+/// stderr in the file's terms (file, topic, message, stamp), with its count and `--allow` name.
+///
+/// ```
+/// use posecov::app::{Overrides, bag, run::{Run, open}};
+/// use posecov::plan::bag::Issue;
+/// let Run::Log(run) = Run::start(open("covariance_health").unwrap(), &Overrides::default(), None).unwrap() else { panic!() };
+/// let checked = bag::check(&run, "covariance_health", &[]);
+/// assert!(checked.line.starts_with("covariance_health: defects on 1 of 3 pose topic(s)"), "{}", checked.line);
+/// assert!(checked.defects[0].starts_with("health_cases.mcap (bundled): topic /amcl_pose, message 1 (stamp 101.000 s): all_zero"), "{:?}", checked.defects);
+/// let allow: Vec<Issue> = Issue::ALL.to_vec();
+/// assert!(bag::check(&run, "covariance_health", &allow).defects.is_empty());
+/// ```
+pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
+    let plan = &run.plan;
+    let file = run.located.origin();
+    let mut defects = Vec::new();
+    let mut notes = 0;
+    for t in &plan.topics {
+        notes += t
+            .health
+            .issues
+            .iter()
+            .filter(|(i, _)| t.class(**i) == Class::Note)
+            .count();
+        let mut found: Vec<_> = t.defects().filter(|(i, _)| !allow.contains(i)).collect();
+        found.sort_by_key(|(_, c)| (c.first_index, c.first_stamp_ns));
+        if let Some((issue, c)) = found.first() {
+            let others = match found.len() - 1 {
+                0 => String::new(),
+                n => format!("; {n} more defect kind(s) on this topic, see `posecov report`"),
+            };
+            defects.push(format!(
+                "{file}: topic {}, message {} (stamp {:.3} s): {} — {} ({} message(s); `--allow {}` accepts it{others})",
+                t.name,
+                c.first_index,
+                secs(c.first_stamp_ns),
+                issue.name(),
+                issue_sentence(*issue, t),
+                c.count,
+                issue.name(),
+            ));
         }
-    )
+    }
+    let facts = format!(
+        "{} messages, {} drawn items{}",
+        plan.messages_total,
+        run.scene.items.len(),
+        match notes {
+            0 => String::new(),
+            n => format!(", {n} kind(s) of note (see `posecov report`)"),
+        }
+    );
+    let line = if defects.is_empty() {
+        format!("{name}: ok ({} pose topic(s), {facts})", plan.topics.len())
+    } else {
+        format!(
+            "{name}: defects on {} of {} pose topic(s) ({facts}; the first of each on stderr)",
+            defects.len(),
+            plan.topics.len()
+        )
+    };
+    Checked { line, defects }
 }

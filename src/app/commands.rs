@@ -3,8 +3,12 @@
 use std::fmt::Write as _;
 
 use super::run::{Opened, PlanRun, open};
-use super::{AppError, Overrides, bag, evaluate, report_json, resolve, resolve_log};
+use super::{
+    AppError, EXIT_FAILED, Overrides, SettingsError, bag, evaluate, report_json, resolve,
+    resolve_log,
+};
 use crate::input::{Format, examples, open_text};
+use crate::plan::bag::Issue;
 
 /// Samples `check` evaluates with (enough to exercise every path, quick on any input).
 pub const CHECK_SAMPLES: u64 = 32;
@@ -110,18 +114,67 @@ pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<Strin
     Ok(out)
 }
 
-/// `posecov check`: read, evaluate with few samples and draw, without showing anything.
+/// What `posecov check` found: one line for stdout, and the first defect of each topic of a
+/// log for stderr (none for a scenario or a graph, whose errors stop the check).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Checked {
+    /// `NAME: ok (…)` or `NAME: defects on …`.
+    pub line: String,
+    /// One line per topic with a defect not `--allow`ed.
+    pub defects: Vec<String>,
+}
+
+impl Checked {
+    /// 0, or [`EXIT_FAILED`] when a defect was found.
+    pub fn exit_code(&self) -> u8 {
+        if self.defects.is_empty() {
+            0
+        } else {
+            EXIT_FAILED
+        }
+    }
+}
+
+/// The findings `--allow NAME` (repeatable) names, each checked against [`Issue::ALL`].
 ///
 /// ```
-/// let line = posecov::app::commands::check("camera_on_robot", &Default::default()).unwrap();
-/// assert!(line.starts_with("camera_on_robot: ok ("), "{line}");
+/// use posecov::app::commands::allowed;
+/// assert_eq!(allowed(&["constant".into()]).unwrap().len(), 1);
+/// let e = allowed(&["nan".into()]).unwrap_err().to_string();
+/// assert!(e.starts_with("--allow nan: out of range: one of non_finite, "), "{e}");
 /// ```
-pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> {
+pub fn allowed(names: &[String]) -> Result<Vec<Issue>, AppError> {
+    names
+        .iter()
+        .map(|n| {
+            Issue::from_name(n).ok_or_else(|| {
+                let all: Vec<&str> = Issue::ALL.iter().map(|i| i.name()).collect();
+                AppError::Settings(SettingsError::OutOfRange {
+                    flag: "--allow",
+                    value: n.clone(),
+                    expected: format!("one of {}", all.join(", ")),
+                })
+            })
+        })
+        .collect()
+}
+
+/// `posecov check`: read, evaluate with few samples and draw, without showing anything; a
+/// log's defects (other than the `allow`ed ones) are found, not errors (see [`Checked`]).
+///
+/// ```
+/// let checked = posecov::app::commands::check("camera_on_robot", &Default::default(), &[]).unwrap();
+/// assert!(checked.line.starts_with("camera_on_robot: ok ("), "{}", checked.line);
+/// assert_eq!(checked.exit_code(), 0);
+/// let log = posecov::app::commands::check("covariance_health", &Default::default(), &[]).unwrap();
+/// assert_eq!(log.exit_code(), 1);
+/// ```
+pub fn check(scenario: &str, overrides: &Overrides, allow: &[Issue]) -> Result<Checked, AppError> {
     let loaded = match open(scenario)? {
         Opened::Plan(loaded) => *loaded,
         Opened::Log(located) => {
             let run = bag::run(&located, &resolve_log(overrides)?, None)?;
-            return Ok(bag::check_line(scenario, &run));
+            return Ok(bag::check(&run, scenario, allow));
         }
     };
     let quick = Overrides {
@@ -136,7 +189,7 @@ pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> 
     let run = PlanRun::from_loaded(loaded, &quick, None)?;
     let (evaluation, scene) = (run.evaluation, run.scene);
     let findings = evaluation.findings().len();
-    Ok(format!(
+    let line = format!(
         "{scenario}: ok ({} results, {} drawn items, {} steps{})",
         evaluation.records().len(),
         scene.items.len(),
@@ -146,5 +199,9 @@ pub fn check(scenario: &str, overrides: &Overrides) -> Result<String, AppError> 
             1 => ", 1 finding (see `posecov report`)".to_owned(),
             n => format!(", {n} findings (see `posecov report`)"),
         }
-    ))
+    );
+    Ok(Checked {
+        line,
+        defects: Vec::new(),
+    })
 }

@@ -41,6 +41,27 @@ pub use settings::{
     SettingsError, resolve, resolve_log,
 };
 
+/// Exit code: success; notes (and, except for `check`, defects) in a log are not failures.
+pub const EXIT_OK: u8 = 0;
+/// Exit code: `check` found a defect in a log, or a scenario or graph has an error located in
+/// it (file:line:column).
+pub const EXIT_FAILED: u8 = 1;
+/// Exit code: the input cannot be processed — unreadable, an unknown format, a log with no
+/// pose-with-covariance topic, a damaged log — or the command line is wrong.
+pub const EXIT_CANNOT: u8 = 2;
+/// Exit code after Ctrl-C (128 + SIGINT), as shells expect.
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// The exit codes of every command, as `--help` and the README show them.
+pub const EXIT_CODES_HELP: &str = "\
+Exit codes (every command; `check` differs where shown):
+  0    success (notes in a log are allowed); stdout closed by the reader (`… | head`): quiet
+  1    check: defects found in a log (other commands show and report them, exit 0);
+       every command: a scenario or graph error located at file:line:column
+  2    cannot process: unreadable file, unknown format, no pose-with-covariance topic,
+       a damaged log, a usage error
+  130  interrupted (Ctrl-C)";
+
 /// Why a command could not run. Each names where the problem is in the user's words: the
 /// file, line, column and key, or the command-line flag.
 #[derive(Debug, thiserror::Error)]
@@ -69,6 +90,23 @@ pub enum AppError {
     /// Live mode: an input it cannot edit, a sink it cannot stream to, the page server.
     #[error("live: {0}")]
     Live(String),
+}
+
+impl AppError {
+    /// The process exit code of this error ([`EXIT_CODES_HELP`]): [`EXIT_FAILED`] for an
+    /// error located in a scenario or graph file, [`EXIT_CANNOT`] for everything else.
+    ///
+    /// ```
+    /// use posecov::app::{EXIT_CANNOT, EXIT_FAILED, load, load_text};
+    /// assert_eq!(load("no/such.toml").unwrap_err().exit_code(), EXIT_CANNOT);
+    /// assert_eq!(load_text("[scenario]\nsamples = 1\n", "t.toml").unwrap_err().exit_code(), EXIT_FAILED);
+    /// ```
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            AppError::Input(InputError::At { .. }) => EXIT_FAILED,
+            _ => EXIT_CANNOT,
+        }
+    }
 }
 
 /// An input and the file it came from (to locate evaluation errors in it), of any format.

@@ -14,8 +14,7 @@ use crate::sink::{
     render_png,
 };
 
-/// Exit code after Ctrl-C (128 + SIGINT), as shells expect.
-pub const EXIT_INTERRUPTED: u8 = 130;
+pub use super::EXIT_INTERRUPTED;
 /// Environment variable bounding how long a served viewer is served (seconds), e.g. for CI.
 pub const SERVE_SECONDS_ENV: &str = "POSECOV_SERVE_SECONDS";
 

@@ -30,7 +30,7 @@ use crate::uncertain::Method;
 
 mod text;
 
-pub use text::{description, issue_word};
+pub use text::{description, issue_sentence, issue_word};
 
 /// RViz's default covariance colour (its position shape).
 const RVIZ: Color = Color::rgb(204, 51, 204);

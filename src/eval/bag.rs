@@ -258,7 +258,7 @@ fn meaning(
             .zip(cov_ros.diagonal().iter())
             .any(|(u, v)| *u && *v != 0.0)
         {
-            return Err(vec![Issue::Placeholder]);
+            return Err(vec![Issue::PlaceholderUsedAxis]);
         }
         let right = ros_cov_to_right(cov_ros, mean.rotation(), reading);
         UncertainPose::try_new(*mean, right, Side::Right)
@@ -367,7 +367,7 @@ mod tests {
         un[3] = true;
         assert_eq!(
             meaning(&mean, &cov, &un, false, RosReading::Tf2).unwrap_err(),
-            vec![Issue::Placeholder]
+            vec![Issue::PlaceholderUsedAxis]
         );
     }
 }

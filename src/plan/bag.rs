@@ -6,8 +6,8 @@
 //! ```
 //! use posecov::plan::bag::{BagPlan, Health, Issue};
 //! let mut health = Health::default();
-//! health.note(Issue::Placeholder, 1_500_000_000);
-//! health.note(Issue::Placeholder, 1_000_000_000);
+//! health.note(Issue::Placeholder, 1_500_000_000, 0);
+//! health.note(Issue::Placeholder, 1_000_000_000, 1);
 //! assert_eq!(health.count(Issue::Placeholder), 2);
 //! assert_eq!(health.first(Issue::Placeholder), Some(1_000_000_000));
 //! assert!(BagPlan::default().topics.is_empty());
@@ -97,75 +97,216 @@ pub struct PoseMessage {
     pub twist_covariance: Option<[f64; COV_LEN]>,
 }
 
-/// A covariance problem one message can have (several at once).
+/// Whether a health finding makes a log's covariance untrustworthy (`posecov check` fails on
+/// it unless `--allow`ed) or is worth knowing only. Defects sort first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Class {
+    /// The covariance cannot be trusted as published.
+    Defect,
+    /// A fact about the covariance or the stamps, not an error.
+    Note,
+}
+
+/// A covariance-health finding (a message can have several). Its `--allow` name and JSON key
+/// is [`Issue::name`]; its class [`Issue::class`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Issue {
-    /// Every entry is 0: the publisher does not know (REP 105 / REP 145 "unknown").
-    AllZero,
-    /// `covariance[0] = -1`: ROS's marker for "this covariance is unknown".
-    UnknownMarker,
-    /// Some diagonal entry ≥ 1e6 (1e6, 1e9, 1.79e308 …): a placeholder for "not estimated".
-    Placeholder,
     /// An entry is NaN or ±∞.
     NonFinite,
-    /// Σ ≠ Σᵀ beyond rounding.
+    /// Σ ≠ Σᵀ beyond the tolerance.
     Asymmetric,
-    /// The smallest eigenvalue (over the estimated axes) is below zero beyond rounding.
+    /// The smallest eigenvalue (over the estimated axes) is below −tolerance.
     NotPsd,
-    /// The orientation is not a unit quaternion (or not finite).
-    BadOrientation,
-    /// The position covariance shrank suddenly (trace ÷ ≥ 5 from one message to the next):
-    /// a relocalisation, a loop closure or a reset.
-    SuddenDrop,
-    /// The position covariance kept growing without a correction (trace ≥ 100 × its value
-    /// after the last drop): dead reckoning only.
-    Growth,
     /// The bytes could not be decoded as the message type (truncated or another definition).
     Undecodable,
+    /// The orientation is not a unit quaternion (or not finite).
+    BadOrientation,
+    /// `covariance[0] = -1`: ROS's marker for "this covariance is unknown".
+    UnknownMarker,
+    /// Every entry is 0 on the estimated axes (placeholder axes aside): the publisher does not
+    /// know, or never filled it in.
+    AllZero,
+    /// A variance ≥ 1e6 on an axis the motion uses (x, y, yaw; all six on a 3-D topic).
+    PlaceholderUsedAxis,
+    /// The covariance stays identical (or, dead-reckoned, does not grow) while the pose moves.
+    Constant,
+    /// The same header stamp on consecutive messages.
+    FrozenStamp,
+    /// A variance ≥ 1e6 on an axis planar motion does not use (z, roll, pitch): "not
+    /// estimated".
+    Placeholder,
+    /// A zero header stamp, replaced by the log time.
+    StampFallback,
+    /// A stamp earlier than the message before.
+    StampOrder,
+    /// The position trace divided by ≥ 5 from one usable message to the next: a
+    /// relocalisation, a loop closure or a reset.
+    Drop,
+    /// The position trace ≥ 100 × its smallest value since the last drop: dead reckoning
+    /// without correction.
+    Growth,
 }
 
 impl Issue {
+    /// Every finding, defects first.
+    pub const ALL: [Issue; 15] = [
+        Issue::NonFinite,
+        Issue::Asymmetric,
+        Issue::NotPsd,
+        Issue::Undecodable,
+        Issue::BadOrientation,
+        Issue::UnknownMarker,
+        Issue::AllZero,
+        Issue::PlaceholderUsedAxis,
+        Issue::Constant,
+        Issue::FrozenStamp,
+        Issue::Placeholder,
+        Issue::StampFallback,
+        Issue::StampOrder,
+        Issue::Drop,
+        Issue::Growth,
+    ];
+
+    /// The `--allow` name and JSON key.
+    ///
+    /// ```
+    /// use posecov::plan::bag::Issue;
+    /// assert_eq!(Issue::PlaceholderUsedAxis.name(), "placeholder_used_axis");
+    /// assert_eq!(Issue::from_name("not_psd"), Some(Issue::NotPsd));
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            Issue::NonFinite => "non_finite",
+            Issue::Asymmetric => "asymmetric",
+            Issue::NotPsd => "not_psd",
+            Issue::Undecodable => "undecodable",
+            Issue::BadOrientation => "bad_orientation",
+            Issue::UnknownMarker => "unknown_marker",
+            Issue::AllZero => "all_zero",
+            Issue::PlaceholderUsedAxis => "placeholder_used_axis",
+            Issue::Constant => "constant",
+            Issue::FrozenStamp => "frozen_stamp",
+            Issue::Placeholder => "placeholder",
+            Issue::StampFallback => "stamp_fallback",
+            Issue::StampOrder => "stamp_order",
+            Issue::Drop => "drop",
+            Issue::Growth => "growth",
+        }
+    }
+
+    /// The finding of an `--allow` name, if any.
+    pub fn from_name(name: &str) -> Option<Issue> {
+        Issue::ALL.into_iter().find(|i| i.name() == name)
+    }
+
+    /// Defect or note; `constant` is a defect on a dead-reckoned topic (its covariance must
+    /// grow) and a note elsewhere.
+    ///
+    /// ```
+    /// use posecov::plan::bag::{Class, Issue};
+    /// assert_eq!(Issue::Constant.class(true), Class::Defect);
+    /// assert_eq!(Issue::Constant.class(false), Class::Note);
+    /// assert_eq!(Issue::Placeholder.class(true), Class::Note);
+    /// ```
+    pub fn class(self, dead_reckoned: bool) -> Class {
+        match self {
+            Issue::Constant if !dead_reckoned => Class::Note,
+            Issue::Placeholder
+            | Issue::StampFallback
+            | Issue::StampOrder
+            | Issue::Drop
+            | Issue::Growth => Class::Note,
+            _ => Class::Defect,
+        }
+    }
+
     /// Whether a message with this issue cannot be drawn as a Gaussian (it is drawn as an
-    /// invalid marker instead). Placeholders, drops and growth are facts, not errors.
+    /// invalid marker instead). Placeholders, stamps, drops, growth and constancy are facts
+    /// about a drawable covariance.
     ///
     /// ```
     /// use posecov::plan::bag::Issue;
     /// assert!(Issue::NotPsd.unusable() && !Issue::Placeholder.unusable());
     /// ```
     pub fn unusable(self) -> bool {
-        !matches!(self, Issue::Placeholder | Issue::SuddenDrop | Issue::Growth)
+        matches!(
+            self,
+            Issue::NonFinite
+                | Issue::Asymmetric
+                | Issue::NotPsd
+                | Issue::Undecodable
+                | Issue::BadOrientation
+                | Issue::UnknownMarker
+                | Issue::AllZero
+        )
     }
 }
 
-/// How often an issue was seen, and when first.
+/// How often an issue was seen, and where first.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct IssueCount {
     /// Messages with the issue.
     pub count: u64,
     /// Stamp (ns) of the earliest such message.
     pub first_stamp_ns: i64,
+    /// That message's number on its topic (0-based).
+    pub first_index: u64,
+}
+
+/// The longest stretch of messages over which a topic's covariance stayed identical (or, on a
+/// dead-reckoned topic, did not grow) while the pose moved.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Stretch {
+    /// Messages in it.
+    pub messages: u64,
+    /// The first one's number on the topic.
+    pub first_index: u64,
+    /// Its first stamp, ns.
+    pub first_stamp_ns: i64,
+    /// Its last stamp, ns.
+    pub last_stamp_ns: i64,
+    /// The distance the position travelled over it, m (sum of the steps).
+    pub distance_m: f64,
 }
 
 /// A topic's covariance health: per issue, the count and first stamp; the worst smallest
-/// eigenvalue of a not-PSD covariance.
+/// eigenvalue of a not-PSD covariance; the longest constant stretch.
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Health {
     /// Per issue.
     pub issues: BTreeMap<Issue, IssueCount>,
     /// The most negative smallest eigenvalue seen (only when some message is not PSD).
     pub min_eigenvalue: Option<f64>,
+    /// The longest stretch without growth while moving (when it makes a `constant` finding).
+    pub constant: Option<Stretch>,
 }
 
 impl Health {
-    /// Counts one message with `issue` at `stamp_ns`.
-    pub fn note(&mut self, issue: Issue, stamp_ns: i64) {
+    /// Counts message number `index` with `issue` at `stamp_ns`.
+    pub fn note(&mut self, issue: Issue, stamp_ns: i64, index: u64) {
+        self.add(
+            issue,
+            IssueCount {
+                count: 1,
+                first_stamp_ns: stamp_ns,
+                first_index: index,
+            },
+        );
+    }
+
+    /// Adds `counted` messages with `issue` (the earliest stamp is kept as the first).
+    pub fn add(&mut self, issue: Issue, counted: IssueCount) {
         let entry = self.issues.entry(issue).or_insert(IssueCount {
             count: 0,
-            first_stamp_ns: stamp_ns,
+            ..counted
         });
-        entry.count += 1;
-        entry.first_stamp_ns = entry.first_stamp_ns.min(stamp_ns);
+        entry.count += counted.count;
+        if counted.first_stamp_ns < entry.first_stamp_ns {
+            entry.first_stamp_ns = counted.first_stamp_ns;
+            entry.first_index = counted.first_index;
+        }
     }
 
     /// Messages with `issue`.
@@ -239,7 +380,41 @@ pub struct TopicPlan {
     pub series: Vec<SeriesPoint>,
 }
 
+/// Whether `frame_id` names an odometry frame as REP 105 does (`odom`, or a namespaced
+/// `robot1/odom`, `odom_combined`): poses in it are dead-reckoned, so their covariance grows.
+///
+/// ```
+/// use posecov::plan::bag::is_odom_frame;
+/// assert!(is_odom_frame("odom") && is_odom_frame("/robot1/odom") && !is_odom_frame("map"));
+/// ```
+pub fn is_odom_frame(frame_id: &str) -> bool {
+    frame_id
+        .rsplit('/')
+        .next()
+        .is_some_and(|last| last.starts_with("odom"))
+}
+
 impl TopicPlan {
+    /// An Odometry topic in an odometry frame ([`is_odom_frame`]): dead reckoning, whose
+    /// covariance must grow while the robot moves.
+    pub fn dead_reckoned(&self) -> bool {
+        self.kind == PoseMessageKind::Odometry && is_odom_frame(&self.frame_id)
+    }
+
+    /// The class of `issue` on this topic ([`Issue::class`]).
+    pub fn class(&self, issue: Issue) -> Class {
+        issue.class(self.dead_reckoned())
+    }
+
+    /// The defects found, with their counts, in the order of [`Issue::ALL`].
+    pub fn defects(&self) -> impl Iterator<Item = (Issue, IssueCount)> + '_ {
+        self.health
+            .issues
+            .iter()
+            .filter(|(i, _)| self.class(**i) == Class::Defect)
+            .map(|(i, c)| (*i, *c))
+    }
+
     /// √ of the twist covariance's diagonal (vx vy vz ωx ωy ωz, in the child frame) of the last
     /// drawn Odometry message, where finite and not a placeholder (`None` per entry otherwise;
     /// `None` for other types).

@@ -6,7 +6,7 @@ use std::fmt::Write;
 use crate::eval::bag::{BagEvaluation, PoseState};
 use crate::input::Format;
 use crate::interop::RosReading;
-use crate::plan::bag::{BagPlan, Issue, TopicPlan};
+use crate::plan::bag::{BagPlan, Class, Issue, TopicPlan};
 use crate::uncertain::chi2_radius;
 
 /// A stamp in seconds, as the timeline shows it.
@@ -14,7 +14,8 @@ fn secs(ns: i64) -> String {
     format!("{:.3} s", ns as f64 * 1e-9)
 }
 
-/// The word for a covariance issue, shown in the text panel, the text report and the README.
+/// The short word for a covariance-health finding (its `--allow` name is
+/// [`Issue::name`]), shown beside its sentence ([`issue_sentence`]).
 ///
 /// ```
 /// use posecov::{draw::bag::issue_word, plan::bag::Issue};
@@ -22,16 +23,98 @@ fn secs(ns: i64) -> String {
 /// ```
 pub fn issue_word(issue: Issue) -> &'static str {
     match issue {
-        Issue::AllZero => "all zero (unknown)",
-        Issue::UnknownMarker => "unknown (-1 marker)",
-        Issue::Placeholder => "placeholder (≥ 1e6)",
         Issue::NonFinite => "NaN or infinite",
         Issue::Asymmetric => "asymmetric",
         Issue::NotPsd => "not positive semi-definite",
-        Issue::BadOrientation => "orientation not a unit quaternion",
-        Issue::SuddenDrop => "sudden drop (relocalisation?)",
-        Issue::Growth => "unbounded growth",
         Issue::Undecodable => "undecodable bytes",
+        Issue::BadOrientation => "orientation not a unit quaternion",
+        Issue::UnknownMarker => "unknown (-1 marker)",
+        Issue::AllZero => "all zero (unknown)",
+        Issue::PlaceholderUsedAxis => "placeholder on a used axis",
+        Issue::Constant => "constant while moving",
+        Issue::FrozenStamp => "frozen stamp",
+        Issue::Placeholder => "placeholder (≥ 1e6)",
+        Issue::StampFallback => "stamp from the log time",
+        Issue::StampOrder => "stamp out of order",
+        Issue::Drop => "sudden drop (relocalisation?)",
+        Issue::Growth => "unbounded growth",
+    }
+}
+
+/// One plain sentence on what a finding means on topic `t` (with its numbers: the smallest
+/// eigenvalue, the constant stretch's span and distance).
+///
+/// ```
+/// use posecov::{draw::bag::issue_sentence, plan::bag::{Issue, TopicPlan, PoseMessageKind}};
+/// # let t = TopicPlan { name: "/odom".into(), kind: PoseMessageKind::Odometry, frame_id: "odom".into(),
+/// #     child_frame_id: String::new(), count: 0, stamps_from_log_time: 0, stamps_out_of_order: 0,
+/// #     stamp_range: None, health: Default::default(), planar: true, drawn: vec![], stride: 1,
+/// #     trajectory: vec![], series: vec![] };
+/// assert!(issue_sentence(Issue::AllZero, &t).starts_with("every estimated entry is 0"));
+/// ```
+pub fn issue_sentence(issue: Issue, t: &TopicPlan) -> String {
+    match issue {
+        Issue::NonFinite => "NaN or ∞ in the covariance.".to_owned(),
+        Issue::Asymmetric => "Σ ≠ Σᵀ beyond the tolerance (1e-9 relative).".to_owned(),
+        Issue::NotPsd => match t.health.min_eigenvalue {
+            Some(lo) => format!(
+                "a negative variance along some direction: smallest eigenvalue {lo:.3e}, below −tolerance."
+            ),
+            None => "a negative variance along some direction.".to_owned(),
+        },
+        Issue::Undecodable => format!(
+            "the bytes are not a {} (truncated, or another definition).",
+            t.kind.ros1_name()
+        ),
+        Issue::BadOrientation => "the quaternion's norm is not 1 (beyond 1e-3).".to_owned(),
+        Issue::UnknownMarker => "covariance[0] = −1, ROS's \"unknown\".".to_owned(),
+        Issue::AllZero => {
+            "every estimated entry is 0: no uncertainty claimed (or never filled in).".to_owned()
+        }
+        Issue::PlaceholderUsedAxis => {
+            let axes = if t.planar {
+                "x, y or yaw"
+            } else {
+                "an axis of a 3-D topic"
+            };
+            format!("a variance ≥ 1e6 on {axes}: an axis the motion uses is not estimated.")
+        }
+        Issue::Constant => match t.health.constant {
+            Some(c) => format!(
+                "the covariance {} over {} messages, {:.1} s and {:.1} m of motion{}.",
+                if t.dead_reckoned() {
+                    "never grows"
+                } else {
+                    "stays identical"
+                },
+                c.messages,
+                (c.last_stamp_ns - c.first_stamp_ns) as f64 * 1e-9,
+                c.distance_m,
+                if t.dead_reckoned() {
+                    "; dead-reckoned odometry integrates noise, so its covariance must grow"
+                } else {
+                    ""
+                }
+            ),
+            None => "the covariance does not change while the pose moves.".to_owned(),
+        },
+        Issue::FrozenStamp => "the same header stamp as the message before.".to_owned(),
+        Issue::Placeholder => {
+            "z, roll or pitch ≥ 1e6, \"not estimated\" on axes planar motion does not use."
+                .to_owned()
+        }
+        Issue::StampFallback => "a zero header stamp: the log time is used.".to_owned(),
+        Issue::StampOrder => {
+            "stamped earlier than the message before (plots are sorted by stamp).".to_owned()
+        }
+        Issue::Drop => {
+            "the position trace fell ÷ ≥ 5 at once (relocalisation, loop closure, reset)."
+                .to_owned()
+        }
+        Issue::Growth => {
+            "the position trace reached ≥ 100 × its value since the last drop (dead reckoning)."
+                .to_owned()
+        }
     }
 }
 
@@ -43,9 +126,18 @@ pub fn issue_word(issue: Issue) -> &'static str {
 pub fn description(plan: &BagPlan, format: Format, e: &BagEvaluation, confidence: f64) -> String {
     let mut s = String::new();
     let format = format.name();
+    let defects: u64 = plan
+        .topics
+        .iter()
+        .flat_map(|t| t.defects().map(|(_, c)| c.count))
+        .sum();
+    let verdict = match defects {
+        0 => "no covariance defect".to_owned(),
+        n => format!("**{n} message(s) with defects** (`posecov check` fails)"),
+    };
     let _ = writeln!(
         s,
-        "**{format}**: {} messages, {} pose topic(s) read.",
+        "**{format}**: {} messages, {} pose topic(s) read; {verdict}.",
         plan.messages_total,
         plan.topics.len()
     );
@@ -118,53 +210,24 @@ fn topic(
     p: f64,
     reading: RosReading,
 ) {
-    let _ = writeln!(s, "\n---\n\n**{}** ({})\n", t.name, t.kind.ros1_name());
-    if !t.frame_id.is_empty() || !t.child_frame_id.is_empty() {
-        let child = if t.child_frame_id.is_empty() {
-            String::new()
-        } else {
-            format!(" → `{}`", t.child_frame_id)
-        };
-        let _ = writeln!(s, "Frames: `{}`{child}.", t.frame_id);
+    let _ = write!(s, "\n---\n\n**{}** ({}", t.name, t.kind.ros1_name());
+    if !t.frame_id.is_empty() {
+        let _ = write!(s, ", `{}`", t.frame_id);
+        if !t.child_frame_id.is_empty() {
+            let _ = write!(s, " → `{}`", t.child_frame_id);
+        }
     }
-    let _ = write!(s, "{} messages", t.count);
+    if t.dead_reckoned() {
+        let _ = write!(s, ", dead-reckoned");
+    }
+    let _ = write!(s, "): {} messages", t.count);
     if let Some((a, b)) = t.stamp_range {
         let _ = write!(s, ", stamps {} … {}", secs(a), secs(b));
     }
     let _ = writeln!(s, ".");
-    if t.stamps_from_log_time > 0 {
-        let _ = writeln!(
-            s,
-            "\n{} message(s) had a zero header stamp: their log time is used.",
-            t.stamps_from_log_time
-        );
-    }
+    health(s, t);
     if t.kind == crate::plan::bag::PoseMessageKind::PoseWithCovariance {
         let _ = writeln!(s, "\nNo header: stamps are the log time.");
-    }
-    if t.stamps_out_of_order > 0 {
-        let _ = writeln!(
-            s,
-            "\n{} message(s) are stamped earlier than the one before (plots are sorted by stamp).",
-            t.stamps_out_of_order
-        );
-    }
-    if t.health.issues.is_empty() {
-        let _ = writeln!(s, "\nCovariance health: every message fine.");
-    } else {
-        let _ = writeln!(
-            s,
-            "\n| covariance health | messages | first at |\n|---|---|---|"
-        );
-        for (issue, c) in &t.health.issues {
-            let mut word = issue_word(*issue).to_owned();
-            if *issue == Issue::NotPsd
-                && let Some(lo) = t.health.min_eigenvalue
-            {
-                word = format!("{word} (smallest eigenvalue {lo:.3e})");
-            }
-            let _ = writeln!(s, "| {word} | {} | {} |", c.count, secs(c.first_stamp_ns));
-        }
     }
     if let Some(sig) = t.twist_sigmas() {
         let names = ["vx", "vy", "vz", "ωx", "ωy", "ωz"];
@@ -186,7 +249,7 @@ fn topic(
     let placeholders3d = e
         .poses
         .iter()
-        .filter(|q| matches!(&q.state, PoseState::Invalid { issues } if issues == &[Issue::Placeholder]))
+        .filter(|q| matches!(&q.state, PoseState::Invalid { issues } if issues == &[Issue::PlaceholderUsedAxis]))
         .count();
     let r2 = |d| chi2_radius(p, d).unwrap_or(f64::NAN);
     let shape = if t.planar {
@@ -235,4 +298,30 @@ fn topic(
             String::new()
         }
     );
+}
+
+/// A topic's health: its defects first (each with its `--allow` name, count, first stamp and
+/// message, and sentence), then its notes.
+fn health(s: &mut String, t: &TopicPlan) {
+    if t.health.issues.is_empty() {
+        let _ = writeln!(s, "\nCovariance health: no defect, no note.");
+        return;
+    }
+    let mut findings: Vec<_> = t.health.issues.iter().collect();
+    findings.sort_by_key(|(i, _)| (t.class(**i), **i));
+    for (issue, c) in findings {
+        let class = match t.class(*issue) {
+            Class::Defect => "**defect**",
+            Class::Note => "note",
+        };
+        let _ = writeln!(
+            s,
+            "\n- {class} `{}` × {}, first at {} (message {}): {}",
+            issue.name(),
+            c.count,
+            secs(c.first_stamp_ns),
+            c.first_index,
+            issue_sentence(*issue, t)
+        );
+    }
 }

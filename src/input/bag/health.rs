@@ -1,9 +1,10 @@
-//! Covariance health of one message, and the per-topic state that finds sudden drops and
-//! unbounded growth. Words and thresholds are the README's ("Covariance health").
+//! Covariance health of one message, and the per-topic state that finds drops, unbounded
+//! growth and a covariance that stays constant while the pose moves. Names, classes and
+//! thresholds are the README's ("Covariance health").
 
 use nalgebra::{DMatrix, SymmetricEigen};
 
-use crate::plan::bag::{COV_LEN, Issue};
+use crate::plan::bag::{COV_LEN, Issue, Stretch};
 
 pub use crate::plan::bag::PLACEHOLDER;
 /// Relative tolerance of the symmetry check: |Σᵢⱼ − Σⱼᵢ| ≤ tol · max(1, max |Σᵢᵢ|).
@@ -14,6 +15,12 @@ pub const PSD_TOLERANCE: f64 = 1e-9;
 pub const DROP_FACTOR: f64 = 5.0;
 /// Growth: the position trace at least this many times its value after the last drop.
 pub const GROWTH_FACTOR: f64 = 100.0;
+/// A `constant` finding needs a stretch over at least this distance (m) …
+pub const CONSTANT_MIN_DISTANCE_M: f64 = 1.0;
+/// … and at least this many messages.
+pub const CONSTANT_MIN_MESSAGES: u64 = 10;
+/// The axes planar motion uses (x, y, yaw), by ROS index.
+const PLANAR_AXES: [usize; 3] = [0, 1, 5];
 
 /// What one message's covariance is.
 #[derive(Debug, Clone, PartialEq)]
@@ -65,16 +72,24 @@ pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHeal
             position_trace: None,
         };
     }
-    if cov[0] == -1.0 {
-        issues.push(Issue::UnknownMarker);
-    } else if cov.iter().all(|v| *v == 0.0) {
-        issues.push(Issue::AllZero);
-    }
-    if diag.iter().any(|v| *v >= PLACEHOLDER) {
-        issues.push(Issue::Placeholder);
-    }
     // The estimated axes: not a placeholder (a huge row would swamp the rounding of the rest).
     let kept: Vec<usize> = (0..6).filter(|&i| diag[i] < PLACEHOLDER).collect();
+    if cov[0] == -1.0 {
+        issues.push(Issue::UnknownMarker);
+    } else if !kept.is_empty()
+        && kept
+            .iter()
+            .all(|&i| kept.iter().all(|&j| cov[i * 6 + j] == 0.0))
+    {
+        issues.push(Issue::AllZero);
+    }
+    if PLANAR_AXES.iter().any(|&i| diag[i] >= PLACEHOLDER) {
+        issues.push(Issue::PlaceholderUsedAxis);
+    } else if diag.iter().any(|v| *v >= PLACEHOLDER) {
+        // z, roll or pitch only: a note if the topic turns out planar, else a defect (the
+        // topic's collector decides when it has seen every message).
+        issues.push(Issue::Placeholder);
+    }
     let scale = kept.iter().map(|&i| diag[i].abs()).fold(0.0, f64::max);
     let tol = SYMMETRY_TOLERANCE * scale.max(1.0);
     let asymmetric = kept.iter().any(|&i| {
@@ -134,7 +149,7 @@ impl Trend {
     /// use posecov::plan::bag::Issue;
     /// let mut t = Trend::default();
     /// assert!(t.next(1.0).is_empty());
-    /// assert_eq!(t.next(0.1), vec![Issue::SuddenDrop]);
+    /// assert_eq!(t.next(0.1), vec![Issue::Drop]);
     /// assert!(t.next(5.0).is_empty());
     /// assert_eq!(t.next(10.0), vec![Issue::Growth]);
     /// ```
@@ -146,7 +161,7 @@ impl Trend {
         if let Some(prev) = self.previous
             && trace * DROP_FACTOR <= prev
         {
-            out.push(Issue::SuddenDrop);
+            out.push(Issue::Drop);
             self.floor = None;
         }
         let floor = self.floor.map_or(trace, |f| f.min(trace));
@@ -156,6 +171,95 @@ impl Trend {
         self.floor = Some(floor);
         self.previous = Some(trace);
         out
+    }
+}
+
+/// The running search for a topic's longest stretch of usable messages whose covariance
+/// stays identical — or, on a dead-reckoned topic, does not grow (the trace of the estimated
+/// block) — while the pose moves.
+#[derive(Debug, Clone, Default)]
+pub struct Constancy {
+    previous: Option<([f64; COV_LEN], f64, [f64; 3])>,
+    current: Option<Stretch>,
+    longest: Option<Stretch>,
+}
+
+impl Constancy {
+    /// The next usable message (number `index` on the topic) with covariance `cov` at
+    /// `position`; `dead_reckoned`: a covariance that does not grow counts as constant.
+    ///
+    /// ```
+    /// use posecov::input::bag::health::Constancy;
+    /// let mut c = Constancy::default();
+    /// let mut cov = [0.0; 36];
+    /// cov[0] = 0.01;
+    /// for k in 0..20 {
+    ///     c.next(k, k as i64 * 1_000_000_000, &cov, [0.5 * k as f64, 0.0, 0.0], false);
+    /// }
+    /// let s = c.finding().unwrap();
+    /// assert_eq!((s.messages, s.first_index, s.last_stamp_ns), (20, 0, 19_000_000_000));
+    /// assert!((s.distance_m - 9.5).abs() < 1e-12);
+    /// ```
+    pub fn next(
+        &mut self,
+        index: u64,
+        stamp_ns: i64,
+        cov: &[f64; COV_LEN],
+        position: [f64; 3],
+        dead_reckoned: bool,
+    ) {
+        let trace: f64 = (0..6)
+            .map(|i| cov[i * 7])
+            .filter(|v| *v < PLACEHOLDER)
+            .sum();
+        let continues = self
+            .previous
+            .is_some_and(|(c, t, _)| c == *cov || (dead_reckoned && trace <= t));
+        let step = match self.previous {
+            Some((_, _, p)) => {
+                let d = (0..3)
+                    .map(|i| (position[i] - p[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                if d.is_finite() { d } else { 0.0 }
+            }
+            None => 0.0,
+        };
+        match &mut self.current {
+            Some(s) if continues => {
+                s.messages += 1;
+                s.last_stamp_ns = stamp_ns;
+                s.distance_m += step;
+            }
+            _ => {
+                self.close();
+                self.current = Some(Stretch {
+                    messages: 1,
+                    first_index: index,
+                    first_stamp_ns: stamp_ns,
+                    last_stamp_ns: stamp_ns,
+                    distance_m: 0.0,
+                });
+            }
+        }
+        self.previous = Some((*cov, trace, position));
+    }
+
+    fn close(&mut self) {
+        if let Some(s) = self.current.take()
+            && self.longest.is_none_or(|l| s.distance_m > l.distance_m)
+        {
+            self.longest = Some(s);
+        }
+    }
+
+    /// The longest stretch, when it makes a `constant` finding: at least
+    /// [`CONSTANT_MIN_MESSAGES`] messages over at least [`CONSTANT_MIN_DISTANCE_M`].
+    pub fn finding(mut self) -> Option<Stretch> {
+        self.close();
+        self.longest.filter(|s| {
+            s.messages >= CONSTANT_MIN_MESSAGES && s.distance_m >= CONSTANT_MIN_DISTANCE_M
+        })
     }
 }
 
@@ -182,6 +286,15 @@ mod tests {
         assert_eq!(
             classify(&diag([0.1, 0.1, 1.79e308, 0.1, 0.1, 0.1]), Q).issues,
             vec![Issue::Placeholder]
+        );
+        assert_eq!(
+            classify(&diag([1e6, 0.1, 0.1, 0.1, 0.1, 0.1]), Q).issues,
+            vec![Issue::PlaceholderUsedAxis]
+        );
+        // Zeros on x, y, yaw with placeholders elsewhere: nothing is estimated.
+        assert_eq!(
+            classify(&diag([0.0, 0.0, 1e6, 1e6, 1e6, 0.0]), Q).issues,
+            vec![Issue::AllZero, Issue::Placeholder]
         );
         let mut n = diag([0.1; 6]);
         n[3] = f64::NAN;

@@ -21,8 +21,8 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::plan::bag::{
-    BagPlan, DrawnMessage, Health, Issue, PoseMessage, PoseMessageKind, SeriesPoint, SkippedTopic,
-    TopicPlan,
+    BagPlan, DrawnMessage, Health, Issue, IssueCount, PoseMessage, PoseMessageKind, SeriesPoint,
+    SkippedTopic, TopicPlan, is_odom_frame,
 };
 
 use super::format::{self, Format};
@@ -107,7 +107,16 @@ pub fn read_located(
                 });
             }
         }
-        collector.finish(path)
+        let plan = collector.finish(path)?;
+        // Nothing to draw is an error for every command (no empty recording), unless Ctrl-C
+        // stopped the read before the first pose message.
+        if !plan.cancelled && plan.topics.iter().all(|t| t.count == 0) {
+            return Err(InputError::Format {
+                file: path.display().to_string(),
+                message: no_pose_topic(&plan),
+            });
+        }
+        Ok(plan)
     };
     match &located.place {
         Place::File(path) => read(path, progress),
@@ -158,6 +167,7 @@ struct TopicState {
     range: Option<(i64, i64)>,
     health: Health,
     trend: health::Trend,
+    constancy: health::Constancy,
     usable: u64,
     planar: bool,
     drawn: Decimator<DrawnMessage>,
@@ -386,6 +396,41 @@ impl<'a> Collector<'a> {
     }
 }
 
+/// Why a log has nothing to draw: the topics it has (type and count), its pose topics without
+/// messages, and the types posecov reads.
+fn no_pose_topic(plan: &BagPlan) -> String {
+    const SHOWN: usize = 12;
+    let mut has: Vec<String> = plan
+        .skipped
+        .iter()
+        .take(SHOWN)
+        .map(|k| format!("{} ({}, {} messages)", k.name, k.message_type, k.count))
+        .collect();
+    if plan.skipped.len() > SHOWN {
+        has.push(format!("… and {} more topics", plan.skipped.len() - SHOWN));
+    }
+    let empty: Vec<&str> = plan.topics.iter().map(|t| t.name.as_str()).collect();
+    if !empty.is_empty() {
+        has.push(format!(
+            "pose topics without messages: {}",
+            empty.join(", ")
+        ));
+    }
+    let has = if has.is_empty() {
+        "no messages at all".to_owned()
+    } else {
+        has.join(", ")
+    };
+    let reads: Vec<String> = PoseMessageKind::ALL
+        .iter()
+        .map(|k| format!("{} (ROS 2: {})", k.ros1_name(), k.ros2_name()))
+        .collect();
+    format!(
+        "no pose-with-covariance topic to draw; the log has {has}; posecov reads {}",
+        reads.join(", ")
+    )
+}
+
 impl TopicState {
     fn new(kind: PoseMessageKind, every: Option<u64>) -> Self {
         TopicState {
@@ -399,6 +444,7 @@ impl TopicState {
             range: None,
             health: Health::default(),
             trend: health::Trend::default(),
+            constancy: health::Constancy::default(),
             usable: 0,
             planar: true,
             drawn: match every {
@@ -416,7 +462,7 @@ impl TopicState {
         let d = match decoded {
             Ok(d) => d,
             Err(_) => {
-                self.health.note(Issue::Undecodable, log_time_ns);
+                self.health.note(Issue::Undecodable, log_time_ns, index);
                 return;
             }
         };
@@ -424,11 +470,17 @@ impl TopicState {
             Some(s) => (s, false),
             None => (log_time_ns, true),
         };
-        if from_log_time && self.kind != PoseMessageKind::PoseWithCovariance {
+        let headed = self.kind != PoseMessageKind::PoseWithCovariance;
+        if from_log_time && headed {
             self.from_log += 1;
+            self.health.note(Issue::StampFallback, stamp_ns, index);
         }
         if self.last_stamp.is_some_and(|last| stamp_ns < last) {
             self.out_of_order += 1;
+            self.health.note(Issue::StampOrder, stamp_ns, index);
+        }
+        if headed && !from_log_time && self.last_stamp == Some(stamp_ns) {
+            self.health.note(Issue::FrozenStamp, stamp_ns, index);
         }
         self.last_stamp = Some(stamp_ns);
         self.range = Some(match self.range {
@@ -446,7 +498,7 @@ impl TopicState {
             h.issues.extend(self.trend.next(trace));
         }
         for issue in &h.issues {
-            self.health.note(*issue, stamp_ns);
+            self.health.note(*issue, stamp_ns, index);
         }
         if h.issues.contains(&Issue::NotPsd) {
             let lo = h.min_eigenvalue.unwrap_or(0.0);
@@ -456,6 +508,10 @@ impl TopicState {
         if usable {
             self.usable += 1;
             self.planar &= h.unestimated[2] && h.unestimated[3] && h.unestimated[4];
+            let dead_reckoned = self.kind == PoseMessageKind::Odometry
+                && self.frame_id.as_deref().is_some_and(is_odom_frame);
+            self.constancy
+                .next(index, stamp_ns, &d.covariance, d.position, dead_reckoned);
             if d.position.iter().all(|v| v.is_finite()) {
                 self.trajectory.push(index, (stamp_ns, d.position));
             }
@@ -499,6 +555,23 @@ impl TopicState {
         trajectory.sort_by_key(|p| p.0);
         let mut series = self.series.into_items();
         series.sort_by_key(|p| p.stamp_ns);
+        let planar = self.planar && self.usable > 0;
+        let mut health = self.health;
+        if !planar && let Some(on_used_axes) = health.issues.remove(&Issue::Placeholder) {
+            // z, roll and pitch are axes a 3-D topic uses.
+            health.add(Issue::PlaceholderUsedAxis, on_used_axes);
+        }
+        if let Some(stretch) = self.constancy.finding() {
+            health.add(
+                Issue::Constant,
+                IssueCount {
+                    count: stretch.messages,
+                    first_stamp_ns: stretch.first_stamp_ns,
+                    first_index: stretch.first_index,
+                },
+            );
+            health.constant = Some(stretch);
+        }
         TopicPlan {
             name,
             kind: self.kind,
@@ -508,8 +581,8 @@ impl TopicState {
             stamps_from_log_time: self.from_log,
             stamps_out_of_order: self.out_of_order,
             stamp_range: self.range,
-            health: self.health,
-            planar: self.planar && self.usable > 0,
+            health,
+            planar,
             drawn: self.drawn.into_items(),
             stride,
             trajectory,
