@@ -209,7 +209,8 @@ pub fn text_width(text: &str, size: f64) -> f64 {
 ///
 /// ```
 /// use posecov::sink::figure::svg::wrap;
-/// assert_eq!(wrap("first order: Cartesian ellipse", 10.0, 100.0), vec!["first order: Cartesian", "ellipse"]);
+/// // At 10 px a line of 100 px holds about 18 characters.
+/// assert_eq!(wrap("first order: Cartesian ellipse", 10.0, 100.0), vec!["first order:", "Cartesian ellipse"]);
 /// ```
 pub fn wrap(text: &str, size: f64, width: f64) -> Vec<String> {
     let mut lines: Vec<String> = Vec::new();
