@@ -274,11 +274,10 @@ struct ServeArgs {
 }
 
 fn parse_probability(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(p) if p > 0.0 && p < 1.0 => Ok(p),
-        Ok(p) => Err(format!("{p} is not strictly between 0 and 1")),
-        Err(err) => Err(err.to_string()),
-    }
+    let p = s.parse::<f64>().map_err(|e| e.to_string())?;
+    posecov::uncertain::Confidence::new(p)
+        .map(posecov::uncertain::Confidence::get)
+        .map_err(|e| e.to_string())
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -12,7 +12,8 @@ use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 
 mod confidence;
 pub use confidence::{
-    Coverage, Region, anees_band, chi2_probability, chi2_radius, sigma_probability, sigma_radius,
+    Confidence, ConfidenceError, Coverage, Region, anees_band, chi2_probability, chi2_radius,
+    sigma_probability, sigma_radius,
 };
 
 /// Which side of the mean a covariance's perturbation multiplies.

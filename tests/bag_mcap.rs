@@ -381,3 +381,53 @@ fn damaged_mcap_is_an_error_not_a_panic() {
     let _ = read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A chunk whose header gives another uncompressed size than its data has (a few falsified
+/// bytes) ends with an error naming the file, at once: it once made the reader spin without
+/// end.
+#[test]
+fn a_falsified_chunk_size_ends_with_an_error() {
+    let bytes = write_example();
+    // The data section's records: opcode, length, body; a chunk's body starts with its
+    // start and end times, then its uncompressed size.
+    let mut chunks = Vec::new();
+    let mut at = 8;
+    while at + 9 <= bytes.len() {
+        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+        if bytes[at] == 0x06 {
+            chunks.push(at + 9 + 16);
+        }
+        if bytes[at] == 0x0f || bytes[at] == 0x02 {
+            break; // data end, footer
+        }
+        at += 9 + len;
+    }
+    assert!(!chunks.is_empty(), "the example has chunks");
+    let dir = std::env::temp_dir().join(format!("posecov-mcap-size-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (k, change) in [1i64, 64, -1, 1 << 20].into_iter().enumerate() {
+        let mut damaged = bytes.clone();
+        for &size_at in &chunks {
+            let size = u64::from_le_bytes(damaged[size_at..size_at + 8].try_into().unwrap());
+            let falsified = size.wrapping_add_signed(change);
+            damaged[size_at..size_at + 8].copy_from_slice(&falsified.to_le_bytes());
+        }
+        let path = dir.join(format!("size{k}.mcap"));
+        std::fs::write(&path, &damaged).unwrap();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let p = path.clone();
+        std::thread::spawn(move || {
+            let r = read_bag(&p, &BagOptions::default(), &mut |_, _| {}, None).map(drop);
+            tx.send(r.map_err(|e| e.to_string())).ok();
+        });
+        let result = rx
+            .recv_timeout(std::time::Duration::from_secs(30))
+            .unwrap_or_else(|_| panic!("uncompressed size {change:+}: still reading after 30 s"));
+        let e = result.expect_err("a falsified chunk size is an error");
+        assert!(
+            e.contains(&format!("size{k}.mcap")) && e.contains("header says"),
+            "{change:+}: {e}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -139,11 +139,11 @@ pub struct Settings {
 
 /// `--confidence` must be a probability strictly between 0 and 1 (every input's check).
 fn check_confidence(confidence: Option<f64>) -> Result<(), SettingsError> {
-    match confidence {
-        Some(p) if !(p > 0.0 && p < 1.0) => Err(SettingsError::OutOfRange {
+    match confidence.map(crate::uncertain::Confidence::new) {
+        Some(Err(e)) => Err(SettingsError::OutOfRange {
             flag: "--confidence",
-            value: p.to_string(),
-            expected: "a probability strictly between 0 and 1, e.g. 0.95".to_owned(),
+            value: e.value.to_string(),
+            expected: e.to_string(),
         }),
         _ => Ok(()),
     }

@@ -73,6 +73,8 @@ impl InputKind {
 pub const ROSBAG_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 /// MCAP magic.
 pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
+/// SQLite's magic (ROS 2's default `.db3` bag storage, which posecov does not read).
+const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
 /// The g2o / GTSAM records posecov reads (any of them first identifies a graph).
 pub const GRAPH_TAGS: &[&str] = &[
     "VERTEX_SE2",
@@ -252,6 +254,8 @@ fn expected() -> String {
 /// assert_eq!(detect("noext", b"EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n").unwrap(), Format::Graph);
 /// let e = detect("a.bag", b"\x89MCAP0\r\n").unwrap_err().to_string();
 /// assert!(e.starts_with("a.bag: the extension .bag says ROS 1 bag, but its content is a MCAP file"), "{e}");
+/// let e = detect("run_0.db3", b"SQLite format 3\0...").unwrap_err().to_string();
+/// assert!(e.contains("ros2 bag convert"), "{e}");
 /// let e = detect("notes.csv", b"1,2,3\n").unwrap_err().to_string();
 /// assert!(e.starts_with("notes.csv: not a file posecov reads"), "{e}");
 /// ```
@@ -269,6 +273,14 @@ pub fn detect(file: &str, head: &[u8]) -> Result<Format, InputError> {
         file: file.to_owned(),
         message,
     };
+    if extension.eq_ignore_ascii_case("db3") || head.starts_with(SQLITE_MAGIC) {
+        return Err(error(
+            "a ROS 2 bag in SQLite storage (.db3); posecov reads MCAP: convert it with \
+             `ros2 bag convert -i BAG_DIR -o out.yaml` (out.yaml naming `storage_id: mcap`), \
+             or record with `ros2 bag record -s mcap`"
+                .to_owned(),
+        ));
+    }
     match (by_extension, by_content) {
         (Some(e), Some(c)) if e == c => Ok(e),
         (Some(e), Some(c)) => Err(error(format!(
@@ -285,11 +297,13 @@ pub fn detect(file: &str, head: &[u8]) -> Result<Format, InputError> {
             e.name(),
             what_identifies(e)
         ))),
-        (Some(e), None) if first_text_line(head).is_some() || head.is_empty() => Ok(e),
-        (Some(e), None) => Err(error(format!(
-            "the extension .{extension} says {}, but the file is not text",
-            e.name()
-        ))),
+        (Some(e), None) => match super::not_text(file, head, &format!("a {}", e.name())) {
+            // A multi-byte character cut by the sniffed length is not the file's end.
+            Some(_) if head.len() == SNIFF_BYTES && first_text_line(head).is_some() => Ok(e),
+            Some(located) => Err(located),
+            // Text whose first token is not recognised: the format's parser names the line.
+            None => Ok(e),
+        },
         (None, None) => Err(error(format!(
             "not a file posecov reads: {}; expected a {}",
             describe(head),

@@ -172,6 +172,47 @@ impl Locator {
     }
 }
 
+/// The first byte of `bytes` that is not text (a NUL byte, or a byte that is not valid
+/// UTF-8, including a sequence cut short), located at its line and column, or `None` when all
+/// of `bytes` is text. `what` names the format ("a TOML scenario").
+///
+/// ```
+/// use posecov::input::not_text;
+/// let e = not_text("a.toml", b"x = 1\ny = \xff\n", "a TOML scenario").unwrap();
+/// assert_eq!(e.to_string().lines().next().unwrap(), "a.toml:2:5: file: byte 0xFF is not UTF-8 text; a TOML scenario is text");
+/// assert!(not_text("a.toml", b"x = 1\n", "a TOML scenario").is_none());
+/// ```
+pub fn not_text(file: &str, bytes: &[u8], what: &str) -> Option<InputError> {
+    let (valid, kind) = match std::str::from_utf8(bytes) {
+        Ok(_) => (bytes.len(), None),
+        Err(e) if e.error_len().is_none() => (
+            e.valid_up_to(),
+            Some("a UTF-8 sequence cut short at the end of the file"),
+        ),
+        Err(e) => (e.valid_up_to(), Some("")),
+    };
+    let nul = bytes[..valid].iter().position(|&b| b == 0);
+    let (offset, message) = match (nul, kind) {
+        (Some(i), _) => (i, "a NUL byte is not text".to_owned()),
+        (None, None) => return None,
+        (None, Some("")) => (
+            valid,
+            format!("byte 0x{:02X} is not UTF-8 text", bytes[valid]),
+        ),
+        (None, Some(k)) => (valid, format!("{k} is not UTF-8 text")),
+    };
+    let text = std::str::from_utf8(&bytes[..offset]).unwrap_or_default();
+    let line_start = text.rfind('\n').map_or(0, |i| i + 1);
+    Some(InputError::At {
+        file: file.to_owned(),
+        line: text.matches('\n').count() + 1,
+        column: text[line_start..].chars().count() + 1,
+        field: "file".to_owned(),
+        message: format!("{message}; {what} is text"),
+        source_line: String::new(),
+    })
+}
+
 fn floor_char_boundary(s: &str, mut i: usize) -> usize {
     while i > 0 && !s.is_char_boundary(i) {
         i -= 1;

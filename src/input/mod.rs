@@ -33,9 +33,10 @@ pub mod format;
 pub mod graph;
 mod located;
 pub mod scenario;
+pub mod suggest;
 
 pub use format::{Format, InputKind};
-pub use located::{InputError, Locator};
+pub use located::{InputError, Locator, not_text};
 
 /// The file an [`Input`] came from, kept to locate later (evaluation) errors in it.
 #[derive(Debug, Clone)]
@@ -189,6 +190,14 @@ pub fn locate(name_or_path: &str) -> Result<Located, InputError> {
             format: e.format,
         });
     }
+    // A path (it has a directory in it): the file is missing, a bundled name was not meant.
+    if name_or_path.contains(['/', '\\']) {
+        return Err(InputError::Read {
+            path: name_or_path.to_owned(),
+            reason: "no such file".to_owned(),
+        });
+    }
+    let guess = suggest::did_you_mean(name_or_path, examples.iter().map(|e| e.name));
     let by_format: Vec<String> = Format::ALL
         .iter()
         .filter_map(|f| {
@@ -203,7 +212,7 @@ pub fn locate(name_or_path: &str) -> Result<Located, InputError> {
     Err(InputError::Read {
         path: name_or_path.to_owned(),
         reason: format!(
-            "no such file, and no bundled example of that name (see `posecov list`; {})",
+            "no such file, and no bundled example of that name; {guess}(see `posecov list`; {})",
             by_format.join("; ")
         ),
     })
@@ -215,6 +224,10 @@ pub fn locate(name_or_path: &str) -> Result<Located, InputError> {
 /// ```
 /// let e = posecov::input::open("no_such_thing").unwrap_err().to_string();
 /// assert!(e.contains("camera_on_robot") && e.contains("gtsam_pose2example"), "{e}");
+/// let e = posecov::input::open("camera_on_robt").unwrap_err().to_string();
+/// assert!(e.contains("did you mean `camera_on_robot`?"), "{e}");
+/// let e = posecov::input::open("logs/run_7.mcap").unwrap_err().to_string();
+/// assert_eq!(e, "logs/run_7.mcap: cannot read input: no such file");
 /// ```
 pub fn open(name_or_path: &str) -> Result<(Source, Input), InputError> {
     open_located(&locate(name_or_path)?)

@@ -38,6 +38,7 @@ enum GuardKind {
         url: String,
     },
     Memory(rr::sink::MemorySinkStorage),
+    Stdout(rr::sink::MemorySinkStorage),
 }
 
 /// Opens `sink` as a recording stream with fixed ids, the default layout, and no recording
@@ -80,7 +81,11 @@ pub fn open_stream(
                     ),
                 });
             }
-            (builder.stdout()?, plain(false))
+            // Kept in memory and written whole when finished: a reader that closes the pipe
+            // early (`| head -c 10`) then ends the run at once and quietly, which the SDK's
+            // stdout writer thread does not (it can hang or report a shutdown).
+            let (rec, storage) = builder.memory()?;
+            (rec, GuardKind::Stdout(storage))
         }
         Sink::Spawn => {
             let viewer = find_native_viewer()?;
@@ -234,11 +239,33 @@ impl SinkGuard {
                 drop(rec);
                 Ok(None)
             }
+            GuardKind::Stdout(storage) => {
+                let bytes = storage
+                    .drain_as_bytes()
+                    .map_err(|err| SinkError::Flush(err.to_string()))?;
+                write_stdout(&bytes)?;
+                Ok(None)
+            }
             GuardKind::Memory(storage) => storage
                 .drain_as_bytes()
                 .map(Some)
                 .map_err(|err| SinkError::Flush(err.to_string())),
         }
+    }
+}
+
+/// Writes a finished recording to stdout. A reader that closed the pipe (`| head -c 10`)
+/// wanted no more: that is not an error (as `ripgrep` and `cat` do).
+fn write_stdout(bytes: &[u8]) -> Result<(), SinkError> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(bytes).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        result => result.map_err(|source| SinkError::Io {
+            action: "writing a recording to",
+            path: "stdout".into(),
+            source,
+        }),
     }
 }
 

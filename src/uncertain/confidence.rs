@@ -191,5 +191,63 @@ impl Coverage {
             inside: q,
             stderr: (q * (1.0 - q) / n).sqrt(),
         }
+
+/// A confidence: the probability p ∈ (0, 1) a drawn region holds (`--confidence`,
+/// `[scenario] confidence`). Checked once, here, wherever it is given.
+///
+/// ```
+/// use posecov::uncertain::Confidence;
+/// assert_eq!(Confidence::new(0.95).unwrap().get(), 0.95);
+/// assert_eq!(Confidence::new(95.0).unwrap_err().to_string(), "95 is not a probability in (0, 1); did you mean 0.95?");
+/// assert_eq!(Confidence::new(1.0).unwrap_err().to_string(), "1 is not a probability in (0, 1), e.g. 0.95");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, serde::Serialize)]
+#[serde(transparent)]
+pub struct Confidence(f64);
+
+/// A number that is not a probability in (0, 1).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("{value} is not a probability in (0, 1){}", hint(*.value))]
+pub struct ConfidenceError {
+    /// The number given.
+    pub value: f64,
+}
+
+/// A percentage (1 < v < 100) was probably meant as a fraction.
+fn hint(value: f64) -> String {
+    if value > 1.0 && value < 100.0 {
+        format!("; did you mean {}?", value / 100.0)
+    } else {
+        ", e.g. 0.95".to_owned()
+    }
+}
+
+impl Confidence {
+    /// The 95 % regions drawn by default.
+    pub const DEFAULT: Confidence = Confidence(0.95);
+
+    /// `p` if it lies strictly between 0 and 1.
+    ///
+    /// # Errors
+    /// [`ConfidenceError`] otherwise (NaN too), suggesting `p / 100` for a percentage.
+    ///
+    /// ```
+    /// assert!(posecov::uncertain::Confidence::new(f64::NAN).is_err());
+    /// ```
+    pub fn new(p: f64) -> std::result::Result<Self, ConfidenceError> {
+        if p > 0.0 && p < 1.0 {
+            Ok(Self(p))
+        } else {
+            Err(ConfidenceError { value: p })
+        }
+    }
+
+    /// The probability.
+    ///
+    /// ```
+    /// assert_eq!(posecov::uncertain::Confidence::DEFAULT.get(), 0.95);
+    /// ```
+    pub fn get(self) -> f64 {
+        self.0
     }
 }

@@ -14,6 +14,9 @@ use crate::app::{AppError, Loaded, load_text};
 use crate::input::scenario::bundled;
 use crate::uncertain::Method;
 
+/// Monte Carlo samples of the evaluation that checks an edited file before it is accepted.
+const EDIT_CHECK_SAMPLES: u64 = 16;
+
 /// A change asked for by the page (or a test): a control's id and its new value.
 #[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
 pub struct Edit {
@@ -170,7 +173,8 @@ impl LiveDocument {
         &self.origin
     }
 
-    /// Applies `edit` if the edited file loads; else returns why and changes nothing.
+    /// Applies `edit` if the edited file loads, evaluates and draws (a quick pass with few
+    /// samples); else returns why and changes nothing.
     ///
     /// # Errors
     /// [`EditError`], naming the control or the file's field.
@@ -197,6 +201,16 @@ impl LiveDocument {
         write(&mut doc, &slot, edit.value)?;
         let text = doc.to_string();
         let mut loaded = load_text(&text, &self.origin)?;
+        // The file's checks pass; its numbers must also evaluate and draw (a control of 1e16
+        // overflows only there), as `posecov check` would find. A quick pass, few samples.
+        let quick = crate::app::Overrides {
+            samples: Some(EDIT_CHECK_SAMPLES),
+            ..Default::default()
+        };
+        crate::app::pipeline(&loaded, &quick, None).map_err(|e| EditError::Value {
+            id: edit.id.clone(),
+            message: format!("the file with this value does not evaluate: {e}"),
+        })?;
         self.doc = doc;
         let note = changes(&self.file_controls, &self.controls());
         loaded.input.about.description.push_str(&note);

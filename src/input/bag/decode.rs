@@ -165,7 +165,7 @@ pub fn decode_ros1(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, Decod
         }
         _ => None,
     };
-    Ok(Decoded {
+    within_reach(Decoded {
         stamp_ns,
         frame_id,
         child_frame_id,
@@ -174,6 +174,20 @@ pub fn decode_ros1(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, Decod
         covariance,
         twist_covariance,
     })
+}
+
+/// A message whose position lies beyond ±[`MAX_COORDINATE`](crate::plan::limits::MAX_COORDINATE)
+/// (1e12 m, as in a scenario file) cannot be drawn or evaluated: it is refused as a decoding
+/// error (the `undecodable` defect), not handed on.
+fn within_reach(d: Decoded) -> Result<Decoded, DecodeError> {
+    let limit = crate::plan::limits::MAX_COORDINATE;
+    if d.position.iter().any(|v| v.is_finite() && v.abs() > limit) {
+        return Err(DecodeError(format!(
+            "pose.position = {:?} lies beyond ±{limit:e} m",
+            d.position
+        )));
+    }
+    Ok(d)
 }
 
 // --------------------------------------------------------------------------------------------
@@ -326,7 +340,7 @@ pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, Decode
             (None, String::new(), String::new(), m, None)
         }
     };
-    Ok(Decoded {
+    within_reach(Decoded {
         stamp_ns,
         frame_id,
         child_frame_id,

@@ -1,23 +1,30 @@
 //! MCAP files (ROS 2) through the `mcap` crate's sans-I/O linear reader: the file is read in
-//! bounded pieces and each chunk decompressed once (zstd, lz4), so memory stays bounded by one
-//! chunk whatever the file's length. Messages are CDR (`message_encoding = "cdr"`), decoded
-//! in `decode` with `re_cdr`.
+//! bounded pieces, and each chunk is decompressed here, once (zstd, lz4), so memory stays
+//! bounded by one chunk whatever the file's length. Messages are CDR
+//! (`message_encoding = "cdr"`), decoded in `decode` with `re_cdr`.
+//!
+//! Every read is bounded by the file's size: a record longer than what is left of the file
+//! is refused where it starts, a chunk must decompress to exactly the size its header gives
+//! (read through a limit of that size), and each record inside a chunk moves the reading on
+//! by at least its 9-byte opcode and length. A damaged log therefore ends with a located
+//! error in one pass over its bytes. (The crate's own chunk decompression can loop without
+//! end on a falsified chunk header; it is not used.)
 
 use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
-use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use super::decode::ros2_kind;
-use super::{Codec, Collector, Stream};
+use super::mcap_records::{ChunkHeader, McapRecord, parse};
+use super::{Codec, Collector, RECORD_LIMIT, Stream};
 use crate::input::InputError;
 
-/// The largest record (or decompressed chunk) read: larger ones are refused, not allocated.
-pub const RECORD_LIMIT: usize = 1 << 30;
 /// At most this many bytes are read from the file at a time.
 const READ_PIECE: usize = 1 << 20;
+/// An opcode (1 byte) and a record length (8 bytes).
+const OPCODE_LEN: usize = 9;
 
 /// Streams every message of the file into `collector`.
 pub(super) fn read(
@@ -35,11 +42,13 @@ pub(super) fn read(
     };
     let mut file = std::fs::File::open(path).map_err(io)?;
     let total = file.metadata().map_err(io)?.len();
+    let limit = RECORD_LIMIT.min(usize::try_from(total).unwrap_or(RECORD_LIMIT));
     let mut reader = LinearReader::new_with_options(
-        LinearReaderOptions::default().with_record_length_limit(RECORD_LIMIT),
+        LinearReaderOptions::default()
+            .with_record_length_limit(limit)
+            .with_emit_chunks(true),
     );
-    let mut schemas: HashMap<u16, (String, String)> = HashMap::new();
-    let mut channels: HashMap<u16, Stream> = HashMap::new();
+    let mut streams = Streams::default();
     let mut done = 0u64;
     let mut last_report = 0u64;
     while let Some(event) = reader.next_event() {
@@ -56,61 +65,226 @@ pub(super) fn read(
                 }
             }
             LinearReadEvent::Record { data, opcode } => {
-                let record = mcap::parse_record(opcode, data)
-                    .map_err(|e| fail(format!("record 0x{opcode:02x} near byte {done}: {e}")))?;
-                match record {
-                    Record::Schema { header, .. } => {
-                        schemas.insert(header.id, (header.name, header.encoding));
+                let at = |e: String| fail(format!("record 0x{opcode:02x} near byte {done}: {e}"));
+                let flow = match parse(opcode, data).map_err(at)? {
+                    McapRecord::Chunk { header, records } => {
+                        let records = decompress(&header, records).map_err(at)?;
+                        chunk_records(&records, |opcode, body| {
+                            let inner = parse(opcode, body)
+                                .map_err(|e| format!("record 0x{opcode:02x} in this chunk: {e}"))?;
+                            streams.take(inner, collector)
+                        })
+                        .map_err(at)?
                     }
-                    Record::Channel(c) => {
-                        let (schema, encoding) =
-                            schemas.get(&c.schema_id).cloned().unwrap_or_default();
-                        let kind = ros2_kind(&schema).map(|k| {
-                            if c.message_encoding == "cdr" {
-                                Ok(k)
-                            } else {
-                                Err(format!(
-                                    "{schema} in {} encoding (schema {encoding}); posecov reads cdr",
-                                    c.message_encoding
-                                ))
-                            }
-                        });
-                        let type_name = if schema.is_empty() {
-                            format!("(no schema, {} encoding)", c.message_encoding)
-                        } else {
-                            schema
-                        };
-                        collector.declare(&c.topic, &type_name, kind.as_ref());
-                        channels.insert(
-                            c.id,
-                            Stream {
-                                topic: c.topic,
-                                type_name,
-                                kind,
-                            },
-                        );
-                    }
-                    Record::Message { header, data } => {
-                        if collector.stop() {
-                            return Ok(());
-                        }
-                        let id = header.channel_id;
-                        collector
-                            .message_on(
-                                channels.get(&id),
-                                "channel",
-                                id.into(),
-                                header.log_time,
-                                &data,
-                                Codec::Cdr,
-                            )
-                            .map_err(fail)?;
-                    }
-                    _ => {}
+                    other => streams.take(other, collector).map_err(at)?,
+                };
+                if flow == Flow::Stop {
+                    return Ok(());
                 }
             }
         }
     }
     progress(total, total);
     Ok(())
+}
+
+/// Whether to read on (the collector may ask to stop: Ctrl-C).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Flow {
+    Continue,
+    Stop,
+}
+
+/// The schemas and channels declared so far.
+#[derive(Default)]
+struct Streams {
+    schemas: HashMap<u16, (String, String)>,
+    channels: HashMap<u16, Stream>,
+}
+
+impl Streams {
+    /// Takes one record of the data section (outside a chunk or inside one).
+    fn take(
+        &mut self,
+        record: McapRecord<'_>,
+        collector: &mut Collector<'_>,
+    ) -> Result<Flow, String> {
+        match record {
+            McapRecord::Schema { id, name, encoding } => {
+                self.schemas.insert(id, (name, encoding));
+            }
+            McapRecord::Channel {
+                id,
+                schema_id,
+                topic,
+                message_encoding,
+            } => {
+                let (schema, encoding) = self.schemas.get(&schema_id).cloned().unwrap_or_default();
+                let kind = ros2_kind(&schema).map(|k| {
+                    if message_encoding == "cdr" {
+                        Ok(k)
+                    } else {
+                        Err(format!(
+                            "{schema} in {message_encoding} encoding (schema {encoding}); posecov reads cdr"
+                        ))
+                    }
+                });
+                let type_name = if schema.is_empty() {
+                    format!("(no schema, {message_encoding} encoding)")
+                } else {
+                    schema
+                };
+                collector.declare(&topic, &type_name, kind.as_ref());
+                self.channels.insert(
+                    id,
+                    Stream {
+                        topic,
+                        type_name,
+                        kind,
+                    },
+                );
+            }
+            McapRecord::Message {
+                channel_id,
+                log_time,
+                data,
+            } => {
+                if collector.stop() {
+                    return Ok(Flow::Stop);
+                }
+                collector.message_on(
+                    self.channels.get(&channel_id),
+                    "channel",
+                    channel_id.into(),
+                    log_time,
+                    data,
+                    Codec::Cdr,
+                )?;
+            }
+            McapRecord::Chunk { .. } => return Err("a chunk inside a chunk".to_owned()),
+            McapRecord::Other => {}
+        }
+        Ok(Flow::Continue)
+    }
+}
+
+/// A chunk's records, decompressed: exactly the `uncompressed_size` its header gives (at most
+/// [`RECORD_LIMIT`]), read through a limit of that size, so a falsified header ends here.
+fn decompress(header: &ChunkHeader, compressed: &[u8]) -> Result<Vec<u8>, String> {
+    let size = usize::try_from(header.uncompressed_size)
+        .ok()
+        .filter(|&s| s <= RECORD_LIMIT)
+        .ok_or_else(|| {
+            format!(
+                "a chunk of {} bytes uncompressed is larger than the {} MiB posecov reads",
+                header.uncompressed_size,
+                RECORD_LIMIT >> 20
+            )
+        })?;
+    // One byte more than expected is read, to tell "too long" from "exactly right".
+    let bound = header.uncompressed_size.saturating_add(1);
+    let mut out = Vec::new();
+    let read = match header.compression.as_str() {
+        "" => {
+            out.extend_from_slice(compressed);
+            Ok(compressed.len())
+        }
+        "zstd" => zstd::stream::read::Decoder::new(compressed)
+            .and_then(|d| d.take(bound).read_to_end(&mut out)),
+        "lz4" => lz4::Decoder::new(compressed).and_then(|d| d.take(bound).read_to_end(&mut out)),
+        other => {
+            return Err(format!(
+                "chunk compression {other:?}: posecov reads zstd, lz4 or none"
+            ));
+        }
+    };
+    read.map_err(|e| format!("the {} chunk does not decompress: {e}", header.compression))?;
+    if out.len() != size {
+        return Err(format!(
+            "the chunk decompresses to {}{} bytes, its header says {size}",
+            out.len().min(size.saturating_add(1)),
+            if out.len() > size { " or more" } else { "" },
+        ));
+    }
+    Ok(out)
+}
+
+/// Calls `take` with each record (opcode, body) of a decompressed chunk, in order; every
+/// record moves on by its opcode and length, and a length past the chunk's end is refused.
+fn chunk_records(
+    mut records: &[u8],
+    mut take: impl FnMut(u8, &[u8]) -> Result<Flow, String>,
+) -> Result<Flow, String> {
+    while !records.is_empty() {
+        let Some((head, rest)) = records.split_first_chunk::<OPCODE_LEN>() else {
+            return Err(format!(
+                "the chunk ends inside a record header ({} bytes left)",
+                records.len()
+            ));
+        };
+        let opcode = head[0];
+        let len = u64::from_le_bytes(head[1..].try_into().unwrap_or_default());
+        let body = usize::try_from(len)
+            .ok()
+            .and_then(|l| rest.get(..l))
+            .ok_or_else(|| {
+                format!(
+                    "record 0x{opcode:02x} of {len} bytes runs past the chunk's end ({} bytes left)",
+                    rest.len()
+                )
+            })?;
+        if take(opcode, body)? == Flow::Stop {
+            return Ok(Flow::Stop);
+        }
+        records = &rest[body.len()..];
+    }
+    Ok(Flow::Continue)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header(compression: &str, compressed: usize, uncompressed: u64) -> ChunkHeader {
+        ChunkHeader {
+            uncompressed_size: uncompressed,
+            compression: compression.to_owned(),
+            compressed_size: compressed as u64,
+        }
+    }
+
+    #[test]
+    fn a_falsified_uncompressed_size_is_refused_at_once() {
+        let records = [0x0f, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0];
+        let zstd = zstd::bulk::compress(&records, 3).unwrap();
+        let good = decompress(&header("zstd", zstd.len(), records.len() as u64), &zstd).unwrap();
+        assert_eq!(good, records);
+        for wrong in [0, 5, records.len() as u64 + 1, 1 << 29, u64::MAX] {
+            let e = decompress(&header("zstd", zstd.len(), wrong), &zstd).unwrap_err();
+            assert!(
+                e.contains("header says") || e.contains("larger than"),
+                "{wrong}: {e}"
+            );
+        }
+        let e = decompress(&header("bz2", 3, 3), b"abc").unwrap_err();
+        assert!(e.contains("\"bz2\""), "{e}");
+    }
+
+    #[test]
+    fn a_record_length_past_the_chunk_is_refused() {
+        let mut seen = 0;
+        let ok = [0x0f, 1, 0, 0, 0, 0, 0, 0, 0, 7];
+        chunk_records(&ok, |o, b| {
+            seen += 1;
+            assert_eq!((o, b), (0x0f, &[7u8][..]));
+            Ok(Flow::Continue)
+        })
+        .unwrap();
+        assert_eq!(seen, 1);
+        let long = [0x0f, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 7];
+        let e = chunk_records(&long, |_, _| Ok(Flow::Continue)).unwrap_err();
+        assert!(e.contains("runs past the chunk's end"), "{e}");
+        let e = chunk_records(&ok[..5], |_, _| Ok(Flow::Continue)).unwrap_err();
+        assert!(e.contains("inside a record header"), "{e}");
+    }
 }

@@ -27,14 +27,24 @@ use crate::plan::bag::{
 
 use super::format::{self, Format};
 use super::{InputError, Located, Place};
+use super::suggest;
 
 pub mod bundled;
 pub mod decode;
 pub mod health;
 mod mcap;
+mod mcap_records;
 mod ros1;
 
 use decode::{DecodeError, Decoded};
+
+/// The largest record or decompressed chunk of a log read (1 GiB): larger ones are refused,
+/// not allocated.
+pub const RECORD_LIMIT: usize = 1 << 30;
+/// A compressed chunk may claim at most this many times its compressed length (plus 1 MiB)
+/// once decompressed: real logs compress ROS messages about 8:1, and a falsified size is
+/// refused before anything is allocated for it.
+pub const MAX_CHUNK_RATIO: u64 = 1024;
 
 /// Default number of messages drawn per topic (at most; evenly spaced).
 pub const DEFAULT_MAX_DRAWN: usize = 200;
@@ -359,7 +369,8 @@ impl<'a> Collector<'a> {
                             .map(String::as_str)
                             .collect();
                         format!(
-                            "no such topic; pose topics in this log: {}",
+                            "no such topic; {}pose topics in this log: {}",
+                            suggest::did_you_mean(wanted, have.iter().copied()),
                             if have.is_empty() {
                                 "none".to_owned()
                             } else {

@@ -12,7 +12,7 @@ use rosbag::record_types::Chunk;
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
 use super::decode::ros1_kind;
-use super::{Codec, Collector, Stream};
+use super::{Codec, Collector, MAX_CHUNK_RATIO, RECORD_LIMIT, Stream};
 use crate::input::InputError;
 use crate::input::format::ROSBAG_MAGIC as ROS1_MAGIC;
 
@@ -86,6 +86,68 @@ fn check_header(path: &Path) -> Result<(), InputError> {
     }
 }
 
+/// Checks a chunk record's header before the crate reads it: the record lies inside the file,
+/// and its uncompressed `size` is what its data can hold (equal to the data's length when
+/// uncompressed; at most [`MAX_CHUNK_RATIO`] times it, plus 1 MiB, and at most
+/// [`RECORD_LIMIT`] when compressed). The crate allocates `size` bytes up front: a falsified
+/// size must not reach it.
+fn check_chunk(file: &mut std::fs::File, pos: u64) -> Result<(), String> {
+    use std::io::{Seek, SeekFrom};
+    let len = file.metadata().map_err(|e| e.to_string())?.len();
+    let mut read_at = |at: u64, n: usize| -> Result<Vec<u8>, String> {
+        if at.saturating_add(n as u64) > len {
+            return Err(format!(
+                "the record runs past the end of the file ({len} bytes)"
+            ));
+        }
+        let mut buf = vec![0u8; n];
+        file.seek(SeekFrom::Start(at)).map_err(|e| e.to_string())?;
+        file.read_exact(&mut buf).map_err(|e| e.to_string())?;
+        Ok(buf)
+    };
+    let u32_of = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+    let header_len = u32_of(&read_at(pos, 4)?) as usize;
+    if header_len > 4096 {
+        return Err(format!("a chunk header of {header_len} bytes"));
+    }
+    let header = read_at(pos + 4, header_len)?;
+    let data_len = u64::from(u32_of(&read_at(pos + 4 + header_len as u64, 4)?));
+    if pos + 8 + header_len as u64 + data_len > len {
+        return Err(format!(
+            "its {data_len} bytes of data run past the end of the file ({len} bytes)"
+        ));
+    }
+    let (mut size, mut compression) = (None, None);
+    let mut rest = &header[..];
+    while rest.len() >= 4 {
+        let field_len = u32_of(rest) as usize;
+        let Some(field) = rest.get(4..4 + field_len) else {
+            return Err("a header field runs past the header".to_owned());
+        };
+        if let Some(v) = field.strip_prefix(b"size=").filter(|v| v.len() == 4) {
+            size = Some(u64::from(u32_of(v)));
+        }
+        if let Some(v) = field.strip_prefix(b"compression=") {
+            compression = Some(String::from_utf8_lossy(v).into_owned());
+        }
+        rest = &rest[4 + field_len..];
+    }
+    let (Some(size), Some(compression)) = (size, compression) else {
+        return Err("the chunk header lacks its size or compression".to_owned());
+    };
+    let most = if compression == "none" {
+        data_len
+    } else {
+        (MAX_CHUNK_RATIO * data_len + (1 << 20)).min(RECORD_LIMIT as u64)
+    };
+    if size > most || (compression == "none" && size != data_len) {
+        return Err(format!(
+            "the header says {size} bytes uncompressed ({compression}) for {data_len} bytes of data"
+        ));
+    }
+    Ok(())
+}
+
 /// Streams every message of the bag into `collector`.
 pub(super) fn read(
     path: &Path,
@@ -124,6 +186,19 @@ pub(super) fn read(
     }
     chunk_positions.sort_unstable();
     chunk_positions.dedup();
+    let mut file = std::fs::File::open(path).map_err(|source| InputError::Read {
+        path: path.display().to_string(),
+        reason: source.to_string(),
+    })?;
+    for (k, &pos) in chunk_positions.iter().enumerate() {
+        check_chunk(&mut file, pos).map_err(|e| {
+            fail(format!(
+                "chunk {} of {} at byte {pos}: {e}",
+                k + 1,
+                chunk_positions.len()
+            ))
+        })?;
+    }
     let total = chunk_positions.len() as u64;
     // Chunks are decompressed in parallel, a few per thread at a time (memory stays bounded
     // by that many chunks), and their messages handed on in file order.

@@ -150,13 +150,10 @@ pub fn read_file(path: &Path) -> Result<(Graph, Input), InputError> {
         });
     }
     let bytes = std::fs::read(path).map_err(read_error)?;
-    let text = String::from_utf8(bytes).map_err(|e| InputError::Format {
-        file: file.clone(),
-        message: format!(
-            "not UTF-8 text (invalid byte at offset {}); a g2o / GTSAM graph is text",
-            e.utf8_error().valid_up_to()
-        ),
-    })?;
+    if let Some(located) = super::not_text(&file, &bytes, "a g2o / GTSAM graph") {
+        return Err(located);
+    }
+    let text = String::from_utf8(bytes).unwrap_or_default();
     read_text(&text, &file)
 }
 

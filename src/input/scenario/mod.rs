@@ -135,10 +135,14 @@ impl Scenario {
     /// assert!(e.to_string().starts_with("/no/such/file.toml: cannot read input"));
     /// ```
     pub fn load(path: &Path) -> Result<Self, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read {
-            path: path.display().to_string(),
+        let file = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| ScenarioError::Read {
+            path: file.clone(),
             reason: e.to_string(),
         })?;
-        Self::parse(&text, &path.display().to_string())
+        if let Some(located) = crate::input::not_text(&file, &bytes, "a TOML scenario") {
+            return Err(located);
+        }
+        Self::parse(&String::from_utf8(bytes).unwrap_or_default(), &file)
     }
 }

@@ -142,7 +142,8 @@ fn keys_before(line: &str, column: usize) -> Vec<String> {
 
 /// A toml/serde message with Rust type names replaced by what the file should contain.
 pub(crate) fn in_file_words(message: &str) -> String {
-    let message = message.trim();
+    let suggested = with_suggestion(message.trim());
+    let message = suggested.as_deref().unwrap_or(message.trim());
     // "invalid value: integer `-5`, expected u64" → "-5 is not a whole number ≥ 0"
     if let Some(rest) = message.strip_prefix("invalid value: integer `")
         && let Some((value, expected)) = rest.split_once("`, expected ")
@@ -163,6 +164,25 @@ pub(crate) fn in_file_words(message: &str) -> String {
         out = out.replace(rust, words);
     }
     out
+}
+
+/// serde's "unknown field `stdd`, expected one of `std`, …" (or variant: a method, a group)
+/// with the nearest accepted name: "unknown field `stdd`; did you mean `std`? expected one
+/// of …". `None` when the message is not of that kind or no name is near.
+fn with_suggestion(message: &str) -> Option<String> {
+    let (what, rest) = ["unknown field `", "unknown variant `"]
+        .iter()
+        .find_map(|p| message.strip_prefix(p).map(|rest| (*p, rest)))?;
+    let (word, rest) = rest.split_once('`')?;
+    let expected = rest.split_once("expected")?.1;
+    let candidates = expected.split('`').skip(1).step_by(2);
+    let guess = crate::input::suggest::did_you_mean(word, candidates);
+    (!guess.is_empty()).then(|| {
+        format!(
+            "{what}{word}`; {guess}{}",
+            rest.trim_start_matches(',').trim_start()
+        )
+    })
 }
 
 /// Rust and serde type names, as a scenario file's author says them.
@@ -230,6 +250,22 @@ mod tests {
         assert!(
             !in_file_words("invalid type: integer `3`, expected struct MeanSpec")
                 .contains("struct")
+        );
+    }
+
+    #[test]
+    fn unknown_names_get_the_nearest() {
+        assert_eq!(
+            in_file_words("unknown field `stdd`, expected one of `std`, `std_deg`, `matrix`"),
+            "unknown field `stdd`; did you mean `std`? expected one of `std`, `std_deg`, `matrix`"
+        );
+        assert_eq!(
+            in_file_words("unknown variant `first_ordr`, expected one of `exact`, `first_order`"),
+            "unknown variant `first_ordr`; did you mean `first_order`? expected one of `exact`, `first_order`"
+        );
+        assert_eq!(
+            in_file_words("unknown field `zzz`, expected `std`"),
+            "unknown field `zzz`, expected `std`"
         );
     }
 }

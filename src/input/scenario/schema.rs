@@ -117,22 +117,29 @@ fn yes() -> bool {
 #[serde(deny_unknown_fields)]
 pub struct MeanSpec {
     /// SE(2) position and heading (radians).
+    #[serde(default, deserialize_with = "exactly")]
     pub xy_theta: Option<[f64; 3]>,
     /// SE(2) position and heading (degrees).
+    #[serde(default, deserialize_with = "exactly")]
     pub xy_theta_deg: Option<[f64; 3]>,
     /// SO(2) angle (radians).
     pub angle: Option<f64>,
     /// SO(2) angle (degrees).
     pub angle_deg: Option<f64>,
     /// SE(3) position.
+    #[serde(default, deserialize_with = "exactly")]
     pub xyz: Option<[f64; 3]>,
     /// Rotation as a unit quaternion, ROS order (x, y, z, w).
+    #[serde(default, deserialize_with = "exactly")]
     pub quaternion_xyzw: Option<[f64; 4]>,
     /// Rotation as roll, pitch, yaw (radians).
+    #[serde(default, deserialize_with = "exactly")]
     pub rpy: Option<[f64; 3]>,
     /// Rotation as roll, pitch, yaw (degrees).
+    #[serde(default, deserialize_with = "exactly")]
     pub rpy_deg: Option<[f64; 3]>,
     /// Rotation as a unit axis and an angle in radians: [x, y, z, angle].
+    #[serde(default, deserialize_with = "exactly")]
     pub axis_angle: Option<[f64; 4]>,
     /// The group element as a matrix, row-major rows.
     pub matrix: Option<Vec<Vec<f64>>>,
@@ -317,12 +324,16 @@ pub struct DrawSpec {
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
     /// Eye position.
+    #[serde(default, deserialize_with = "exactly")]
     pub position: Option<[f64; 3]>,
     /// Direction from the target towards the eye; the distance is chosen to fit the scene.
+    #[serde(default, deserialize_with = "exactly")]
     pub direction: Option<[f64; 3]>,
     /// The point looked at (default: the middle of what is drawn).
+    #[serde(default, deserialize_with = "exactly")]
     pub target: Option<[f64; 3]>,
     /// World direction up on screen (default +z).
+    #[serde(default, deserialize_with = "exactly")]
     pub up: Option<[f64; 3]>,
 }
 
@@ -354,4 +365,36 @@ impl Default for DrawSpec {
     fn default() -> Self {
         toml::from_str("").unwrap_or_else(|_| unreachable!("every [draw] key has a default"))
     }
+}
+
+/// An optional array of exactly `N` numbers: more are refused as fewer are (serde's arrays
+/// read the first `N` of a longer TOML array and drop the rest without a word).
+fn exactly<'de, D, const N: usize>(deserializer: D) -> Result<Option<[f64; N]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    struct Exactly<const N: usize>;
+    impl<'de, const N: usize> serde::de::Visitor<'de> for Exactly<N> {
+        type Value = [f64; N];
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "an array of {N} numbers")
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<[f64; N], A::Error> {
+            let mut out = [0.0; N];
+            let mut count = 0usize;
+            while let Some(x) = seq.next_element::<f64>()? {
+                if let Some(slot) = out.get_mut(count) {
+                    *slot = x;
+                }
+                count += 1;
+            }
+            if count != N {
+                return Err(serde::de::Error::custom(format!(
+                    "expected an array of {N} numbers, found {count}"
+                )));
+            }
+            Ok(out)
+        }
+    }
+    deserializer.deserialize_seq(Exactly::<N>).map(Some)
 }

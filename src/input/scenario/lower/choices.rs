@@ -9,8 +9,11 @@ use crate::input::scenario::ScenarioError;
 use crate::input::scenario::schema::{CameraSpec, SigmaPointsSpec};
 use crate::propagate::sigma_point::Unscented;
 
+/// The largest camera coordinate accepted (m): squares and sums of it stay finite.
+const CAMERA_LIMIT: f64 = 1e9;
+
 impl Lowering<'_> {
-    /// `[draw] camera`: finite numbers; `position` or `direction`, not both; a non-zero
+    /// `[draw] camera`: finite numbers within ±1e9 m; `position` or `direction`, not both; a non-zero
     /// `direction` and `up`; the eye not at its target; `up` not along the line of sight.
     pub(super) fn camera(
         &self,
@@ -28,6 +31,11 @@ impl Lowering<'_> {
         for (key, v) in named {
             if let Some(v) = v.filter(|v| v.iter().any(|x| !x.is_finite())) {
                 return fail(format!("{key} = {v:?} is not three finite numbers"));
+            }
+            if let Some(v) = v.filter(|v| v.iter().any(|x| x.abs() > CAMERA_LIMIT)) {
+                return fail(format!(
+                    "{key} = {v:?} is beyond ±{CAMERA_LIMIT:e} m (a camera is placed in the scene's metres)"
+                ));
             }
         }
         let norm = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();

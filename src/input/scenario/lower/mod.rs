@@ -144,13 +144,9 @@ impl Lowering<'_> {
             ));
         }
         if let Some(c) = &h.confidence
-            && !(*c.get_ref() > 0.0 && *c.get_ref() < 1.0)
+            && let Err(e) = crate::uncertain::Confidence::new(*c.get_ref())
         {
-            return Err(self.err(
-                c.span(),
-                "scenario.confidence",
-                format!("{} is not a probability in (0, 1), e.g. 0.95", c.get_ref()),
-            ));
+            return Err(self.err(c.span(), "scenario.confidence", e.to_string()));
         }
         let mut methods = h.methods.clone();
         methods.dedup();
@@ -283,7 +279,8 @@ impl Lowering<'_> {
                 op.kind.span(),
                 &format!("{field}.kind"),
                 format!(
-                    "unknown operation `{kind}`; expected one of {}",
+                    "unknown operation `{kind}`; {}expected one of {}",
+                    crate::input::suggest::did_you_mean(kind, kinds.iter().copied()),
                     kinds.join(", ")
                 ),
             ));
@@ -386,8 +383,9 @@ impl Lowering<'_> {
                 name.span(),
                 field,
                 format!(
-                    "no pose named `{}` (defined so far: {})",
+                    "no pose named `{}`; {}(defined so far: {})",
                     name.get_ref(),
+                    crate::input::suggest::did_you_mean(name.get_ref(), known.iter().copied()),
                     known.join(", ")
                 ),
             )

@@ -45,6 +45,26 @@ impl Lowering<'_> {
             },
             "compose" | "between" | "compose_correlated" | "between_correlated" => {
                 let (lhs, rhs) = (pose(&op.lhs, "lhs")?, pose(&op.rhs, "rhs")?);
+                if let (Operand::Defined(a), Operand::Defined(b)) = (lhs, rhs)
+                    && a == b
+                    && op.cross_cov.is_none()
+                    && let Some(rhs_name) = &op.rhs
+                {
+                    let base = kind.trim_end_matches("_correlated");
+                    return Err(self.err(
+                        rhs_name.span(),
+                        &f("rhs"),
+                        format!(
+                            "`lhs` and `rhs` are the same uncertain pose `{}`: `{kind}` treats its two sides as independent, but they are one draw ({}); use two poses, or `{base}_correlated` with `cross_cov` equal to its covariance",
+                            rhs_name.get_ref(),
+                            if base == "between" {
+                                "X⁻¹·X is exactly the identity"
+                            } else {
+                                "X·X is not X·Y with Y drawn apart"
+                            }
+                        ),
+                    ));
+                }
                 let cross_cov = match &op.cross_cov {
                     None => None,
                     Some(c) => Some(self.cross_cov(t, field, lhs, rhs, c)?),

@@ -1,0 +1,171 @@
+//! The fuzz harness: every input posecov reads, mutated, run through what `posecov check` and
+//! `report --json` run, under a watchdog, and judged against written invariants. Stable Rust,
+//! no extra tools: `cargo test --test fuzz`.
+//!
+//! # Families
+//!
+//! | family | inputs | path run |
+//! |---|---|---|
+//! | `scenario` | bundled scenarios + 3 extra seeds, mutated in TOML structure and bytes | parse → lower → evaluate (≤ 32 samples) → draw → validate → records |
+//! | `graph` | the g2o / GTSAM / TORO graphs, mutated by token, line and byte | read → lower → evaluate (16 samples) → draw → validate → `report --json` |
+//! | `ros1` | the bundled bz2 bag and a small uncompressed bag written here, mutated by byte (lengths and counts set to edge values) | read → evaluate → draw → validate → `report --json` |
+//! | `mcap` | the bundled MCAP, mutated by byte | the same |
+//! | `live_api` | raw HTTP requests to the live page's server: methods, paths, `Host`, `Origin`, content types, edits of every control to edge values | a real server on loopback |
+//!
+//! # Invariants
+//!
+//! 1. No panic (`panic`).
+//! 2. No hang: every run ends within `POSECOV_FUZZ_HANG_MS` (5 s) and below
+//!    `POSECOV_FUZZ_MEMORY_CAP_MB` (4 GiB allocated) (`hang`, `memory`); none is slow (> 5 s,
+//!    `slow`) or peaks above 512 MiB (`memory`).
+//! 3. No known-invalid input accepted (`accepted_*`): undefined names, a point used as a
+//!    pose, an array of the wrong length, one uncertain pose on both sides of `compose` /
+//!    `between`, a camera beyond ±1e9 m, a non-positive axis length, a non-finite number in a
+//!    graph record, a request naming another server (`Host` or `Origin`), an edit that leaves
+//!    a scenario `posecov check` refuses.
+//! 4. No non-finite number in the output: records, findings and the JSON report have no
+//!    `null` where a number belongs; scenes have only finite numbers and validate; every
+//!    covariance is symmetric and positive semi-definite, or reported as not
+//!    (`nonfinite_*`, `scene_invalid`, `asymmetric_cov`, `non_psd`).
+//! 5. Every error is located: a scenario error is `file:line:column: field: message` with
+//!    the place inside the text, the field in the file's words and no Rust words
+//!    (`error_unlocated`, `error_bad_location`, `error_field_*`, `error_rust_speak`); a graph
+//!    error names the file (and a place inside it when it gives one); a log error names the
+//!    file. The live API answers every request, never with a 5xx (`server_error`).
+//!
+//! # Running
+//!
+//! - `cargo test --test fuzz`: the smoke run (CI): `POSECOV_FUZZ_SMOKE` cases per family
+//!   (default 400), about half a minute on 2 cores.
+//! - `cargo test --test fuzz long -- --ignored --nocapture`: the long run,
+//!   `POSECOV_FUZZ_CASES` per family (default 20 000) from `POSECOV_FUZZ_SEED` (default 0),
+//!   families `POSECOV_FUZZ_FAMILIES` (comma-separated; default all), starting at case
+//!   `POSECOV_FUZZ_START`. It prints one summary line per family (counts per outcome, time).
+//! - Failing inputs are written, one per distinct failure, to
+//!   `target/fuzz-failures/<family>-<class>-s<seed>-c<case>.<ext>` with a `.txt` saying what
+//!   happened and which mutations made it; the input being run is in
+//!   `target/fuzz-current-<family>.<ext>` (if the process dies).
+//! - One scenario file: `POSECOV_FUZZ_FILE=x.toml cargo test --test fuzz scenario_file --
+//!   --ignored --nocapture` (with `POSECOV_FUZZ_REDUCE=1`, a line-reduced input per failure).
+
+mod graph;
+mod harness;
+#[cfg(feature = "viewer")]
+mod live_api;
+mod logs;
+mod scenario;
+
+use harness::{Family, Summary, campaign, env_u64};
+
+/// Every family, by name.
+fn families() -> Vec<Box<dyn Family>> {
+    #[cfg_attr(not(feature = "viewer"), allow(unused_mut))]
+    let mut all: Vec<Box<dyn Family>> = vec![
+        Box::new(scenario::Scenarios::new()),
+        Box::new(graph::Graphs),
+        Box::new(logs::Logs::new(logs::LogKind::Ros1)),
+        Box::new(logs::Logs::new(logs::LogKind::Mcap)),
+    ];
+    // The page server needs the viewer feature (axum, tokio).
+    #[cfg(feature = "viewer")]
+    all.push(Box::new(live_api::LiveApi::new()));
+    all
+}
+
+fn assert_clean(summaries: &[Summary]) {
+    let failing: Vec<String> = summaries
+        .iter()
+        .filter(|s| !s.clean())
+        .map(|s| format!("{} ({} failing cases)", s.family, s.failing_cases))
+        .collect();
+    assert!(
+        failing.is_empty(),
+        "fuzzing found failures in {failing:?} (see above)"
+    );
+}
+
+/// Short and bounded: runs in CI.
+#[test]
+fn smoke() {
+    let cases = env_u64("POSECOV_FUZZ_SMOKE").unwrap_or(400);
+    let summaries: Vec<Summary> = families()
+        .iter()
+        .map(|f| campaign(f.as_ref(), 1, 0..cases))
+        .collect();
+    assert_clean(&summaries);
+}
+
+/// The long run (see the module docs).
+#[test]
+#[ignore = "long; POSECOV_FUZZ_CASES per family"]
+fn long() {
+    let seed = env_u64("POSECOV_FUZZ_SEED").unwrap_or(0);
+    let start = env_u64("POSECOV_FUZZ_START").unwrap_or(0);
+    let cases = env_u64("POSECOV_FUZZ_CASES").unwrap_or(20_000);
+    let wanted = std::env::var("POSECOV_FUZZ_FAMILIES").unwrap_or_default();
+    let summaries: Vec<Summary> = families()
+        .iter()
+        .filter(|f| wanted.is_empty() || wanted.split(',').any(|w| w.trim() == f.name()))
+        .map(|f| campaign(f.as_ref(), seed, start..start + cases))
+        .collect();
+    let total: u64 = summaries.iter().map(|s| s.cases).sum();
+    println!("fuzz total: {total} cases");
+    assert_clean(&summaries);
+}
+
+/// The extra scenario seeds are valid scenarios (so their mutants start from something that
+/// works), and the small bag written here reads.
+#[test]
+fn seeds_are_valid() {
+    let _guard = harness::RUN_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    let limits = harness::Limits::from_env();
+    for (name, text) in scenario::EXTRA_SEEDS {
+        let found = scenario::classify(
+            text,
+            scenario::ORIGIN,
+            scenario::run_text(text, &limits),
+            &limits,
+        );
+        assert!(found.iter().all(|f| f.class == "ok"), "{name}: {found:?}");
+    }
+    let ros1 = logs::Logs::new(logs::LogKind::Ros1);
+    let (found, _) = ros1.check(&logs::small_bag(), &limits);
+    assert!(
+        found.iter().all(|f| f.class == "ok"),
+        "small bag: {found:?}"
+    );
+}
+
+/// Runs one scenario file (`POSECOV_FUZZ_FILE`) through the same checks and prints what it
+/// finds.
+#[test]
+#[ignore = "needs POSECOV_FUZZ_FILE"]
+fn scenario_file() {
+    let _guard = harness::RUN_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    harness::install_panic_hook();
+    let path = std::env::var("POSECOV_FUZZ_FILE").expect("set POSECOV_FUZZ_FILE");
+    let bytes = std::fs::read(&path).expect("read POSECOV_FUZZ_FILE");
+    let text = String::from_utf8_lossy(&bytes);
+    let limits = harness::Limits::from_env();
+    let findings = scenario::classify(
+        &text,
+        scenario::ORIGIN,
+        scenario::run_text(&text, &limits),
+        &limits,
+    );
+    for f in &findings {
+        println!("{}: {}", f.class, f.message);
+    }
+    if env_u64("POSECOV_FUZZ_REDUCE").unwrap_or(0) != 0 {
+        for f in findings
+            .iter()
+            .filter(|f| !harness::GOOD.contains(&f.class))
+        {
+            match scenario::reduce(&text, &harness::dedup_key(f), &limits) {
+                Ok(r) => println!("--- reduced for {}:\n{r}---", f.class),
+                Err(_) => println!("--- reduction of {} hung", f.class),
+            }
+        }
+    }
+    assert!(findings.iter().all(|f| harness::GOOD.contains(&f.class)));
+}
