@@ -320,10 +320,10 @@ pub fn dedup_key(f: &Finding) -> String {
 }
 
 /// The first non-finite number of a JSON document, as serde_json writes it (`null`) where a
-/// number belongs: a `null` inside an array (an entry of a vector or matrix), or as the value
-/// of a key not in `may_be_null` (keys whose value is absent by design, such as a finding's
-/// `step`).
-pub fn json_null(v: &serde_json::Value, may_be_null: &[&str]) -> Option<String> {
+/// number belongs: any `null`, except under the keys in `optional` (values that may be
+/// absent by design, such as a finding's `step` or a topic's stamps when it has no message;
+/// their subtree is not looked at).
+pub fn json_null(v: &serde_json::Value, optional: &[&str]) -> Option<String> {
     let mut stack = vec![("".to_owned(), v)];
     while let Some((path, v)) = stack.pop() {
         match v {
@@ -335,7 +335,7 @@ pub fn json_null(v: &serde_json::Value, may_be_null: &[&str]) -> Option<String> 
             ),
             serde_json::Value::Object(o) => stack.extend(
                 o.iter()
-                    .filter(|(k, x)| !(x.is_null() && may_be_null.contains(&k.as_str())))
+                    .filter(|(k, _)| !optional.contains(&k.as_str()))
                     .map(|(k, x)| (format!("{path}.{k}"), x)),
             ),
             _ => {}

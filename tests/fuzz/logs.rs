@@ -13,7 +13,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use posecov::app::Overrides;
-use posecov::app::bag::{LogPlace, report_json, run};
+use posecov::app::bag::report_json;
+use posecov::app::run::{Run as AppRun, open};
 
 use crate::harness::{
     Family, Finding, Limits, Run, Stage, finding, json_null, mutate_bytes, run_guarded, settle,
@@ -127,9 +128,13 @@ fn run_log(path: PathBuf, stage: Stage) -> Result<serde_json::Value, String> {
         samples: Some(8),
         ..Default::default()
     };
-    let log = run(&LogPlace::File(path), "fuzz", &overrides, None).map_err(|e| e.to_string())?;
+    let opened = open(&path.display().to_string()).map_err(|e| e.to_string())?;
+    let AppRun::Log(log) = AppRun::start(opened, &overrides, None).map_err(|e| e.to_string())?
+    else {
+        return Err("read as a plan, not a log".to_owned());
+    };
     stage("report");
-    Ok(report_json(&log))
+    Ok(report_json("fuzz", &log))
 }
 
 fn judge(file: &str, run: Run<Result<serde_json::Value, String>>, limits: &Limits) -> Vec<Finding> {
@@ -148,8 +153,14 @@ fn judge(file: &str, run: Run<Result<serde_json::Value, String>>, limits: &Limit
         }
         Ok(json) => {
             // Absent by design: no eigenvalue for a covariance that is not finite, no twist
-            // where the messages have none.
-            let optional = ["step", "min_eigenvalue", "twist_sigma_last"];
+            // σ where the messages have none, no stamps for a topic without messages.
+            let optional = [
+                "step",
+                "min_eigenvalue",
+                "twist_sigma_last",
+                "first_s",
+                "last_s",
+            ];
             if let Some(path) = json_null(&json, &optional) {
                 found.push(finding("nonfinite_json", format!("null at {path}")));
             }

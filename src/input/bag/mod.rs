@@ -26,8 +26,8 @@ use crate::plan::bag::{
 };
 
 use super::format::{self, Format};
-use super::{InputError, Located, Place};
 use super::suggest;
+use super::{InputError, Located, Place};
 
 pub mod bundled;
 pub mod decode;
