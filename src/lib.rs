@@ -5,8 +5,22 @@
 //! every method the literature offers, and draws it — sampled clouds, covariance ellipsoids,
 //! Exp-mapped "banana" surfaces, orientation sprays — in the Rerun viewer.
 //!
-//! This crate is the library behind the `posecov` binary. Its data path:
-//! scenario → evaluation (pure library calls) → scene (plain data) → sink (Rerun, .rrd, JSON).
+//! This crate is the library behind the `posecov` binary. Data flows one way, through five
+//! stages, each getting only its own settings and handing plain data to the next:
+//!
+//! 1. [`input`]: a file (TOML scenario, g2o / GTSAM / TORO pose graph, ROS 1 bag, MCAP) or a
+//!    bundled example, its format decided once, read and checked with every error at its
+//!    `file:line:column` → a typed [`plan`] ([`plan::Plan`]; a robot log:
+//!    [`plan::bag::LogSummary`]).
+//! 2. [`eval`]: numbers only — every method's estimate, Monte Carlo statistics and typed
+//!    findings ([`eval::Evaluation`]; logs: [`eval::bag`]).
+//! 3. [`draw`]: what to show — shapes, clouds, plots, text and views as plain data.
+//! 4. [`scene`]: that plain data ([`scene::Scene`]), validated, knowing nothing of Rerun.
+//! 5. `sink` (viewer feature): the scene to the Rerun viewer, an .rrd file, stdout or a web
+//!    viewer.
+//!
+//! [`app`] resolves the settings once (flags over file over defaults) and runs the stages;
+//! `ARCHITECTURE.md` says where each kind of change goes. The math underneath:
 //!
 //! - [`lie`]: the groups SO(2), SO(3), SE(2), SE(3) with exp/log, adjoints and every Jacobian.
 //! - [`uncertain`]: poses with covariances (mean, Σ, side), validation, side conversion.

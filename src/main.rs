@@ -185,7 +185,7 @@ struct EvalArgs {
     samples: Option<u64>,
     /// Probability inside drawn regions, strictly between 0 and 1 (default: the scenario's).
     #[arg(long, value_parser = parse_probability)]
-    confidence: Option<f64>,
+    confidence: Option<posecov::uncertain::Confidence>,
     /// Monte-Carlo particles held in memory at once, rounded up to a multiple of 1024
     /// (default: what fits 128 MiB, at most 65536). Larger samples are simulated block by block: memory
     /// stays bounded, statistics use every sample, and each block's cloud is logged in turn.
@@ -273,11 +273,9 @@ struct ServeArgs {
     open_browser: bool,
 }
 
-fn parse_probability(s: &str) -> Result<f64, String> {
+fn parse_probability(s: &str) -> Result<posecov::uncertain::Confidence, String> {
     let p = s.parse::<f64>().map_err(|e| e.to_string())?;
-    posecov::uncertain::Confidence::new(p)
-        .map(posecov::uncertain::Confidence::get)
-        .map_err(|e| e.to_string())
+    posecov::uncertain::Confidence::new(p).map_err(|e| e.to_string())
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {

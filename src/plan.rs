@@ -543,6 +543,24 @@ pub mod limits {
     pub const MIN_SAMPLES: u64 = 2;
     /// Most Monte Carlo samples (larger ones run in blocks of bounded memory).
     pub const MAX_SAMPLES: u64 = 10_000_000;
+    /// Monte Carlo samples when neither the command line nor the file says.
+    pub const DEFAULT_SAMPLES: u64 = 2000;
+
+    /// The one check of a Monte Carlo sample count ([`MIN_SAMPLES`] ..= [`MAX_SAMPLES`]),
+    /// for the command line, the file and the evaluation alike: `Err` with what is accepted.
+    ///
+    /// ```
+    /// use posecov::plan::limits::check_samples;
+    /// assert_eq!(check_samples(2000), Ok(2000));
+    /// assert_eq!(check_samples(1).unwrap_err(), "use 2 ..= 10000000");
+    /// ```
+    pub fn check_samples(n: u64) -> Result<u64, String> {
+        if (MIN_SAMPLES..=MAX_SAMPLES).contains(&n) {
+            Ok(n)
+        } else {
+            Err(format!("use {MIN_SAMPLES} ..= {MAX_SAMPLES}"))
+        }
+    }
     /// Most steps of one propagation (odometry, compounding, Euler vs Exp, Euler–Maruyama).
     pub const MAX_STEPS: u64 = 100_000;
     /// Most particle-steps (samples × steps, summed over operations) one evaluation runs:

@@ -11,9 +11,14 @@ use crate::error::{Error, Result, check_finite};
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 
 mod confidence;
+mod validate;
 pub use confidence::{
     Confidence, ConfidenceError, Coverage, Region, anees_band, chi2_probability, chi2_radius,
     sigma_probability, sigma_radius,
+};
+pub use validate::{
+    PSD_TOLERANCE, SYMMETRY_TOLERANCE, psd_tolerance, symmetry_tolerance, validate_covariance,
+    validate_covariance_dyn,
 };
 
 /// Which side of the mean a covariance's perturbation multiplies.
@@ -54,118 +59,6 @@ pub enum Method {
     ClosedForm,
     /// Numerical integration of a continuous-time covariance ODE.
     NumericIntegral,
-}
-
-impl Method {
-    /// A short human-readable label ("first order", "Monte Carlo", …).
-    ///
-    /// ```
-    /// use posecov::uncertain::Method;
-    /// assert_eq!(Method::MonteCarlo.label(), "Monte Carlo");
-    /// ```
-    pub fn label(self) -> &'static str {
-        match self {
-            Method::Exact => "exact",
-            Method::FirstOrder => "first order",
-            Method::LectureNoJr => "first order without Jr (lecture)",
-            Method::SecondOrder => "second order",
-            Method::FourthOrder => "fourth order",
-            Method::SigmaPoints => "sigma points",
-            Method::MonteCarlo => "Monte Carlo",
-            Method::VectorSpace => "vector space (SSC)",
-            Method::ClosedForm => "closed form",
-            Method::NumericIntegral => "numeric integral",
-        }
-    }
-}
-
-/// Tolerance on |Σᵢⱼ − Σⱼᵢ|, relative to max(1, max |Σ|): inputs typed with a few decimals or
-/// produced by f64 arithmetic pass; a transposed entry does not.
-pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
-
-/// Allowance for round-off in the positive-semi-definite check: the smallest eigenvalue of Σ
-/// may be as low as −`PSD_TOLERANCE` · max(1, λ_max) and still be accepted (as 0).
-pub const PSD_TOLERANCE: f64 = 1e-12;
-
-/// Validates a covariance: finite, symmetric within [`SYMMETRY_TOLERANCE`], positive
-/// semi-definite by its eigenvalues within [`PSD_TOLERANCE`]. Returns the symmetrised matrix
-/// ½(Σ + Σᵀ).
-///
-/// ```
-/// use posecov::uncertain::validate_covariance;
-/// use nalgebra::Matrix2;
-/// assert!(validate_covariance("Σ", &Matrix2::new(1.0, 0.5, 0.5, 1.0)).is_ok());
-/// assert!(validate_covariance("Σ", &Matrix2::new(1.0, 2.0, 2.0, 1.0)).is_err()); // eigenvalue −1
-/// assert!(validate_covariance("Σ", &Matrix2::new(1.0, 0.5, 0.4, 1.0)).is_err()); // asymmetric
-/// ```
-pub fn validate_covariance<const N: usize>(
-    what: &'static str,
-    cov: &TangentMatrix<N>,
-) -> Result<TangentMatrix<N>> {
-    let sym = validate_covariance_dyn(what, &DMatrix::from_iterator(N, N, cov.iter().copied()))?;
-    Ok(TangentMatrix::<N>::from_iterator(sym.iter().copied()))
-}
-
-/// [`validate_covariance`] for a matrix whose size is known only at run time (a joint
-/// covariance of several poses): square, finite, symmetric within [`SYMMETRY_TOLERANCE`],
-/// positive semi-definite within [`PSD_TOLERANCE`]. Returns ½(Σ + Σᵀ).
-///
-/// ```
-/// use posecov::uncertain::validate_covariance_dyn;
-/// use nalgebra::DMatrix;
-/// assert!(validate_covariance_dyn("joint", &DMatrix::<f64>::identity(4, 4)).is_ok());
-/// assert!(validate_covariance_dyn("joint", &DMatrix::<f64>::identity(4, 3)).is_err()); // not square
-/// ```
-pub fn validate_covariance_dyn(what: &'static str, cov: &DMatrix<f64>) -> Result<DMatrix<f64>> {
-    let (n, cols) = cov.shape();
-    if n != cols {
-        return Err(Error::WrongShape {
-            what,
-            expected_rows: n.max(cols),
-            expected_cols: n.max(cols),
-            rows: n,
-            cols,
-        });
-    }
-    check_finite(what, cov.transpose().iter().copied())?;
-    let scale = cov.amax().max(1.0);
-    let tolerance = SYMMETRY_TOLERANCE * scale;
-    let mut worst = (0, 0, 0.0);
-    for row in 0..n {
-        for col in row + 1..n {
-            let difference = (cov[(row, col)] - cov[(col, row)]).abs();
-            if difference > worst.2 {
-                worst = (row, col, difference);
-            }
-        }
-    }
-    let (row, col, difference) = worst;
-    if difference > tolerance {
-        return Err(Error::NotSymmetric {
-            what,
-            row,
-            col,
-            upper: cov[(row, col)],
-            lower: cov[(col, row)],
-            difference,
-            tolerance,
-        });
-    }
-    let sym = (cov + cov.transpose()) * 0.5;
-    if n == 0 {
-        return Ok(sym);
-    }
-    let eigenvalues = SymmetricEigen::new(sym.clone()).eigenvalues;
-    let min_eigenvalue = eigenvalues.min();
-    let tolerance = PSD_TOLERANCE * eigenvalues.max().max(1.0);
-    if min_eigenvalue < -tolerance {
-        return Err(Error::NotPositiveSemiDefinite {
-            what,
-            min_eigenvalue,
-            tolerance,
-        });
-    }
-    Ok(sym)
 }
 
 /// A pose (or rotation) with a Gaussian uncertainty on the manifold: (μ, Σ, side).

@@ -256,3 +256,14 @@ fn a_live_edit_that_does_not_evaluate_is_refused() {
     )
     .unwrap();
 }
+
+/// A key is named as the file writes it: `std_deg[2]`, not `std[2]`.
+#[test]
+fn a_negative_std_deg_is_named_as_typed() {
+    let text = SE2.replace(
+        "cov = { std = [0.1, 0.1, 0.2] }",
+        "cov = { std_deg = [0.1, 0.1, -2] }",
+    );
+    let e = error_of(&text);
+    assert!(e.contains("std_deg[2] = -2 is negative"), "{e}");
+}

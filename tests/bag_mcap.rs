@@ -193,7 +193,7 @@ fn write_example() -> Vec<u8> {
     w.into_inner().into_inner()
 }
 
-fn read(bytes: &[u8], options: &BagOptions) -> posecov::plan::bag::BagPlan {
+fn read(bytes: &[u8], options: &BagOptions) -> posecov::plan::bag::LogSummary {
     let dir = std::env::temp_dir().join(format!("posecov-mcap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // Tests run in parallel: one file each.
@@ -430,4 +430,44 @@ fn a_falsified_chunk_size_ends_with_an_error() {
         );
     }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A declared topic without messages is listed, evaluated and drawn: a scene that validates
+/// and says "0 messages" (the stages after reading, through the public API).
+#[test]
+fn a_topic_without_messages_is_drawn() {
+    use posecov::draw::bag::{BagDrawSettings, bag_scene, description};
+    use posecov::eval::bag::evaluate_bag;
+    use posecov::input::{About, Format};
+    use posecov::uncertain::Confidence;
+    let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
+    let schema = w
+        .add_schema(
+            "geometry_msgs/msg/PoseWithCovarianceStamped",
+            "ros2msg",
+            b"",
+        )
+        .unwrap();
+    w.add_channel(schema, "/empty", "cdr", &BTreeMap::new())
+        .unwrap();
+    w.finish().unwrap();
+    let plan = read(&w.into_inner().into_inner(), &BagOptions::default());
+    assert_eq!(plan.topics.len(), 1);
+    assert_eq!(
+        (plan.topics[0].name.as_str(), plan.topics[0].count),
+        ("/empty", 0)
+    );
+    let e = evaluate_bag(&plan, &Default::default());
+    let text = description(&plan, Format::Mcap, &e, Confidence::DEFAULT);
+    assert!(text.contains("0 messages"), "{text}");
+    let settings = BagDrawSettings {
+        about: About {
+            title: "t".into(),
+            description: String::new(),
+            source: String::new(),
+        },
+        confidence: Confidence::DEFAULT,
+        axis_length: None,
+    };
+    assert!(bag_scene(&e, &settings, &text).validate().is_ok());
 }

@@ -137,10 +137,15 @@ fn ctrl_c_keeps_what_was_read_and_draws_it() {
     };
     let settings = posecov::draw::bag::BagDrawSettings {
         about,
-        confidence: 0.95,
+        confidence: posecov::uncertain::Confidence::DEFAULT,
         axis_length: None,
     };
-    let text = posecov::draw::bag::description(&plan, posecov::input::Format::Ros1Bag, &e, 0.95);
+    let text = posecov::draw::bag::description(
+        &plan,
+        posecov::input::Format::Ros1Bag,
+        &e,
+        posecov::uncertain::Confidence::DEFAULT,
+    );
     assert!(text.contains("Interrupted (Ctrl-C)"), "{text}");
     assert!(
         posecov::draw::bag::bag_scene(&e, &settings, &text)

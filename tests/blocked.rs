@@ -101,7 +101,7 @@ fn draw(loaded: &Loaded, e: &AnyEvaluation) -> posecov::scene::Scene {
 }
 
 fn block_samples(e: &AnyEvaluation) -> usize {
-    e.run().2
+    e.ran_with().block_samples
 }
 
 fn max_abs(m: &[[f64; 6]]) -> f64 {

@@ -19,7 +19,12 @@ fn run(text: &str, samples: u64) -> (Loaded, AnyEvaluation, Value) {
         ..Default::default()
     };
     let (evaluation, _) = pipeline(&loaded, &overrides, None).expect("evaluates");
-    let json = report_json("t", &loaded, &evaluation, 0.95);
+    let json = report_json(
+        "t",
+        &loaded,
+        &evaluation,
+        posecov::uncertain::Confidence::DEFAULT,
+    );
     (loaded, evaluation, json)
 }
 
@@ -364,8 +369,8 @@ fn no_bundled_scenario_wraps_its_sigma_points_until_alpha_pushes_them_past_pi() 
         let (_, evaluation, json) = run(b.text, 16);
         assert!(wrap_finding(&json).is_none(), "{}", b.name);
         if evaluation
-            .run()
-            .3
+            .ran_with()
+            .methods
             .contains(&posecov::uncertain::Method::SigmaPoints)
         {
             with_sigma_points.push(b.name);
@@ -386,7 +391,12 @@ fn no_bundled_scenario_wraps_its_sigma_points_until_alpha_pushes_them_past_pi() 
         ..Default::default()
     };
     let (evaluation, _) = pipeline(&loaded, &overrides, None).unwrap();
-    let json = report_json("t", &loaded, &evaluation, 0.95);
+    let json = report_json(
+        "t",
+        &loaded,
+        &evaluation,
+        posecov::uncertain::Confidence::DEFAULT,
+    );
     let wrap = wrap_finding(&json).expect("α = 6 pushes them past π");
     let turn = 6.0 * 3f64.sqrt() * 20f64.to_radians();
     assert!((wrap["largest_rotation_rad"].as_f64().unwrap() - turn).abs() < 1e-12);

@@ -204,9 +204,7 @@ fn save_writes_atomically_and_two_processes_write_the_same_content() {
         .map(|f| std::fs::read(f).expect("read rrd"));
     assert_same_content(&a, &b);
     match rerun_cli() {
-        None => eprintln!(
-            "SKIPPED rrd verify/compare: no rerun CLI ($POSECOV_RERUN_CLI, or ../shared/scripts/rerun-cli)"
-        ),
+        None => eprintln!("SKIPPED rrd verify/compare: no rerun CLI (set $POSECOV_RERUN_CLI)"),
         Some(cli) => {
             for args in [vec!["rrd", "verify"], vec!["rrd", "compare"]] {
                 let out = Command::new(&cli)

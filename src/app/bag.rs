@@ -21,7 +21,7 @@ use crate::draw::bag::{BagDrawSettings, bag_scene, description, issue_sentence, 
 use crate::eval::bag::{BagEvaluation, evaluate_bag};
 use crate::input::bag::{BagOptions, bundled, read_located};
 use crate::input::{About, Located, Place};
-use crate::plan::bag::{BagPlan, Class, Issue};
+use crate::plan::bag::{Class, Issue, LogSummary};
 use crate::scene::Scene;
 
 /// A read, evaluated and drawn log.
@@ -32,7 +32,7 @@ pub struct LogRun {
     /// The settings it ran with.
     pub settings: LogSettings,
     /// What was read.
-    pub plan: BagPlan,
+    pub plan: LogSummary,
     /// Its numbers.
     pub evaluation: BagEvaluation,
     /// Its scene (validated).
@@ -80,7 +80,7 @@ fn read(
     located: &Located,
     options: &BagOptions,
     cancel: Option<&AtomicBool>,
-) -> Result<BagPlan, AppError> {
+) -> Result<LogSummary, AppError> {
     let file = located.origin();
     let bar = ProgressBar::new(0).with_message(format!("reading {file}"));
     bar.set_style(
@@ -205,7 +205,7 @@ pub fn report_text(name: &str, run: &LogRun) -> String {
     format!(
         "{name} — {} ({:.1} % regions, seed {})\n\n{}",
         run.scene.title,
-        100.0 * run.settings.confidence,
+        100.0 * run.settings.confidence.get(),
         run.settings.eval.seed,
         run.scene.description_markdown
     )

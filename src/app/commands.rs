@@ -76,13 +76,14 @@ pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<Strin
         let value = report_json(scenario, &loaded, &evaluation, confidence);
         return Ok(serde_json::to_string_pretty(&value).unwrap_or_default() + "\n");
     }
-    let (seed, samples, _, _) = evaluation.run();
+    let ran = evaluation.ran_with();
+    let (seed, samples) = (ran.seed, ran.samples);
     let mut out = String::new();
     let _ = writeln!(
         out,
         "{scenario} — {} (seed {seed}, {samples} samples, {:.1} % regions)",
         loaded.input.about.title,
-        100.0 * confidence
+        100.0 * confidence.get()
     );
     for r in &evaluation.records() {
         let error = r.relative_error_vs_monte_carlo.map_or(String::new(), |e| {

@@ -214,16 +214,16 @@ fn evaluate_and_draw(
 /// use posecov::app::{Overrides, load, pipeline, report_json};
 /// let loaded = load("camera_on_robot").unwrap();
 /// let (evaluation, _) = pipeline(&loaded, &Overrides { samples: Some(64), ..Default::default() }, None).unwrap();
-/// let json = report_json("camera_on_robot", &loaded, &evaluation, 0.95);
+/// let json = report_json("camera_on_robot", &loaded, &evaluation, posecov::uncertain::Confidence::DEFAULT);
 /// assert_eq!(json["meta"]["samples"], 64);
 /// ```
 pub fn report_json(
     name: &str,
     loaded: &Loaded,
     evaluation: &AnyEvaluation,
-    confidence: f64,
+    confidence: crate::uncertain::Confidence,
 ) -> serde_json::Value {
-    let (seed, samples, block_samples, methods) = evaluation.run();
+    let ran = evaluation.ran_with();
     let sigma = loaded.input.defaults.sigma_points.unwrap_or_default();
     let mut report = serde_json::json!({
         "scenario": name,
@@ -234,15 +234,16 @@ pub fn report_json(
             "description": loaded.input.about.description,
             "source": loaded.input.about.source,
             "group": evaluation.group().name(),
-            "seed": seed,
-            "samples": samples,
-            "block_samples": block_samples,
+            "seed": ran.seed,
+            "samples": ran.samples,
+            "block_samples": ran.block_samples,
             "confidence": confidence,
-            "methods": methods,
+            "methods": ran.methods,
             "sigma_points": { "alpha": sigma.alpha, "beta": sigma.beta, "kappa": sigma.kappa },
         },
         "results": evaluation.records(),
         "monte_carlo": evaluation.monte_carlo_records(),
+        "along_track": evaluation.along_track(),
         "findings": evaluation.findings(),
     });
     // A pose graph's optimisation: poses, marginals, loop closures (eval::graph).

@@ -94,8 +94,8 @@ impl PlanRun {
 
     /// How many Monte Carlo blocks beyond the first are shown after the scene.
     pub fn later_blocks(&self) -> u64 {
-        let (_, n, b, _) = self.evaluation.run();
-        (n.div_ceil(b.max(1)) as u64).saturating_sub(1)
+        let ran = self.evaluation.ran_with();
+        (ran.samples.div_ceil(ran.block_samples.max(1)) as u64).saturating_sub(1)
     }
 
     /// The clouds of Monte Carlo block `k` (1 ..= [`later_blocks`](Self::later_blocks)),

@@ -6,20 +6,17 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::run::{Opened, PlanRun, Run, open};
 use super::sinks::{
     EXIT_INTERRUPTED, ViewOptions, choose_sink, finish, flush, render_with, scenario_name, serve,
+    watch_file,
 };
 use super::{AppError, Overrides};
 use crate::scene::Scene;
 use crate::sink::{self, LogOutcome, RecordingIds, Sink, open_stream};
-
-/// How often `--watch` looks at the file's modification time.
-const WATCH_POLL: Duration = Duration::from_millis(300);
 
 impl Run {
     /// Logs the scene, then the clouds of any later Monte Carlo blocks one block at a time
@@ -159,38 +156,35 @@ pub(crate) fn watch_saving(
     let path = PathBuf::from(&options.scenario);
     let sink = Sink::Save(file.to_owned());
     let mut generation = 0u64;
-    let mut last_seen = None;
-    while !cancel.load(Ordering::Relaxed) {
-        let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
-        if modified != last_seen {
-            last_seen = modified;
-            match start(&options.scenario, &options.overrides) {
-                Err(err) => eprintln!(
-                    "error: {err}\n(waiting for the next change of {})",
-                    path.display()
-                ),
-                Ok(run) => {
-                    let mut ids = run.ids(&options.scenario);
-                    ids.recording_id = format!("{}/gen-{generation}", ids.recording_id);
-                    let (rec, guard) = open_stream(&sink, &ids, run.scene())?;
-                    let outcome = run.log(&rec, cancel)?;
-                    let code = finish(guard, rec, &sink, outcome)?;
-                    if code != 0 {
-                        return Ok(code);
-                    }
-                    eprintln!(
-                        "[{generation}] recorded {} ({} items); watching {} for changes (Ctrl-C stops)",
-                        path.display(),
-                        run.scene().items.len(),
-                        path.display()
-                    );
-                    generation += 1;
+    watch_file(&path, true, cancel, None, |changed| {
+        if !changed {
+            return Ok(None);
+        }
+        match start(&options.scenario, &options.overrides) {
+            Err(err) => eprintln!(
+                "error: {err}\n(waiting for the next change of {})",
+                path.display()
+            ),
+            Ok(run) => {
+                let mut ids = run.ids(&options.scenario);
+                ids.recording_id = format!("{}/gen-{generation}", ids.recording_id);
+                let (rec, guard) = open_stream(&sink, &ids, run.scene())?;
+                let outcome = run.log(&rec, cancel)?;
+                let code = finish(guard, rec, &sink, outcome)?;
+                if code != 0 {
+                    return Ok(Some(code));
                 }
+                eprintln!(
+                    "[{generation}] recorded {} ({} items); watching {} for changes (Ctrl-C stops)",
+                    path.display(),
+                    run.scene().items.len(),
+                    path.display()
+                );
+                generation += 1;
             }
         }
-        std::thread::sleep(WATCH_POLL);
-    }
-    Ok(0)
+        Ok(None)
+    })
 }
 
 /// Opens and runs the watched file again.

@@ -12,11 +12,11 @@ use crate::input::bag::BagOptions;
 use crate::input::{Input, InputKind};
 use crate::interop::RosReading;
 use crate::plan::{StepPolicy, limits};
+use crate::uncertain::Confidence;
 
-/// Monte Carlo samples when neither the command line nor the file says.
-pub const DEFAULT_SAMPLES: u64 = crate::eval::DEFAULT_SAMPLES as u64;
+pub use crate::plan::limits::DEFAULT_SAMPLES;
 /// Probability inside drawn regions when neither the command line nor the file says.
-pub const DEFAULT_CONFIDENCE: f64 = crate::eval::DEFAULT_CONFIDENCE;
+pub const DEFAULT_CONFIDENCE: Confidence = Confidence::DEFAULT;
 /// At most this many cloud samples per drawn message of a robot log (`--samples`).
 pub const MAX_CLOUD_SAMPLES: u64 = 10_000;
 
@@ -27,8 +27,8 @@ pub struct Overrides {
     pub seed: Option<u64>,
     /// `--samples`.
     pub samples: Option<u64>,
-    /// `--confidence`.
-    pub confidence: Option<f64>,
+    /// `--confidence` (a probability in (0, 1) by its type: checked where it is parsed).
+    pub confidence: Option<Confidence>,
     /// `--block-samples`.
     pub block_samples: Option<u64>,
     /// `--topic` (repeatable; robot logs only): the topics to read.
@@ -125,7 +125,7 @@ fn check_flags(given: InputKind, overrides: &Overrides) -> Result<(), SettingsEr
             });
         }
     }
-    check_confidence(overrides.confidence)
+    Ok(())
 }
 
 /// Everything the stages need, resolved.
@@ -135,18 +135,6 @@ pub struct Settings {
     pub eval: EvalSettings,
     /// For [`crate::draw::scene`].
     pub draw: DrawSettings,
-}
-
-/// `--confidence` must be a probability strictly between 0 and 1 (every input's check).
-fn check_confidence(confidence: Option<f64>) -> Result<(), SettingsError> {
-    match confidence.map(crate::uncertain::Confidence::new) {
-        Some(Err(e)) => Err(SettingsError::OutOfRange {
-            flag: "--confidence",
-            value: e.value.to_string(),
-            expected: e.to_string(),
-        }),
-        _ => Ok(()),
-    }
 }
 
 /// Resolves the settings of `input` under `overrides` (values in the file were checked when
@@ -170,12 +158,12 @@ pub fn resolve(
     let file = &input.defaults;
     check_flags(InputKind::Plan, overrides)?;
     if let Some(n) = overrides.samples
-        && !(limits::MIN_SAMPLES..=limits::MAX_SAMPLES).contains(&n)
+        && let Err(expected) = limits::check_samples(n)
     {
         return Err(SettingsError::OutOfRange {
             flag: "--samples",
             value: n.to_string(),
-            expected: format!("use {} ..= {}", limits::MIN_SAMPLES, limits::MAX_SAMPLES),
+            expected,
         });
     }
     if let Some(b) = overrides.block_samples
@@ -229,7 +217,7 @@ pub struct LogSettings {
     /// For [`crate::eval::bag::evaluate_bag`]: seed and cloud samples.
     pub eval: BagEvalSettings,
     /// Probability inside drawn regions.
-    pub confidence: f64,
+    pub confidence: Confidence,
 }
 
 /// Resolves the settings of a robot log under `overrides` (a log file has no settings of its

@@ -54,7 +54,42 @@ pub(crate) fn flush(rec: &rerun::RecordingStream) -> Result<(), AppError> {
         .map_err(|e| AppError::Sink(SinkError::Flush(e.to_string())))
 }
 
-/// Name used in the recording id: a bundled name as is, a file by its stem.
+/// How often `--watch` looks at the file's modification time.
+pub(crate) const WATCH_POLL: Duration = Duration::from_millis(300);
+
+/// The one watch loop of `--watch`: every [`WATCH_POLL`] until Ctrl-C (or `limit` has
+/// passed), `tick` is called with whether `path`'s modification time changed since the last
+/// call (at the first call: whether the file exists, when `first_counts`). `tick` returns
+/// `Some(code)` to stop with that exit code; the loop ends with 0.
+///
+/// # Errors
+/// What `tick` returns.
+pub(crate) fn watch_file(
+    path: &Path,
+    first_counts: bool,
+    cancel: &AtomicBool,
+    limit: Option<Duration>,
+    mut tick: impl FnMut(bool) -> Result<Option<u8>, AppError>,
+) -> Result<u8, AppError> {
+    let modified = || std::fs::metadata(path).and_then(|m| m.modified()).ok();
+    let mut last_seen = if first_counts { None } else { modified() };
+    let start = std::time::Instant::now();
+    while !cancel.load(std::sync::atomic::Ordering::Relaxed)
+        && limit.is_none_or(|l| start.elapsed() < l)
+    {
+        let now = modified();
+        let changed = now != last_seen;
+        last_seen = now;
+        if let Some(code) = tick(changed)? {
+            return Ok(code);
+        }
+        std::thread::sleep(WATCH_POLL);
+    }
+    Ok(0)
+}
+
+/// Name used in the recording id and in file names offered for download: a bundled name as
+/// is, a file by its stem.
 pub(crate) fn scenario_name(scenario: &str) -> String {
     Path::new(scenario)
         .file_stem()

@@ -16,17 +16,18 @@
 
 use nalgebra::{Matrix2, Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
 
-use super::shapes::{self, AXIS_COLORS, chi2_radius, ellipsoid_of};
+use super::shapes::{self, AXIS_COLORS, ellipsoid_of};
 use super::{DrawSettings, Painter, v3, views};
 use crate::eval::bag::{BagEvaluation, PoseState, RvizNumbers, TopicEvaluation};
 use crate::input::{About, DrawChoices, Layout};
 use crate::lie::{GroupKind, LieGroup, Se3};
 use crate::plan::StepPolicy;
+use crate::scene::WORLD;
 use crate::scene::{
     Color, Ellipsoid, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, Plot, PointCloud,
     ScalarSeries, Scene, SceneItem, Swatch, Timeline, Timing, Vec3,
 };
-use crate::uncertain::Method;
+use crate::uncertain::{Confidence, Method};
 
 mod text;
 
@@ -47,7 +48,7 @@ pub struct BagDrawSettings {
     /// Title and description of the log (the text panel starts with it).
     pub about: About,
     /// Probability inside drawn regions, in (0, 1).
-    pub confidence: f64,
+    pub confidence: Confidence,
     /// Length of the frames' axes (m); `None`: from the trajectory's size.
     pub axis_length: Option<f64>,
 }
@@ -63,8 +64,8 @@ pub struct BagDrawSettings {
 /// let plan = read_bag(path.as_ref(), &BagOptions::default(), &mut |_, _| {}, None).unwrap();
 /// let e = evaluate_bag(&plan, &BagEvalSettings::default());
 /// let about = About { title: "test2.bag".into(), description: String::new(), source: String::new() };
-/// let settings = BagDrawSettings { about, confidence: 0.95, axis_length: None };
-/// let scene = bag_scene(&e, &settings, &description(&plan, Format::Ros1Bag, &e, 0.95));
+/// let settings = BagDrawSettings { about, confidence: posecov::uncertain::Confidence::DEFAULT, axis_length: None };
+/// let scene = bag_scene(&e, &settings, &description(&plan, Format::Ros1Bag, &e, posecov::uncertain::Confidence::DEFAULT));
 /// assert!(scene.validate().is_ok());
 /// assert!(scene.items.iter().any(|i| i.path == "world/jackal_velocity_controller/odom/meaning/banana"));
 /// ```
@@ -111,7 +112,7 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
     p.scene.timeline = Timeline::for_stamps(stamps.chain(series));
     plots(&mut p.scene, e);
     // Views and cameras as for every scene: a planar log from straight above.
-    let plan = views::ViewPlan {
+    let plan = views::ViewInputs {
         poses: &p.methods,
         rotation_only: false,
         top: planar,
@@ -174,7 +175,7 @@ fn flat(planar: bool, v: &Vector3<f64>) -> Vec3 {
 }
 
 fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
-    let base = format!("world/{}", topic_path(&t.name));
+    let base = format!("{WORLD}/{}", topic_path(&t.name));
     let color = Method::ALL[k % Method::ALL.len()].color();
     let strip: Vec<Vec3> = t
         .trajectory
@@ -196,9 +197,9 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
         );
     }
     history(p, &base, t);
-    let r_pos = chi2_radius(p.confidence(), t.position_dof);
-    let r_disc = chi2_radius(p.confidence(), 2);
-    let r_fan = chi2_radius(p.confidence(), 1);
+    let r_pos = p.confidence().radius(t.position_dof);
+    let r_disc = p.confidence().radius(2);
+    let r_fan = p.confidence().radius(1);
     for pose in &t.poses {
         let at = Timing::Stamp(pose.stamp_ns);
         let Some(mean) = pose.mean else {
@@ -274,7 +275,7 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
 /// The faint static overview: RViz's position region and the meaning's banana outline of
 /// every drawn message.
 fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
-    let r = chi2_radius(p.confidence(), t.position_dof);
+    let r = p.confidence().radius(t.position_dof);
     let shapes_rviz: Vec<Ellipsoid> = t
         .poses
         .iter()
@@ -631,7 +632,7 @@ fn plots(scene: &mut Scene, e: &BagEvaluation) {
                 "sigma_rotation"
             };
             scene.series.push(ScalarSeries {
-                path: format!("plots/{plot}/{topic}/{name}"),
+                path: format!("{}/{plot}/{topic}/{name}", crate::scene::PLOTS),
                 name: format!("{} σ{name}", t.name),
                 color: AXIS_COLORS[axis % 3],
                 width: 1.5,
@@ -645,7 +646,7 @@ fn plots(scene: &mut Scene, e: &BagEvaluation) {
             .collect();
         if !points.is_empty() {
             scene.series.push(ScalarSeries {
-                path: format!("plots/position_trace/{topic}"),
+                path: format!("{}/position_trace/{topic}", crate::scene::PLOTS),
                 name: format!("{} tr Σ_position", t.name),
                 color: MEANING,
                 width: 1.5,

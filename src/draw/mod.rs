@@ -22,7 +22,7 @@
 //! use posecov::draw::{DrawSettings, scene};
 //! let loaded = load_text("[scenario]\ntitle='t'\ngroup='se2'\nmethods=['first_order']\n[[pose]]\nname='a'\nmean={xy_theta=[1,2,0]}\ncov={std=[0.1,0.1,0.3]}\n", "t.toml").unwrap();
 //! let (evaluation, _) = pipeline(&loaded, &Overrides::default(), None).unwrap();
-//! let s = scene(&evaluation, &DrawSettings::from_input(&loaded.input, 0.95));
+//! let s = scene(&evaluation, &DrawSettings::from_input(&loaded.input, posecov::uncertain::Confidence::DEFAULT));
 //! assert!(s.items.iter().any(|i| i.path == "world/a/given/banana"));
 //! assert!(s.validate().is_ok());
 //! ```
@@ -35,24 +35,22 @@ use crate::eval::{AnyEvaluation, Evaluation, Node, PathKind, Role};
 use crate::input::{About, DrawChoices, Input, Layout};
 use crate::lie::{GroupKind, LieGroup, Se3};
 use crate::plan::StepPolicy;
+use crate::scene::WORLD;
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, Scene,
     SceneItem, Swatch, Timing, Triads, Vec3,
 };
-use crate::uncertain::Method;
+use crate::uncertain::{Confidence, Method};
 
 pub mod bag;
 mod graph;
 mod legend;
+mod node;
+use node::{draw_node, draw_particles};
 mod plots;
 mod shapes;
 mod text;
 mod views;
-
-use shapes::chi2_radius;
-
-/// Colour of the Monte Carlo heading arrows of planar poses (light red).
-const HEADING_COLOR: Color = Color::rgb(255, 120, 120);
 
 /// At most this many Monte Carlo particles get a small axis triad.
 const TRIAD_SUBSAMPLE: usize = 60;
@@ -63,7 +61,7 @@ pub struct DrawSettings {
     /// Title, description, source for the text panel.
     pub about: About,
     /// Probability inside drawn regions, in (0, 1).
-    pub confidence: f64,
+    pub confidence: Confidence,
     /// What to draw.
     pub choices: DrawChoices,
     /// Which steps of a propagation are drawn in full (the same policy the evaluation used).
@@ -76,10 +74,12 @@ impl DrawSettings {
     /// ```
     /// use posecov::draw::DrawSettings;
     /// use posecov::input::scenario::{Scenario, lower};
+    /// use posecov::uncertain::Confidence;
     /// let input = lower(&Scenario::load_any("camera_on_robot").unwrap()).unwrap();
-    /// assert_eq!(DrawSettings::from_input(&input, 0.9).confidence, 0.9);
+    /// let p = Confidence::new(0.9).unwrap();
+    /// assert_eq!(DrawSettings::from_input(&input, p).confidence, p);
     /// ```
-    pub fn from_input(input: &Input, confidence: f64) -> Self {
+    pub fn from_input(input: &Input, confidence: Confidence) -> Self {
         Self {
             about: input.about.clone(),
             confidence,
@@ -150,7 +150,7 @@ fn part_of<G: LieGroup<N>, const N: usize>(
         for point in &block.points {
             if let Some(particles) = &point.particles {
                 p.push(
-                    format!("world/{}/monte_carlo/cloud/block_{part}", point.name),
+                    format!("{WORLD}/{}/monte_carlo/cloud/block_{part}", point.name),
                     None,
                     point_cloud_item(particles.clone()),
                 );
@@ -247,7 +247,7 @@ impl<'s> Painter<'s> {
         }
     }
 
-    fn confidence(&self) -> f64 {
+    fn confidence(&self) -> Confidence {
         self.settings.confidence
     }
 
@@ -299,15 +299,15 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     }
     if choices.trajectories {
         let radius = 0.004 * p.extent.max(0.25);
-        for path in &e.paths {
+        for path in &e.trajectories {
             let (name, color, what) = match path.kind {
                 PathKind::Nominal => (
-                    format!("world/{}/nominal", path.output),
+                    format!("{WORLD}/{}/nominal", path.output),
                     scene::NOMINAL,
                     "nominal path",
                 ),
                 PathKind::Sample(i) => (
-                    format!("world/{}/samples/{i}", path.output),
+                    format!("{WORLD}/{}/samples/{i}", path.output),
                     Method::MonteCarlo.color(),
                     "Monte Carlo sample paths",
                 ),
@@ -344,9 +344,9 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
                 method.color(),
                 Swatch::Dashed,
             );
-            let shape = shapes::ellipsoid_of(mean, cov, chi2_radius(p.confidence(), 3));
+            let shape = shapes::ellipsoid_of(mean, cov, p.confidence().radius(3));
             p.push(
-                format!("world/{}/{}/ellipsoid", point.name, method.slug()),
+                format!("{WORLD}/{}/{}/ellipsoid", point.name, method.slug()),
                 None,
                 ItemKind::Ellipsoids(Ellipsoids {
                     shapes: vec![shape],
@@ -364,7 +364,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
                 Swatch::Dots,
             );
             p.push(
-                format!("world/{}/monte_carlo/cloud", point.name),
+                format!("{WORLD}/{}/monte_carlo/cloud", point.name),
                 None,
                 point_cloud_item(particles.clone()),
             );
@@ -389,7 +389,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         for (k, color) in shapes::AXIS_COLORS.iter().enumerate() {
             let c = frame.columns.column(k);
             p.push(
-                format!("world/{}/euler/axis_{}", frame.output, ["x", "y", "z"][k]),
+                format!("{WORLD}/{}/euler/axis_{}", frame.output, ["x", "y", "z"][k]),
                 Some(frame.step),
                 ItemKind::Arrows(Arrows {
                     origins: vec![[0.0; 3]],
@@ -403,7 +403,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     let (plots, series) = plots::plots(e);
     p.scene.plots = plots;
     p.scene.series = series;
-    let plan = views::ViewPlan {
+    let plan = views::ViewInputs {
         poses: &p.methods,
         rotation_only: G::KIND.is_rotation_only(),
         top: p.scene.planar,
@@ -440,7 +440,7 @@ fn links<G: LieGroup<N>, const N: usize>(p: &mut Painter, e: &Evaluation<G, N>) 
     if !strips.is_empty() {
         p.legend("links between poses".to_owned(), scene::LINK, Swatch::Line);
         p.push(
-            "world/links".to_owned(),
+            format!("{WORLD}/links"),
             None,
             ItemKind::LineStrips(LineStrips {
                 strips,
@@ -476,7 +476,7 @@ fn scene_extent<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> f64 {
         .iter()
         .map(|n| *n.nominal.to_se3().translation())
         .chain(
-            e.paths
+            e.trajectories
                 .iter()
                 .flat_map(|p| p.poses.iter().map(|x| *x.to_se3().translation())),
         )
@@ -509,292 +509,4 @@ fn primary_method<G: LieGroup<N>, const N: usize>(node: &Node<G, N>) -> Option<M
 /// A method computed for `node` (not Monte Carlo, not an input's given Gaussian).
 fn is_analytic<G: LieGroup<N>, const N: usize>(node: &Node<G, N>, method: Method) -> bool {
     method != Method::MonteCarlo && !(node.role == Role::Input && method == Method::Exact)
-}
-
-fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>) {
-    let choices = &p.settings.choices;
-    let (axes, ellipsoids, bananas, orientation) = (
-        choices.axes,
-        choices.ellipsoids,
-        choices.bananas,
-        choices.orientation,
-    );
-    let pose3 = node.nominal.to_se3();
-    if axes {
-        p.scene.add_legend(legend::axes("pose frames"));
-        p.push(
-            format!("world/{}/frame", node.name),
-            node.step,
-            ItemKind::Frame(Frame {
-                translation: v3(pose3.translation()),
-                rotation: pose3.rotation().to_quaternion_xyzw(),
-                axis_length: p.axis_length,
-                label: choices.labels.then(|| node.name.clone()),
-            }),
-        );
-    }
-    if node.role == Role::Fixed {
-        return;
-    }
-    let rotation_only = p.kind.is_rotation_only();
-    let primary = primary_method(node);
-    if !p.detailed(node) {
-        // Between detailed steps only the (light) frame and the primary ellipsoid are logged,
-        // so the step slider still shows the growth.
-        if let Some(e) = node
-            .estimates
-            .iter()
-            .find(|e| Some(e.result.method) == primary)
-            && ellipsoids
-            && !rotation_only
-        {
-            let who = e.result.method.label().to_owned();
-            cartesian_legend(p, who, e.result.method);
-            shapes::position_ellipsoid(
-                p,
-                &format!("world/{}/{}", node.name, e.result.method.slug()),
-                node.step,
-                &e.result.pose,
-                e.result.method.color(),
-            );
-        }
-        return;
-    }
-    // Every method's regions on the main method's side: a banana is a 3-D slice of the tangent
-    // ellipsoid along its largest principal directions, which depend on the side, so one
-    // Gaussian read on two sides would look like two.
-    let side = node
-        .estimates
-        .iter()
-        .find(|e| Some(e.result.method) == primary)
-        .map(|e| e.result.pose.side());
-    // The Cartesian ellipses drawn for this pose: (method, who, centre, covariance).
-    let mut cartesian: Vec<(Method, String, Vec3, nalgebra::Matrix3<f64>)> = Vec::new();
-    for estimate in &node.estimates {
-        let pose = side.map_or(estimate.result.pose, |s| estimate.result.pose.to_side(s));
-        let method = estimate.result.method;
-        if method == Method::MonteCarlo && node.particles.is_some() {
-            continue; // the cloud itself shows Monte Carlo
-        }
-        let is_primary = Some(method) == primary;
-        // An input's own Gaussian is "given", not computed by a method.
-        let segment = if node.role == Role::Input && method == Method::Exact {
-            "given"
-        } else {
-            method.slug()
-        };
-        let drawn = match p.methods.iter().position(|(n, _)| *n == node.name) {
-            Some(i) => &mut p.methods[i].1,
-            None => {
-                p.methods
-                    .push((node.name.clone(), views::PoseMethods::default()));
-                &mut p.methods.last_mut().expect("just pushed").1
-            }
-        };
-        if is_primary {
-            drawn.main = Some(segment);
-        } else if method != Method::MonteCarlo && !drawn.others.contains(&segment) {
-            drawn.others.push(segment);
-        }
-        let base = format!("world/{}/{segment}", node.name);
-        let color = method.color();
-        // The Cartesian ellipsoid: the primary method's (to contrast with its banana) and the
-        // vector-space baseline's (a Gaussian in (x, y, θ) is exactly that ellipse).
-        let who = legend::who(segment, method.label());
-        if !rotation_only && ellipsoids && (is_primary || method == Method::VectorSpace) {
-            cartesian_legend(p, who.clone(), method);
-            if let Some(cov) = pose.position_cov_in_world_3d() {
-                let centre = v3(pose.mean().to_se3().translation());
-                cartesian.push((method, who.clone(), centre, cov));
-            }
-            shapes::position_ellipsoid(p, &base, node.step, &pose, color);
-        }
-        let region = legend::percent(p.confidence());
-        if bananas && !rotation_only && method != Method::VectorSpace {
-            let point_of = |x: &G| *x.to_se3().translation();
-            if is_primary || p.layout == Layout::PerMethod {
-                p.legend(
-                    format!("{who}: Exp-mapped {region} region"),
-                    color,
-                    Swatch::Region,
-                );
-                shapes::banana(p, &base, node.step, &pose, color, point_of);
-            } else {
-                p.legend(
-                    format!("{who}: Exp-mapped {region} region, principal outlines"),
-                    color,
-                    Swatch::Line,
-                );
-                shapes::outlines(
-                    p,
-                    &format!("{base}/banana_outline"),
-                    node.step,
-                    &pose,
-                    color,
-                    point_of,
-                );
-            }
-        }
-        if orientation && rotation_only {
-            p.legend(
-                format!("{who}: {region} region of each axis tip"),
-                color,
-                Swatch::Line,
-            );
-            for (k, axis) in ["axis_x", "axis_y", "axis_z"].iter().enumerate() {
-                let len = p.axis_length;
-                let path = format!("{base}/{axis}");
-                shapes::outlines(p, &path, node.step, &pose, color, move |x| {
-                    let s = x.to_se3();
-                    s.translation() + s.rotation().act(&(Vector3::ith(k, 1.0) * len))
-                });
-            }
-        }
-    }
-    coinciding(p, &node.name, &cartesian);
-    if let Some(particles) = &node.particles {
-        draw_particles(p, node, particles, None);
-    }
-}
-
-/// Says when the vector-space ellipse and another method's Cartesian ellipse of one pose are
-/// the same (same centre and matrix to 1e-9 relative): one hides the other exactly, and a
-/// reader would conclude the hidden one is missing. Once per pose name, in the legend and the
-/// text panel.
-fn coinciding(
-    p: &mut Painter,
-    pose: &str,
-    drawn: &[(Method, String, Vec3, nalgebra::Matrix3<f64>)],
-) {
-    let Some((_, _, c0, m0)) = drawn.iter().find(|d| d.0 == Method::VectorSpace) else {
-        return;
-    };
-    for (method, who, c, m) in drawn.iter().filter(|d| d.0 != Method::VectorSpace) {
-        let scale = m0.amax().max(f64::MIN_POSITIVE);
-        let same_matrix = (m - m0).amax() <= 1e-9 * scale;
-        let same_centre = (0..3).all(|k| (c[k] - c0[k]).abs() <= 1e-9 * (1.0 + c0[k].abs()));
-        if !(same_matrix && same_centre) {
-            continue;
-        }
-        let region = legend::percent(p.confidence());
-        p.legend(
-            format!(
-                "{who}: Cartesian {region} ellipse = the vector-space one here (same matrix; drawn under it)"
-            ),
-            method.color(),
-            Swatch::Dashed,
-        );
-        let sentence = format!(
-            "**{pose}:** the vector-space ellipse ({}) coincides with the {who} Cartesian one ({}) here: same matrix, so only one line shows.\n\n",
-            Method::VectorSpace.color_name(),
-            method.color_name()
-        );
-        if !p.scene.description_markdown.contains(&sentence) {
-            p.scene.description_markdown.push_str(&sentence);
-        }
-    }
-}
-
-fn draw_particles<G: LieGroup<N>, const N: usize>(
-    p: &mut Painter,
-    node: &Node<G, N>,
-    particles: &[G],
-    part: Option<usize>,
-) {
-    let choices = p.settings.choices.clone();
-    let base = format!("world/{}/monte_carlo", node.name);
-    // Later blocks of a blocked sample: their points only, as children of the first block's.
-    let suffix = part.map_or_else(String::new, |k| format!("/block_{k}"));
-    let poses: Vec<Se3> = particles.iter().map(LieGroup::to_se3).collect();
-    let rotation_only = p.kind.is_rotation_only();
-    if choices.clouds && !rotation_only {
-        p.legend(
-            format!("Monte Carlo samples ({})", particles.len()),
-            Method::MonteCarlo.color(),
-            Swatch::Dots,
-        );
-        p.push(
-            format!("{base}/cloud{suffix}"),
-            node.step,
-            ItemKind::Points(PointCloud {
-                positions: poses.iter().map(|x| v3(x.translation())).collect(),
-                color: cloud_color(),
-                radius: 0.006 * p.axis_length / 0.15,
-            }),
-        );
-    }
-    let stride = (poses.len() / TRIAD_SUBSAMPLE).max(1);
-    let subsample: Vec<&Se3> = poses.iter().step_by(stride).take(TRIAD_SUBSAMPLE).collect();
-    if part.is_some() || !choices.sample_axes || rotation_only {
-        // Triads and headings are a subsample, drawn once from the first block.
-    } else if p.kind == GroupKind::Se2 {
-        // Planar poses: a heading arrow per subsampled particle (a z axis would only clutter).
-        p.legend(
-            "Monte Carlo headings (a subsample)".to_owned(),
-            HEADING_COLOR,
-            Swatch::Line,
-        );
-        p.push(
-            format!("{base}/headings"),
-            node.step,
-            ItemKind::Arrows(Arrows {
-                origins: subsample.iter().map(|x| v3(x.translation())).collect(),
-                vectors: subsample
-                    .iter()
-                    .map(|x| v3(&x.rotation().act(&(Vector3::x() * 0.35 * p.axis_length))))
-                    .collect(),
-                color: HEADING_COLOR.with_alpha(200),
-                radius: 0.0015 * p.axis_length / 0.15,
-            }),
-        );
-    } else {
-        p.scene
-            .add_legend(legend::axes("Monte Carlo samples' axes (a subsample)"));
-        p.push(
-            format!("{base}/triads"),
-            node.step,
-            ItemKind::Triads(Triads {
-                translations: subsample.iter().map(|x| v3(x.translation())).collect(),
-                rotations: subsample
-                    .iter()
-                    .map(|x| x.rotation().to_quaternion_xyzw())
-                    .collect(),
-                axis_length: 0.35 * p.axis_length,
-                line_radius: 0.0015 * p.axis_length / 0.15,
-            }),
-        );
-    }
-    if choices.orientation && (rotation_only || p.kind == GroupKind::Se3) {
-        p.scene.add_legend(legend::axes("Monte Carlo axis tips"));
-        for (k, name) in ["spray_x", "spray_y", "spray_z"].iter().enumerate() {
-            let tips = poses
-                .iter()
-                .map(|x| {
-                    v3(&(x.translation()
-                        + x.rotation().act(&(Vector3::ith(k, 1.0) * p.axis_length))))
-                })
-                .collect();
-            p.push(
-                format!("{base}/{name}{suffix}"),
-                node.step,
-                ItemKind::Points(PointCloud {
-                    positions: tips,
-                    color: shapes::AXIS_COLORS[k].with_alpha(140),
-                    radius: 0.004 * p.axis_length.max(0.3),
-                }),
-            );
-        }
-    }
-}
-
-/// The legend entry of a method's Cartesian position ellipse (the vector-space baseline's is
-/// its whole Gaussian in (x, y[, z])).
-fn cartesian_legend(p: &mut Painter, who: String, method: Method) {
-    let region = legend::percent(p.confidence());
-    let label = if method == Method::VectorSpace {
-        format!("{who}: {region} ellipse")
-    } else {
-        format!("{who}: Cartesian {region} ellipse (first-order position)")
-    };
-    p.legend(label, method.color(), Swatch::Dashed);
 }

@@ -137,25 +137,19 @@ pub(super) fn along_track_lines<G: LieGroup<N>, const N: usize>(
     name: &str,
 ) -> Vec<Line> {
     let mut lines = Vec::new();
-    if G::KIND.is_rotation_only() {
-        return lines;
-    }
-    for node in steps_of(e, name) {
-        let analytic = node
-            .estimates
+    let values: Vec<_> = e
+        .along_track()
+        .into_iter()
+        .filter(|a| a.output == name)
+        .collect();
+    let mut steps: Vec<u64> = values.iter().map(|a| a.step).collect();
+    steps.dedup();
+    for step in steps {
+        let at_step = values
             .iter()
-            .filter(|est| est.result.method != Method::MonteCarlo)
-            .map(|est| (est.result.method, est.result.pose.cov_left()[(0, 0)]));
-        let monte_carlo = node
-            .monte_carlo
-            .and_then(|mc| mc.uncentred_left)
-            .map(|c| (Method::MonteCarlo, c[(0, 0)]));
-        add(
-            &mut lines,
-            ALONG_TRACK,
-            node.step.unwrap_or(0) as i64,
-            analytic.chain(monte_carlo),
-        );
+            .filter(|a| a.step == step)
+            .map(|a| (a.method, a.variance_m2));
+        add(&mut lines, ALONG_TRACK, step as i64, at_step);
     }
     lines
 }
@@ -222,37 +216,36 @@ fn consistency_lines<G: LieGroup<N>, const N: usize>(
     }
 }
 
-/// max |RᵀR − I| per step of the Euler matrices and of the Exp rotations.
+/// max |RᵀR − I| per step of the Euler matrices and of the Exp rotations (as evaluated:
+/// [`MatrixFrame`](crate::eval::MatrixFrame)), for the Exp node `name`.
 fn orthogonality_lines<G: LieGroup<N>, const N: usize>(
     e: &Evaluation<G, N>,
     name: &str,
     lines: &mut Vec<Line>,
 ) {
-    let drift =
-        |m: &nalgebra::Matrix3<f64>| (m.transpose() * m - nalgebra::Matrix3::identity()).amax();
-    let frames = e
+    let frames: Vec<_> = e
         .matrix_frames
         .iter()
-        .filter(|f| name.strip_suffix("_exp") == Some(f.output.as_str()));
+        .filter(|f| f.exp_node == name)
+        .collect();
     lines.push(Line {
         kind: ORTHOGONALITY,
         method: None,
         label: "Euler steps R(I + ω̂dt)".to_owned(),
         reference: false,
-        points: frames.map(|f| (f.step as i64, drift(&f.columns))).collect(),
+        points: frames
+            .iter()
+            .map(|f| (f.step as i64, f.orthogonality_error))
+            .collect(),
     });
     lines.push(Line {
         kind: ORTHOGONALITY,
         method: Some(Method::Exact),
         label: "exponential map R·Exp(ωdt)".to_owned(),
         reference: false,
-        points: steps_of(e, name)
-            .map(|n| {
-                (
-                    n.step.unwrap_or(0) as i64,
-                    drift(&n.nominal.to_se3().rotation().to_matrix()),
-                )
-            })
+        points: frames
+            .iter()
+            .map(|f| (f.step as i64, f.exp_orthogonality_error))
             .collect(),
     });
 }

@@ -8,7 +8,7 @@ use crate::lie::{LieGroup, Tangent, TangentMatrix};
 use crate::scene::{
     self, Color, Ellipsoid, Ellipsoids, FillMode, ItemKind, LineStrips, Surface, Vec3,
 };
-use crate::uncertain::UncertainPose;
+use crate::uncertain::{Confidence, UncertainPose};
 
 /// Sphere-mesh resolution of banana surfaces (latitude bands, meridians).
 const BANANA_MESH: (u32, u32) = (16, 32);
@@ -20,13 +20,6 @@ const RANK_TOLERANCE: f64 = 1e-9;
 
 /// Colours of the x, y, z axes ([`scene::AXIS_COLORS`]).
 pub(super) use crate::scene::AXIS_COLORS;
-
-/// The Mahalanobis radius of a p-confidence region in d dimensions,
-/// [`uncertain::chi2_radius`](crate::uncertain::chi2_radius) (the confidence is validated
-/// before drawing; an invalid one draws nothing rather than NaN).
-pub(super) fn chi2_radius(p: f64, d: usize) -> f64 {
-    crate::uncertain::chi2_radius(p, d).unwrap_or(0.0)
-}
 
 /// An ellipsoid from a 3×3 covariance: half sizes r√λ along the eigenvectors (a flat one for
 /// a planar covariance gets a small thickness so it stays visible). The orientation comes from
@@ -67,7 +60,7 @@ pub(super) fn position_ellipsoid<G: LieGroup<N>, const N: usize>(
     let shape = ellipsoid_of(
         pose.mean().to_se3().translation(),
         &cov,
-        chi2_radius(p.confidence(), d),
+        p.confidence().radius(d),
     );
     p.push(
         format!("{base}/ellipsoid"),
@@ -102,7 +95,7 @@ struct PrincipalFrame<const N: usize> {
 }
 
 impl<const N: usize> PrincipalFrame<N> {
-    fn of<G: LieGroup<N>>(pose: &UncertainPose<G, N>, confidence: f64) -> Self {
+    fn of<G: LieGroup<N>>(pose: &UncertainPose<G, N>, confidence: Confidence) -> Self {
         let (values, vectors) = principal_axes(pose.cov());
         // A Gaussian of rank k < N lives in a k-dimensional subspace: its p-region has the χ²_k
         // radius, not χ²_N (a yaw-only noise would otherwise be drawn far too wide).
@@ -112,7 +105,7 @@ impl<const N: usize> PrincipalFrame<N> {
             .filter(|l| **l > RANK_TOLERANCE * largest)
             .count()
             .max(1);
-        let r = chi2_radius(confidence, rank);
+        let r = confidence.radius(rank);
         let column = |i: usize| match (values.get(i), vectors.get(i)) {
             (Some(l), Some(v)) => v * (r * l.sqrt()),
             _ => Tangent::<N>::zeros(),

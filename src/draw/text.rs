@@ -6,8 +6,7 @@ use std::fmt::Write as _;
 
 use super::DrawSettings;
 use super::plots::along_track_lines;
-use super::shapes::chi2_radius;
-use crate::eval::{Consistency, Evaluation, Finding, Node, Role};
+use crate::eval::{Consistency, Evaluation, FailureReason, Finding, Node, Role};
 use crate::lie::{GroupKind, LieGroup};
 use crate::plan::OpKind;
 use crate::uncertain::{Coverage, Method, Region};
@@ -33,8 +32,8 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
          Regions are drawn at {:.1} % confidence (χ² radius {:.3} for the {}-DOF tangent ellipsoid).\n",
         G::NAME,
         tangent_order(G::KIND),
-        settings.confidence * 100.0,
-        chi2_radius(settings.confidence, N),
+        settings.confidence.get() * 100.0,
+        settings.confidence.radius(N),
         N
     );
     if !e.methods.is_empty() {
@@ -277,10 +276,11 @@ fn finding_text(f: &Finding) -> String {
             reason,
             later_steps,
         } => format!(
-            "*{} gave no estimate for `{output}`{}{}: {reason}.*",
+            "*{} gave no estimate for `{output}`{}{}: {}.*",
             method.label(),
             at(step),
-            and_later(*later_steps)
+            and_later(*later_steps),
+            failure_words(reason)
         ),
         Finding::NotPositiveSemiDefinite {
             output,
@@ -362,6 +362,20 @@ fn final_nodes<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Vec<&Nod
         last.insert(&node.name, node);
     }
     order.iter().filter_map(|n| last.get(n).copied()).collect()
+}
+
+/// Why a method failed, in words.
+fn failure_words(reason: &FailureReason) -> String {
+    match reason {
+        FailureReason::NotFinite => "the result is not finite (overflow)".to_owned(),
+        FailureReason::StatisticsNotFinite => {
+            "the sample statistics are not finite (overflow)".to_owned()
+        }
+        FailureReason::NeedsOneNoise => {
+            "it needs one noise covariance Σ_w shared by every step".to_owned()
+        }
+        FailureReason::Refused { message } => message.clone(),
+    }
 }
 
 #[cfg(test)]

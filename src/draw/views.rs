@@ -17,11 +17,10 @@
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::input::{CameraChoice, Layout};
+use crate::scene::WORLD;
 use crate::scene::{Camera, ItemKind, Scene, Vec3, View3d, grid_columns, rotate};
 use crate::uncertain::Method;
 
-/// The segment of an input's own Gaussian.
-const GIVEN: &str = "given";
 /// Rerun's default vertical field of view of a 3-D view (55°).
 const FOV_Y: f64 = 55.0 * std::f64::consts::PI / 180.0;
 /// Width over height assumed for the 3-D area (two thirds of a 16:10 window); a grid of
@@ -38,15 +37,35 @@ const FLAT_DEG: f64 = 35.0;
 /// ...and is seen from this far off the vertical, from −y.
 const FLAT_TILT_DEG: f64 = 30.0;
 
-/// Which methods were drawn for one pose: the main one and the others (slugs).
+/// What a pose's regions were drawn from: the input's own Gaussian, or a method's estimate.
+/// Its entity-path segment is [`Estimate::segment`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Estimate {
+    /// An input's own Gaussian (not computed by a method), `given`.
+    Given,
+    /// A method's estimate, under the method's slug.
+    Method(Method),
+}
+
+impl Estimate {
+    /// The entity-path segment: `given` or the method's slug.
+    pub(super) fn segment(self) -> &'static str {
+        match self {
+            Estimate::Given => "given",
+            Estimate::Method(m) => m.slug(),
+        }
+    }
+}
+
+/// Which estimates were drawn for one pose: the main one and the others.
 #[derive(Default, Debug)]
 pub(super) struct PoseMethods {
-    pub main: Option<&'static str>,
-    pub others: Vec<&'static str>,
+    pub main: Option<Estimate>,
+    pub others: Vec<Estimate>,
 }
 
 /// What the views are made from besides the scene's items.
-pub(super) struct ViewPlan<'a> {
+pub(super) struct ViewInputs<'a> {
     /// Per drawn (uncertain) pose, its methods.
     pub poses: &'a [(String, PoseMethods)],
     /// Rotations only (SO(2), SO(3)).
@@ -72,7 +91,7 @@ pub(super) fn default_layout(rotation_only: bool, poses: usize, most_methods: us
 }
 
 /// The scene's views, each with its camera.
-pub(super) fn views(scene: &Scene, plan: &ViewPlan) -> Vec<View3d> {
+pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
     let layout = plan.layout;
     let whole = |name: &str| View3d {
         name: name.to_owned(),
@@ -87,8 +106,8 @@ pub(super) fn views(scene: &Scene, plan: &ViewPlan) -> Vec<View3d> {
                     methods
                         .others
                         .iter()
-                        .filter(|m| **m != Method::VectorSpace.slug())
-                        .map(|m| format!("world/{pose}/{m}")),
+                        .filter(|m| **m != Estimate::Method(Method::VectorSpace))
+                        .map(|m| format!("{WORLD}/{pose}/{}", m.segment())),
                 );
             }
             vec![view]
@@ -99,7 +118,7 @@ pub(super) fn views(scene: &Scene, plan: &ViewPlan) -> Vec<View3d> {
             .iter()
             .map(|(pose, _)| View3d {
                 name: pose.clone(),
-                include: vec![format!("world/{pose}")],
+                include: vec![format!("{WORLD}/{pose}")],
                 ..Default::default()
             })
             .collect(),
@@ -162,20 +181,22 @@ pub(super) fn note(views: &[View3d]) -> Option<String> {
     })
 }
 
-/// One view per analytic method, each leaving out the other methods.
-fn per_method(plan: &ViewPlan) -> Vec<View3d> {
-    let mut all: Vec<&'static str> = Vec::new();
+/// One view per analytic method, each leaving out the other methods (an input's own
+/// Gaussian is shown in every view).
+fn per_method(plan: &ViewInputs) -> Vec<View3d> {
+    let mut all: Vec<Method> = Vec::new();
     for (_, m) in plan.poses {
-        // An input's own Gaussian ("given") is shown in every view.
-        for slug in m.main.iter().chain(&m.others).filter(|s| **s != GIVEN) {
-            if !all.contains(slug) {
-                all.push(slug);
+        for e in m.main.iter().chain(&m.others) {
+            if let Estimate::Method(method) = e
+                && !all.contains(method)
+            {
+                all.push(*method);
             }
         }
     }
     all.iter()
-        .map(|shown| View3d {
-            name: label_of(shown).to_owned(),
+        .map(|&shown| View3d {
+            name: shown.label().to_owned(),
             exclude: plan
                 .poses
                 .iter()
@@ -183,21 +204,13 @@ fn per_method(plan: &ViewPlan) -> Vec<View3d> {
                     m.main
                         .iter()
                         .chain(&m.others)
-                        .filter(|s| *s != shown && **s != GIVEN)
-                        .map(move |s| format!("world/{pose}/{s}"))
+                        .filter(move |e| matches!(e, Estimate::Method(o) if *o != shown))
+                        .map(move |e| format!("{WORLD}/{pose}/{}", e.segment()))
                 })
                 .collect(),
             ..Default::default()
         })
         .collect()
-}
-
-/// The legend label of a method slug.
-fn label_of(slug: &str) -> &'static str {
-    Method::ALL
-        .iter()
-        .find(|m| m.slug() == slug)
-        .map_or("3D", |m| m.label())
 }
 
 /// Every point a view draws: positions, vertices, ellipsoid and axis extremes.
@@ -243,7 +256,7 @@ fn add(a: &Vec3, b: &Vec3) -> Vec3 {
 }
 
 /// The camera of a view that draws `points` ([module docs](self)); `None` without points.
-pub(super) fn camera(points: &[Vector3<f64>], plan: &ViewPlan, aspect: f64) -> Option<Camera> {
+pub(super) fn camera(points: &[Vector3<f64>], plan: &ViewInputs, aspect: f64) -> Option<Camera> {
     let choice = plan.camera.unwrap_or_default();
     let up = choice.up.map_or(Vector3::z(), Vector3::from).normalize();
     if let Some(position) = choice.position {
@@ -363,8 +376,8 @@ fn fit(
 mod tests {
     use super::*;
 
-    fn plan(poses: &[(String, PoseMethods)], top: bool) -> ViewPlan<'_> {
-        ViewPlan {
+    fn plan(poses: &[(String, PoseMethods)], top: bool) -> ViewInputs<'_> {
+        ViewInputs {
             poses,
             rotation_only: false,
             top,

@@ -1,4 +1,4 @@
-//! The numbers of a robot log ([`BagPlan`]): per drawn message, what its covariance means in
+//! The numbers of a robot log ([`LogSummary`]): per drawn message, what its covariance means in
 //! posecov's body-frame right form (through the one ROS conversion,
 //! [`ros_cov_to_right`]), a seeded sample cloud, and the numbers RViz draws from
 //! the same message. Planar topics become SE(2) (x, y, yaw), others SE(3).
@@ -21,7 +21,7 @@ use nalgebra::{Matrix3, Matrix6, Vector2};
 
 use crate::interop::{RosReading, ros_cov_to_right};
 use crate::lie::{Se2, Se3, So2, So3};
-use crate::plan::bag::{BagPlan, Issue, SeriesPoint, TopicPlan};
+use crate::plan::bag::{Issue, LogSummary, SeriesPoint, TopicPlan};
 use crate::sample::{Sampler, chunk_rng};
 use crate::uncertain::{Side, UncertainPose};
 
@@ -142,7 +142,7 @@ pub struct BagEvaluation {
 /// Evaluates every topic of a log.
 ///
 /// See the [module docs](self) for an example.
-pub fn evaluate_bag(plan: &BagPlan, settings: &BagEvalSettings) -> BagEvaluation {
+pub fn evaluate_bag(plan: &LogSummary, settings: &BagEvalSettings) -> BagEvaluation {
     BagEvaluation {
         topics: plan
             .topics

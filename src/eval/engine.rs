@@ -4,14 +4,16 @@
 use std::ops::Range;
 use std::sync::Arc;
 
-use nalgebra::{DMatrix, Matrix3, SymmetricEigen, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 use super::blocked::{BlockedStats, VectorSums};
 use super::consistency::ConsistencySums;
 use super::groups::EvalGroup;
-use super::model::{Estimate, Evaluation, Finding, McSummary, Node, PointNode, Role};
+use super::model::{
+    Estimate, Evaluation, FailureReason, Finding, McSummary, Node, PointNode, Role,
+};
 use super::{EvalError, EvalSettings};
-use crate::lie::{LieGroup, TangentMatrix};
+use crate::lie::LieGroup;
 use crate::plan::{OpKind, Operand, Plan, PoseValue, limits};
 use crate::propagate::sigma_point::JointInputs;
 use crate::propagate::{Propagated, relative_frobenius_error};
@@ -75,6 +77,16 @@ impl<G: LieGroup<N>, const N: usize> Draft<'_, G, N> {
     }
 }
 
+/// The operation an [`Engine`] is evaluating: its index in the plan and its output's name
+/// (what every error and finding is located by).
+#[derive(Debug, Clone, Default)]
+pub struct Current {
+    /// Index of the operation in the plan.
+    pub operation: usize,
+    /// Name of its output.
+    pub output: String,
+}
+
 pub(super) struct Engine<'a, 's, G: EvalGroup<N>, const N: usize> {
     pub plan: &'a Plan<G, N>,
     pub settings: &'a EvalSettings,
@@ -88,8 +100,8 @@ pub(super) struct Engine<'a, 's, G: EvalGroup<N>, const N: usize> {
     /// so every random draw is the one the whole sample would make.
     pub block: Range<usize>,
     stats: StatsMode<'s, G, N>,
-    /// The operation being evaluated: index and output name.
-    pub current: (usize, String),
+    /// The operation being evaluated.
+    pub current: Current,
     /// Its kind (`None` while sampling the inputs).
     current_kind: Option<OpKind>,
 }
@@ -115,7 +127,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 unscented: settings.unscented,
                 nodes: Vec::new(),
                 points: Vec::new(),
-                paths: Vec::new(),
+                trajectories: Vec::new(),
                 matrix_frames: Vec::new(),
                 findings: Vec::new(),
                 graph: None,
@@ -123,7 +135,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             families: 0,
             block,
             stats,
-            current: (0, String::new()),
+            current: Current::default(),
             current_kind: None,
         };
         engine.inputs()?;
@@ -132,7 +144,10 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 engine.out.findings.push(Finding::Interrupted);
                 break;
             }
-            engine.current = (i, operation.output.clone());
+            engine.current = Current {
+                operation: i,
+                output: operation.output.clone(),
+            };
             engine.current_kind = Some(operation.op.kind());
             engine.operation(&operation.op)?;
             let node = engine
@@ -203,37 +218,10 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
     /// An error about the current operation.
     pub(super) fn math(&self, source: crate::Error) -> EvalError {
         EvalError::Math {
-            operation: self.current.0,
-            output: self.current.1.clone(),
+            operation: self.current.operation,
+            output: self.current.output.clone(),
             source,
         }
-    }
-
-    /// A finding that a method failed for the current output.
-    pub(super) fn method_failed(&mut self, step: Option<u64>, method: Method, reason: String) {
-        let output = &self.current.1;
-        // One finding per output and method: later steps are counted, not repeated.
-        for f in &mut self.out.findings {
-            if let Finding::MethodFailed {
-                output: o,
-                method: m,
-                later_steps,
-                ..
-            } = f
-                && o == output
-                && *m == method
-            {
-                *later_steps += 1;
-                return;
-            }
-        }
-        self.out.findings.push(Finding::MethodFailed {
-            output: output.clone(),
-            step,
-            method,
-            reason,
-            later_steps: 0,
-        });
     }
 
     /// The sigma-point estimate of the current output through `map` over the inputs' joint
@@ -251,7 +239,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             Ok((estimate, wrap)) => {
                 if let Some(w) = wrap {
                     self.out.findings.push(Finding::SigmaPointsWrap {
-                        output: self.current.1.clone(),
+                        output: self.current.output.clone(),
                         largest_rotation_rad: w.largest_rotation,
                         alpha: w.alpha,
                         alpha_below_pi: w.alpha_below_pi,
@@ -260,7 +248,13 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 Some(estimate)
             }
             Err(e) => {
-                self.method_failed(None, Method::SigmaPoints, e.to_string());
+                self.method_failed(
+                    None,
+                    Method::SigmaPoints,
+                    FailureReason::Refused {
+                        message: e.to_string(),
+                    },
+                );
                 None
             }
         }
@@ -287,8 +281,8 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                     .flatten()
                     .map(|i| &self.out.nodes[i])
                     .ok_or_else(|| EvalError::Undefined {
-                        operation: self.current.0,
-                        output: self.current.1.clone(),
+                        operation: self.current.operation,
+                        output: self.current.output.clone(),
                         definition: k,
                     })?;
                 let pose = node
@@ -340,17 +334,13 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             if !finite_pose(&result) {
                 if i == 0 {
                     return Err(EvalError::NonFinite {
-                        operation: self.current.0,
-                        output: self.current.1.clone(),
+                        operation: self.current.operation,
+                        output: self.current.output.clone(),
                         step: draft.step,
                         method: result.method.label(),
                     });
                 }
-                self.method_failed(
-                    draft.step,
-                    result.method,
-                    "the result is not finite (overflow)".to_owned(),
-                );
+                self.method_failed(draft.step, result.method, FailureReason::NotFinite);
                 continue;
             }
             self.check_psd(name, draft.step, result.method, result.pose.cov());
@@ -396,7 +386,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                     self.method_failed(
                         draft.step,
                         Method::MonteCarlo,
-                        "the sample statistics are not finite (overflow)".to_owned(),
+                        FailureReason::StatisticsNotFinite,
                     );
                 }
                 Some(Ok(mc)) => {
@@ -427,8 +417,12 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                     node.monte_carlo = Some(mc);
                 }
                 Some(Err(e)) => {
-                    let reason = crate::Error::from(e).to_string();
-                    self.method_failed(draft.step, Method::MonteCarlo, reason);
+                    let message = crate::Error::from(e).to_string();
+                    self.method_failed(
+                        draft.step,
+                        Method::MonteCarlo,
+                        FailureReason::Refused { message },
+                    );
                 }
                 None => {}
             }
@@ -512,8 +506,8 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             && cov.iter().all(|v| v.abs() <= limits::OVERFLOW_VARIANCE))
         {
             return Err(EvalError::NonFinite {
-                operation: self.current.0,
-                output: self.current.1.clone(),
+                operation: self.current.operation,
+                output: self.current.output.clone(),
                 step: None,
                 method: Method::FirstOrder.label(),
             });
@@ -541,7 +535,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                     self.method_failed(
                         None,
                         Method::MonteCarlo,
-                        "the sample statistics are not finite".to_owned(),
+                        FailureReason::StatisticsNotFinite,
                     );
                 }
             }
@@ -552,40 +546,6 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             particles: cloud,
         });
         Ok(())
-    }
-
-    /// Reports a covariance that is not positive semi-definite (smallest eigenvalue below
-    /// −1e-9 of the largest magnitude).
-    fn check_psd(&mut self, name: &str, step: Option<u64>, method: Method, cov: &TangentMatrix<N>) {
-        let sym = (cov + cov.transpose()) * 0.5;
-        let eig = SymmetricEigen::new(DMatrix::from_iterator(N, N, sym.iter().copied()));
-        let smallest = eig.eigenvalues.min();
-        let largest = eig.eigenvalues.max();
-        let scale = eig.eigenvalues.amax().max(f64::MIN_POSITIVE);
-        if smallest < -1e-9 * scale {
-            for f in &mut self.out.findings {
-                if let Finding::NotPositiveSemiDefinite {
-                    output,
-                    method: m,
-                    later_steps,
-                    ..
-                } = f
-                    && output == name
-                    && *m == method
-                {
-                    *later_steps += 1;
-                    return;
-                }
-            }
-            self.out.findings.push(Finding::NotPositiveSemiDefinite {
-                output: name.to_owned(),
-                step,
-                method,
-                smallest_eigenvalue: smallest,
-                largest_eigenvalue: largest,
-                later_steps: 0,
-            });
-        }
     }
 }
 

@@ -44,11 +44,14 @@ pub mod graph;
 pub mod groups;
 mod model;
 mod ops;
+mod propagations;
+mod reports;
 
 pub use consistency::{Anees, Consistency, CoverageSummary};
 pub use model::{
-    AnyEvaluation, Estimate, Evaluation, Finding, MatrixFrame, McSummary, MonteCarloRecord, Node,
-    PathKind, PointNode, PosePath, Role,
+    AlongTrack, AnyEvaluation, Estimate, Evaluation, FailureReason, Finding, MatrixFrame,
+    McSummary, MonteCarloRecord, Node, PathKind, PointNode, PosePath, RanWith, Role,
+    orthogonality_error,
 };
 
 use crate::lie::{Se2, Se3, So2, So3};
@@ -67,11 +70,9 @@ pub const MAX_BLOCK_SAMPLES: usize = 64 * CHUNK_SIZE;
 /// At least this many particles per block, however many nodes hold particles.
 pub const MIN_BLOCK_SAMPLES: usize = 4 * CHUNK_SIZE;
 
-/// Monte Carlo samples of [`EvalSettings::default`] (and of a scenario that names none).
-pub const DEFAULT_SAMPLES: usize = 2000;
-
-/// The probability inside drawn regions when neither the command line nor the file says.
-pub const DEFAULT_CONFIDENCE: f64 = 0.95;
+/// The probability inside drawn regions when neither the command line nor the file says
+/// ([`Confidence::DEFAULT`](crate::uncertain::Confidence::DEFAULT)).
+pub const DEFAULT_CONFIDENCE: f64 = crate::uncertain::Confidence::DEFAULT.get();
 
 /// What an evaluation needs besides the plan, resolved once by the caller.
 #[derive(Debug, Clone)]
@@ -103,7 +104,7 @@ impl Default for EvalSettings {
     fn default() -> Self {
         Self {
             seed: 0,
-            samples: DEFAULT_SAMPLES,
+            samples: limits::DEFAULT_SAMPLES as usize,
             methods: Vec::new(),
             block_samples: None,
             steps: StepPolicy::default(),
@@ -297,7 +298,8 @@ pub fn evaluate_block(
     main: &AnyEvaluation,
     block: usize,
 ) -> Result<Option<AnyEvaluation>, EvalError> {
-    let (_, n, b, _) = main.run();
+    let ran = main.ran_with();
+    let (n, b) = (ran.samples, ran.block_samples);
     let start = block.saturating_mul(b.max(1));
     if start >= n || !settings.monte_carlo() {
         return Ok(None);
@@ -313,11 +315,13 @@ pub fn evaluate_block(
 
 fn check_settings(settings: &EvalSettings) -> Result<(), EvalError> {
     let n = settings.samples as u64;
-    if settings.monte_carlo() && !(limits::MIN_SAMPLES..=limits::MAX_SAMPLES).contains(&n) {
+    if settings.monte_carlo()
+        && let Err(expected) = limits::check_samples(n)
+    {
         return Err(EvalError::Setting {
             what: "samples",
             value: n.to_string(),
-            expected: format!("use {} ..= {}", limits::MIN_SAMPLES, limits::MAX_SAMPLES),
+            expected,
         });
     }
     if settings.block_samples == Some(0) {

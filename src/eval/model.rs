@@ -138,10 +138,73 @@ pub struct PosePath<G> {
 pub struct MatrixFrame {
     /// The output it belongs to.
     pub output: String,
+    /// The node of the exponential map it is compared with, at the same step.
+    pub exp_node: String,
     /// Step on the `step` timeline.
     pub step: u64,
     /// The matrix; column k is the image of axis k.
     pub columns: Matrix3<f64>,
+    /// Its drift from a rotation, max |RᵀR − I| ([`orthogonality_error`]).
+    pub orthogonality_error: f64,
+    /// The same of the exponential map's rotation at this step.
+    pub exp_orthogonality_error: f64,
+}
+
+/// What an evaluation ran with ([`AnyEvaluation::ran_with`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RanWith<'a> {
+    /// Seed of every random draw.
+    pub seed: u64,
+    /// Monte Carlo samples.
+    pub samples: usize,
+    /// Particles per block.
+    pub block_samples: usize,
+    /// The methods compared.
+    pub methods: &'a [Method],
+}
+
+/// One method's along-track variance at one step of a compounding
+/// ([`Evaluation::along_track`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AlongTrack {
+    /// The compounding's output.
+    pub output: String,
+    /// Step on the `step` timeline.
+    pub step: u64,
+    /// The method.
+    pub method: Method,
+    /// Σ_ρxρx, left (world) form (m²).
+    pub variance_m2: f64,
+}
+
+/// How far a 3×3 matrix is from a rotation: max |RᵀR − I| over the entries.
+///
+/// ```
+/// use nalgebra::Matrix3;
+/// use posecov::eval::orthogonality_error;
+/// assert_eq!(orthogonality_error(&Matrix3::identity()), 0.0);
+/// assert!((orthogonality_error(&(Matrix3::identity() * 1.1)) - 0.21).abs() < 1e-12);
+/// ```
+pub fn orthogonality_error(m: &Matrix3<f64>) -> f64 {
+    (m.transpose() * m - Matrix3::identity()).amax()
+}
+
+/// Why a method gave no estimate ([`Finding::MethodFailed`]); `report --json` writes it as
+/// `{"kind": "not_finite"}` or `{"kind": "refused", "message": …}`, the text panel in words.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum FailureReason {
+    /// The result overflowed: a number not finite or beyond the overflow limits.
+    NotFinite,
+    /// The Monte Carlo sample statistics overflowed.
+    StatisticsNotFinite,
+    /// The vector-space baseline needs one noise covariance shared by every step.
+    NeedsOneNoise,
+    /// The method refused its inputs (a sigma-point spread, a singular matrix, …).
+    Refused {
+        /// The method's own message.
+        message: String,
+    },
 }
 
 /// A fact the evaluation found that is not an estimate: something to tell the user in the
@@ -207,7 +270,7 @@ pub enum Finding {
         /// The method.
         method: Method,
         /// Why.
-        reason: String,
+        reason: FailureReason,
         /// How many later recorded steps of the same output failed the same way.
         later_steps: u64,
     },
@@ -332,13 +395,56 @@ pub struct Evaluation<G: LieGroup<N>, const N: usize> {
     /// Uncertain points.
     pub points: Vec<PointNode>,
     /// Polylines of poses.
-    pub paths: Vec<PosePath<G>>,
+    pub trajectories: Vec<PosePath<G>>,
     /// Non-orthonormal frames (Euler integration).
     pub matrix_frames: Vec<MatrixFrame>,
     /// What the user should know besides the estimates.
     pub findings: Vec<Finding>,
     /// A pose graph's optimisation and marginals (g2o / GTSAM inputs).
     pub graph: Option<super::graph::GraphEvaluation<G, N>>,
+}
+
+impl<G: LieGroup<N>, const N: usize> Evaluation<G, N> {
+    /// Every method's along-track variance per step of each compounding (`compound`):
+    /// Σ_ρxρx of the left (world) form, in m², the variance second-order compounding misses
+    /// (Barfoot & Furgale 2014, Fig. 2). Monte Carlo's is the uncentred E\[ξξᵀ\] about the
+    /// propagated mean, as in their experiments. Empty for rotations.
+    ///
+    /// ```
+    /// use posecov::{eval::{EvalSettings, evaluate}, plan::{AnyPlan, Plan}};
+    /// let e = evaluate(&AnyPlan::Se3(Plan::default()), &EvalSettings::default()).unwrap();
+    /// assert!(e.along_track().is_empty());
+    /// ```
+    pub fn along_track(&self) -> Vec<AlongTrack> {
+        if G::KIND.is_rotation_only() {
+            return Vec::new();
+        }
+        self.nodes
+            .iter()
+            .filter(|n| n.op == Some(OpKind::Compound) && n.role == Role::Output)
+            .filter_map(|n| n.step.map(|step| (n, step)))
+            .flat_map(|(n, step)| {
+                let analytic = n
+                    .estimates
+                    .iter()
+                    .filter(|e| e.result.method != Method::MonteCarlo)
+                    .map(|e| (e.result.method, e.result.pose.cov_left()[(0, 0)]));
+                let monte_carlo = n
+                    .monte_carlo
+                    .as_ref()
+                    .and_then(|mc| mc.uncentred_left)
+                    .map(|c| (Method::MonteCarlo, c[(0, 0)]));
+                analytic
+                    .chain(monte_carlo)
+                    .map(move |(method, variance_m2)| AlongTrack {
+                        output: n.name.clone(),
+                        step,
+                        method,
+                        variance_m2,
+                    })
+            })
+            .collect()
+    }
 }
 
 impl<G: LieGroup<N>, const N: usize> Evaluation<G, N>
@@ -495,6 +601,17 @@ impl AnyEvaluation {
         with_evaluation!(self, e => super::consistency::last_output_summary(&e.nodes))
     }
 
+    /// [`Evaluation::along_track`] of any group.
+    ///
+    /// ```
+    /// use posecov::{eval::{EvalSettings, evaluate}, plan::{AnyPlan, Plan}};
+    /// let e = evaluate(&AnyPlan::So3(Plan::default()), &EvalSettings::default()).unwrap();
+    /// assert!(e.along_track().is_empty());
+    /// ```
+    pub fn along_track(&self) -> Vec<AlongTrack> {
+        with_evaluation!(self, e => e.along_track())
+    }
+
     /// The findings.
     ///
     /// ```
@@ -518,14 +635,19 @@ impl AnyEvaluation {
         with_evaluation!(self, e => e.graph.as_ref().map(|g| g.report()))
     }
 
-    /// (seed, samples, block samples, methods) the evaluation ran with.
+    /// What the evaluation ran with: seed, samples, block size, methods.
     ///
     /// ```
     /// use posecov::{eval::{EvalSettings, evaluate}, plan::{AnyPlan, Plan}};
     /// let e = evaluate(&AnyPlan::So3(Plan::default()), &EvalSettings::default()).unwrap();
-    /// assert_eq!(e.run().0, 0);
+    /// assert_eq!(e.ran_with().seed, 0);
     /// ```
-    pub fn run(&self) -> (u64, usize, usize, &[Method]) {
-        with_evaluation!(self, e => (e.seed, e.samples, e.block_samples, e.methods.as_slice()))
+    pub fn ran_with(&self) -> RanWith<'_> {
+        with_evaluation!(self, e => RanWith {
+            seed: e.seed,
+            samples: e.samples,
+            block_samples: e.block_samples,
+            methods: e.methods.as_slice(),
+        })
     }
 }

@@ -6,23 +6,18 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use super::EvalError;
-use super::engine::{Draft, Engine, Extras, Particles};
+use super::engine::{Draft, Engine};
 use super::groups::EvalGroup;
-use super::model::{Finding, MatrixFrame, Node, PathKind, PosePath, Role};
+use super::model::{FailureReason, Finding, Role};
 use crate::lie::{LieGroup, Tangent, TangentMatrix};
-use crate::plan::{
-    Control, DiffDriveMotion, FrameSide, OdometryModel, Op, OpKind, Operand, limits,
-};
+use crate::plan::{FrameSide, Op, Operand};
 use crate::propagate::Propagated;
 use crate::propagate::first_order::{self, CorrelatedPair};
 use crate::propagate::fourth_order::Order;
 use crate::propagate::fusion::{FusionOptions, fuse};
-use crate::propagate::odometry::{
-    InputNoise, StepNoise, propagate_increments_each, propagate_tangent_inputs_each,
-};
 use crate::propagate::sigma_point::JointInputs;
-use crate::sample::{Sampler, fill_par_from, joint_square_root, retract, standard_normal};
-use crate::uncertain::{Method, Side, UncertainPose};
+use crate::sample::{fill_par_from, joint_square_root, retract, standard_normal};
+use crate::uncertain::{Method, UncertainPose};
 
 /// Compose (`X · Y`) or between (`X⁻¹ · Y`).
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -80,12 +75,12 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         }
     }
 
-    fn output(&self) -> String {
-        self.current.1.clone()
+    pub(super) fn output(&self) -> String {
+        self.current.output.clone()
     }
 
     /// First order, then `extra`, then sigma points through `map` where requested.
-    fn estimates(
+    pub(super) fn estimates(
         &mut self,
         first: Propagated<G, N>,
         extra: Vec<Propagated<G, N>>,
@@ -101,7 +96,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
     }
 
     /// The Smith–Self–Cheeseman compose X·Y in vector coordinates, where requested and defined.
-    fn vector_space(
+    pub(super) fn vector_space(
         &mut self,
         x: &UncertainPose<G, N>,
         y: &UncertainPose<G, N>,
@@ -112,13 +107,19 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         match G::ssc_compose(x, y)? {
             Ok(r) => Some(r),
             Err(e) => {
-                self.method_failed(None, Method::VectorSpace, e.to_string());
+                self.method_failed(
+                    None,
+                    Method::VectorSpace,
+                    FailureReason::Refused {
+                        message: e.to_string(),
+                    },
+                );
                 None
             }
         }
     }
 
-    fn single(
+    pub(super) fn single(
         &mut self,
         estimates: Vec<Propagated<G, N>>,
         particles: Option<Arc<Vec<G>>>,
@@ -251,220 +252,6 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         out
     }
 
-    /// Odometry: analytic recursions, then every particle takes every step with fresh noise;
-    /// statistics are taken at each recorded step as the particles pass.
-    fn odometry(
-        &mut self,
-        input: Operand<G>,
-        model: OdometryModel,
-        controls: &[Control<G, N>],
-        noise: &StepNoise<N>,
-    ) -> Result<(), EvalError> {
-        let (start, start_particles) = self.gaussian(input)?;
-        let start_right = start.to_side(Side::Right);
-        let increments: Vec<G> = controls.iter().map(|c| c.increment).collect();
-        let mut tracks: Vec<Vec<Propagated<G, N>>> = Vec::new();
-        match model {
-            OdometryModel::Increment => tracks.push(
-                propagate_increments_each(&start_right, &increments, noise)
-                    .map_err(|e| self.math(e))?,
-            ),
-            OdometryModel::Exp => {
-                let inputs: Vec<Tangent<N>> = controls.iter().map(|c| c.tangent).collect();
-                tracks.push(
-                    propagate_tangent_inputs_each(
-                        &start_right,
-                        &inputs,
-                        noise,
-                        InputNoise::RightJacobian,
-                    )
-                    .map_err(|e| self.math(e))?,
-                );
-                if self.wants(Method::LectureNoJr) {
-                    tracks.push(
-                        propagate_tangent_inputs_each(
-                            &start_right,
-                            &inputs,
-                            noise,
-                            InputNoise::LectureNoJr,
-                        )
-                        .map_err(|e| self.math(e))?,
-                    );
-                }
-            }
-        }
-        if self.wants(Method::VectorSpace) {
-            match (noise, noise.as_slice()) {
-                (StepNoise::Same(_), [same]) => {
-                    match G::ssc_odometry(&start_right, &increments, same) {
-                        Some(Ok(track)) => tracks.push(track),
-                        Some(Err(e)) => {
-                            self.method_failed(None, Method::VectorSpace, e.to_string())
-                        }
-                        None => {}
-                    }
-                }
-                _ => self.method_failed(None, Method::VectorSpace, "needs one Σ_w".into()),
-            }
-        }
-        let last = controls.len() as u64;
-        let name = self.output();
-        let step_estimates = |k: usize| -> Vec<Propagated<G, N>> {
-            tracks.iter().filter_map(|t| t.get(k).copied()).collect()
-        };
-        let mut current: Option<Vec<G>> = self
-            .monte_carlo
-            .then(|| self.particles_of(&start, start_particles).as_ref().clone());
-        let samplers = Sampler::<G, N>::right_noise(noise.as_slice()).map_err(|e| self.math(e))?;
-        self.push_step(&name, 0, last, step_estimates(0), current.as_deref())?;
-        for (k, control) in controls.iter().enumerate() {
-            if self.settings.cancelled() {
-                self.out.findings.push(Finding::Interrupted);
-                break;
-            }
-            if let (Some(particles), Some(sampler)) =
-                (current.as_mut(), samplers.get(k).or(samplers.first()))
-            {
-                let family = self.next_family();
-                let (seed, first_chunk) = (self.settings.seed, self.first_chunk());
-                fill_par_map(particles, seed, family, first_chunk, |rng, x| {
-                    let w = sampler.draw_tangent(rng);
-                    match model {
-                        OdometryModel::Increment => x.compose(&control.increment).rplus(&w),
-                        OdometryModel::Exp => x.rplus(&(control.tangent + w)),
-                    }
-                });
-            }
-            self.push_step(
-                &name,
-                k as u64 + 1,
-                last,
-                step_estimates(k + 1),
-                current.as_deref(),
-            )?;
-        }
-        self.nominal_path(tracks[0].iter().map(|r| *r.pose.mean()).collect());
-        self.thinned(last);
-        Ok(())
-    }
-
-    /// Adds step `k` of the current propagation.
-    fn push_step(
-        &mut self,
-        name: &str,
-        k: u64,
-        last: u64,
-        estimates: Vec<Propagated<G, N>>,
-        particles: Option<&[G]>,
-    ) -> Result<(), EvalError> {
-        // Barfoot & Furgale's uncentred Monte Carlo covariance, for compounding's plot.
-        let extras = Extras {
-            uncentred_left: self.current_kind() == Some(OpKind::Compound),
-            position_mean: false,
-        };
-        let draft = Draft {
-            step: Some(k),
-            last_step: Some(last),
-            estimates,
-            particles: particles.map_or(Particles::None, Particles::Step),
-            extras,
-        };
-        self.push(name, Role::Output, draft)
-    }
-
-    fn nominal_path(&mut self, poses: Vec<G>) {
-        self.out.paths.push(PosePath {
-            output: self.output(),
-            kind: PathKind::Nominal,
-            poses,
-        });
-    }
-
-    /// Says when a long propagation recorded only some steps.
-    fn thinned(&mut self, last: u64) {
-        let recorded = (0..=last)
-            .filter(|k| self.settings.steps.records(*k, last))
-            .count() as u64;
-        if recorded < last + 1 {
-            self.out.findings.push(Finding::StepsThinned {
-                output: self.output(),
-                steps: last,
-                recorded,
-            });
-        }
-    }
-
-    /// Barfoot & Furgale's repeated compounding T_k = (Exp(w) T̄) · T_{k−1}, left form.
-    fn compound(
-        &mut self,
-        input: Operand<G>,
-        step_mean: G,
-        noise: &TangentMatrix<N>,
-        noise_side: Side,
-        steps: u64,
-    ) -> Result<(), EvalError> {
-        let (start, start_particles) = self.gaussian(input)?;
-        let increment = UncertainPose::new_unchecked(step_mean, *noise, noise_side);
-        let orders: Vec<(Order, Method)> = [
-            (Order::Second, Method::SecondOrder),
-            (Order::Fourth, Method::FourthOrder),
-        ]
-        .into_iter()
-        .filter(|(_, m)| self.wants(*m))
-        .collect();
-        let mut first = Propagated {
-            pose: start.to_side(noise_side),
-            method: Method::FirstOrder,
-        };
-        let mut higher: Vec<Propagated<G, N>> = orders
-            .iter()
-            .map(|(_, m)| Propagated {
-                pose: start.to_side(Side::Left),
-                method: *m,
-            })
-            .collect();
-        let mut current: Option<Vec<G>> = self
-            .monte_carlo
-            .then(|| self.particles_of(&start, start_particles).as_ref().clone());
-        let sampler = Sampler::new(&increment).map_err(|e| self.math(e))?;
-        let name = self.output();
-        let mut nominal = vec![*first.pose.mean()];
-        let all = |first: &Propagated<G, N>, higher: &[Propagated<G, N>]| {
-            let mut v = vec![*first];
-            v.extend_from_slice(higher);
-            v
-        };
-        self.push_step(&name, 0, steps, all(&first, &higher), current.as_deref())?;
-        for k in 1..=steps {
-            if self.settings.cancelled() {
-                self.out.findings.push(Finding::Interrupted);
-                break;
-            }
-            first = first_order::compose(&increment, &first.pose);
-            for (h, (order, _)) in higher.iter_mut().zip(&orders) {
-                if let Some(next) = G::compound(&increment, &h.pose, *order) {
-                    *h = next;
-                }
-            }
-            if let Some(particles) = current.as_mut() {
-                let family = self.next_family();
-                let first_chunk = self.first_chunk();
-                fill_par_map(
-                    particles,
-                    self.settings.seed,
-                    family,
-                    first_chunk,
-                    |rng, x| sampler.draw(rng).compose(x),
-                );
-            }
-            nominal.push(*first.pose.mean());
-            self.push_step(&name, k, steps, all(&first, &higher), current.as_deref())?;
-        }
-        self.nominal_path(nominal);
-        self.thinned(steps);
-        Ok(())
-    }
-
     /// An uncertain point seen from an uncertain pose.
     fn point_through_pose(
         &mut self,
@@ -523,7 +310,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                 | FusionError::NotConverged { source, .. } => (None, source),
             };
             EvalError::Fusion {
-                operation: self.current.0,
+                operation: self.current.operation,
                 output: self.output(),
                 input,
                 source,
@@ -546,130 +333,10 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         };
         self.single(vec![fused.result], particles)
     }
-
-    /// A differential-drive robot from a known start (Long et al. 2012).
-    fn diff_drive(&mut self, start: G, motion: &DiffDriveMotion) -> Result<(), EvalError> {
-        let samples = if self.monte_carlo {
-            self.block.len()
-        } else {
-            0
-        };
-        let seed = self.settings.seed.wrapping_add(self.next_family());
-        let integral = self.wants(Method::NumericIntegral);
-        let outcome = match G::diff_drive(motion, integral, samples, self.first_chunk(), seed) {
-            None => {
-                return Err(EvalError::WrongGroup {
-                    operation: self.current.0,
-                    output: self.output(),
-                    what: "diff_drive",
-                    group: G::NAME,
-                });
-            }
-            Some(Err(e)) => return Err(self.math(e)),
-            Some(Ok(o)) => o,
-        };
-        let moved = |g: &G| start.compose(g);
-        // Results are relative to the start pose: move them with a known left change of frame.
-        let estimates: Vec<Propagated<G, N>> = outcome
-            .estimates
-            .iter()
-            .filter(|e| self.wants(e.method) || e.method == Method::ClosedForm)
-            .map(|e| Propagated {
-                pose: first_order::change_frame_left(&start, &e.pose).pose,
-                method: e.method,
-            })
-            .collect();
-        let particles = (!outcome.end_poses.is_empty())
-            .then(|| Arc::new(outcome.end_poses.iter().map(moved).collect::<Vec<G>>()));
-        let name = self.output();
-        let mut draft = Draft::single(estimates, particles);
-        draft.extras.position_mean = true;
-        self.push(&name, Role::Output, draft)?;
-        let node = &self.out.nodes[self.out.nodes.len() - 1];
-        if let (Some(mc), Some(end)) = (&node.monte_carlo, outcome.nominal_path.last())
-            && let Some(cartesian) = mc.position_mean
-        {
-            let lie = mc.stats.mean.to_se3();
-            let nominal = moved(end).to_se3();
-            self.out.findings.push(Finding::DiffDriveMeans {
-                output: name,
-                diffusion: motion.diffusion,
-                nominal_end: [nominal.translation().x, nominal.translation().y],
-                lie_mean: [lie.translation().x, lie.translation().y],
-                cartesian_mean: [cartesian.x, cartesian.y],
-            });
-        }
-        self.nominal_path(outcome.nominal_path.iter().map(moved).collect());
-        for (i, t) in outcome.trajectories.iter().enumerate() {
-            self.out.paths.push(PosePath {
-                output: self.output(),
-                kind: PathKind::Sample(i),
-                poses: t.iter().map(moved).collect(),
-            });
-        }
-        Ok(())
-    }
-
-    /// Euler integration R(I + ω̂dt) against R·Exp(ωdt), from the identity.
-    fn euler_vs_exp(&mut self, rate: &Vector3<f64>, dt: f64, steps: u64) -> Result<(), EvalError> {
-        let Some(track) = G::euler_vs_exp(rate, dt, steps) else {
-            return Err(EvalError::WrongGroup {
-                operation: self.current.0,
-                output: self.output(),
-                what: "euler_vs_exp",
-                group: G::NAME,
-            });
-        };
-        let output = self.output();
-        let name = format!("{output}_exp");
-        let drift = |m: &Matrix3<f64>| (m.transpose() * m - Matrix3::identity()).amax();
-        for (k, (euler, exp)) in track.iter().enumerate() {
-            let k = k as u64;
-            if !self.settings.steps.records(k, steps) {
-                continue;
-            }
-            if !euler.iter().all(|v| v.abs() <= limits::OVERFLOW_COORDINATE) {
-                return Err(EvalError::NonFinite {
-                    operation: self.current.0,
-                    output,
-                    step: Some(k),
-                    method: "Euler integration",
-                });
-            }
-            self.out.matrix_frames.push(MatrixFrame {
-                output: output.clone(),
-                step: k,
-                columns: *euler,
-            });
-            // A rotation known exactly: a node with no estimate, drawn as its frame.
-            self.out.nodes.push(Node {
-                name: name.clone(),
-                role: Role::Output,
-                op: Some(OpKind::EulerVsExp),
-                step: Some(k),
-                last_step: Some(steps),
-                nominal: *exp,
-                estimates: Vec::new(),
-                monte_carlo: None,
-                particles: None,
-            });
-        }
-        if let Some((m, g)) = track.last() {
-            self.out.findings.push(Finding::EulerDrift {
-                output,
-                steps,
-                dt,
-                euler: drift(m),
-                exp: drift(&g.to_se3().rotation().to_matrix()),
-            });
-        }
-        self.thinned(steps);
-        Ok(())
-    }
 }
 
 /// `x ← f(rng, x)` over a slice, in parallel, deterministic per seed and family.
-fn fill_par_map<G: Copy + Send + Sync>(
+pub(super) fn fill_par_map<G: Copy + Send + Sync>(
     xs: &mut [G],
     seed: u64,
     family: u64,

@@ -328,7 +328,7 @@ pub struct FileSettings {
     /// Monte Carlo samples.
     pub samples: Option<u64>,
     /// Probability inside drawn regions.
-    pub confidence: Option<f64>,
+    pub confidence: Option<crate::uncertain::Confidence>,
     /// Methods to compare.
     pub methods: Vec<Method>,
     /// Sigma-point parameters (`[methods.sigma_points]`), if given.

@@ -4,13 +4,13 @@
 //! numbers; nothing here reads a file.
 //!
 //! ```
-//! use posecov::plan::bag::{BagPlan, Health, Issue};
+//! use posecov::plan::bag::{LogSummary, Health, Issue};
 //! let mut health = Health::default();
 //! health.note(Issue::Placeholder, 1_500_000_000, 0);
 //! health.note(Issue::Placeholder, 1_000_000_000, 1);
 //! assert_eq!(health.count(Issue::Placeholder), 2);
 //! assert_eq!(health.first(Issue::Placeholder), Some(1_000_000_000));
-//! assert!(BagPlan::default().topics.is_empty());
+//! assert!(LogSummary::default().topics.is_empty());
 //! ```
 
 use std::collections::BTreeMap;
@@ -449,7 +449,7 @@ pub struct SkippedTopic {
 
 /// A whole log, reduced: the pose topics and what was skipped.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct BagPlan {
+pub struct LogSummary {
     /// The pose-with-covariance topics read (filtered by `--topic`), in name order.
     pub topics: Vec<TopicPlan>,
     /// Other topics, in name order.

@@ -1,4 +1,5 @@
-//! One fixed colour per method, so a method looks the same in every scenario, plot and legend.
+//! Each method's words, slug and colour in one place: one fixed colour per method, so a
+//! method looks the same in every scenario, plot and legend.
 //!
 //! Colours follow the Okabe–Ito palette (distinguishable with the common colour-vision
 //! deficiencies), lightened where needed to read on the viewer's dark background. Monte Carlo
@@ -75,6 +76,27 @@ impl Method {
             Self::MonteCarlo => "grey",
             Self::VectorSpace => "vermillion",
             Self::LectureNoJr => "gold",
+        }
+    }
+
+    /// A short human-readable label ("first order", "Monte Carlo", …).
+    ///
+    /// ```
+    /// use posecov::uncertain::Method;
+    /// assert_eq!(Self::MonteCarlo.label(), "Monte Carlo");
+    /// ```
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Exact => "exact",
+            Self::FirstOrder => "first order",
+            Self::LectureNoJr => "first order without Jr (lecture)",
+            Self::SecondOrder => "second order",
+            Self::FourthOrder => "fourth order",
+            Self::SigmaPoints => "sigma points",
+            Self::MonteCarlo => "Monte Carlo",
+            Self::VectorSpace => "vector space (SSC)",
+            Self::ClosedForm => "closed form",
+            Self::NumericIntegral => "numeric integral",
         }
     }
 

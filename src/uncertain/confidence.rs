@@ -242,12 +242,23 @@ impl Confidence {
         }
     }
 
+    /// The Mahalanobis radius of this confidence's region in `dof` ≥ 1 dimensions,
+    /// [`chi2_radius`] (which cannot fail for a valid confidence; `dof` 0 is taken as 1).
+    ///
+    /// ```
+    /// use posecov::uncertain::Confidence;
+    /// assert!((Confidence::DEFAULT.radius(3) - 2.795).abs() < 1e-3);
+    /// ```
+    pub fn radius(self, dof: usize) -> f64 {
+        chi2_radius(self.0, dof.max(1)).unwrap_or(f64::NAN)
+    }
+
     /// The probability.
     ///
     /// ```
     /// assert_eq!(posecov::uncertain::Confidence::DEFAULT.get(), 0.95);
     /// ```
-    pub fn get(self) -> f64 {
+    pub const fn get(self) -> f64 {
         self.0
     }
 }

@@ -165,7 +165,12 @@ fn run_graph(text: &str, stage: crate::harness::Stage) -> Result<Output, String>
     stage("evaluate");
     let (evaluation, scene) = pipeline(&loaded, &overrides, None).map_err(|e| e.to_string())?;
     stage("report");
-    let json = report_json("fuzz", &loaded, &evaluation, 0.95);
+    let json = report_json(
+        "fuzz",
+        &loaded,
+        &evaluation,
+        posecov::uncertain::Confidence::DEFAULT,
+    );
     Ok(Output {
         json,
         scene_valid: scene.validate().map_err(|e| e.to_string()),

@@ -39,22 +39,20 @@ pub fn assert_same_content(a: &[u8], b: &[u8]) {
     }
 }
 
-/// The Rerun CLI: `$POSECOV_RERUN_CLI` (set by `.ci/run`), else `../shared/scripts/rerun-cli`
-/// beside the repository. Under CI (`CI` set) a missing CLI is a failure, not a skip.
+/// The Rerun CLI: `$POSECOV_RERUN_CLI` (set by `.ci/run`), and nothing else. Under CI (`CI`
+/// set) a missing CLI is a failure, not a skip.
 pub fn rerun_cli() -> Option<PathBuf> {
-    let candidates = [
-        std::env::var_os("POSECOV_RERUN_CLI").map(PathBuf::from),
-        Some(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/scripts/rerun-cli")),
-    ];
-    let found = candidates.into_iter().flatten().find(|cli| {
-        cli.is_file()
-            && Command::new(cli)
-                .arg("--version")
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .status()
-                .is_ok_and(|s| s.success())
-    });
+    let found = std::env::var_os("POSECOV_RERUN_CLI")
+        .map(PathBuf::from)
+        .filter(|cli| {
+            cli.is_file()
+                && Command::new(cli)
+                    .arg("--version")
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::null())
+                    .status()
+                    .is_ok_and(|s| s.success())
+        });
     if found.is_none() {
         assert!(
             std::env::var_os("CI").is_none(),

@@ -1,6 +1,6 @@
 //! The controls of live mode, generated from the scenario document itself: every number the
 //! file gives under a pose's `mean`/`cov` or an operation key that
-//! [`OPERATION_KINDS`] lists for its kind, plus the `[scenario]` settings, the methods and
+//! [`OPERATION_KINDS`](crate::input::scenario::OPERATION_KINDS) lists for its kind, plus the `[scenario]` settings, the methods and
 //! the `[draw]` switches. Nothing here lists operation keys a second time.
 //!
 //! A control's id is its place in the file in the lowering's words (`pose[0].cov.std_deg[2]`,
@@ -10,7 +10,7 @@
 use serde::Serialize;
 use toml_edit::{DocumentMut, Item, Value};
 
-use crate::input::scenario::OPERATION_KINDS;
+use crate::input::scenario::OperationKind;
 use crate::input::scenario::schema::DrawSpec;
 use crate::lie::GroupKind;
 use crate::plan::limits;
@@ -157,7 +157,7 @@ fn setting_control(key: &'static str, value: Option<f64>) -> Control {
         }
         "seed" => (value.unwrap_or(0.0), 0.0, 1000.0, 1.0, true),
         _ => (
-            value.unwrap_or(crate::app::DEFAULT_CONFIDENCE),
+            value.unwrap_or(crate::app::DEFAULT_CONFIDENCE.get()),
             0.5,
             0.999,
             0.001,
@@ -218,7 +218,9 @@ fn operations(doc: &DocumentMut, group: GroupKind, out: &mut Vec<Slot>) {
     for (i, op) in ops.iter().enumerate() {
         let kind = op.get("kind").and_then(Item::as_str).unwrap_or("?");
         let output = op.get("output").and_then(Item::as_str).unwrap_or("?");
-        let Some((_, required, optional)) = OPERATION_KINDS.iter().find(|(k, ..)| *k == kind)
+        let Some(OperationKind {
+            required, optional, ..
+        }) = OperationKind::named(kind)
         else {
             continue;
         };

@@ -5,19 +5,15 @@ use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
 
 use super::document::{Edit, EditValue, LiveDocument};
 use super::server::{PageOptions, bind_page, serve_page};
 use super::worker::{Live, passes};
 use crate::app::sinks::{
-    ServeOptions, ViewOptions, choose_sink, say_serving, scenario_name, serve_limit,
+    ServeOptions, ViewOptions, choose_sink, say_serving, scenario_name, serve_limit, watch_file,
 };
 use crate::app::{AppError, Overrides, pipeline};
 use crate::sink::{RecordingIds, Sink, open_stream};
-
-/// How often `--watch` looks at the file's modification time.
-const WATCH_POLL: Duration = Duration::from_millis(300);
 
 /// What `posecov live` was asked to do.
 #[derive(Clone, Debug)]
@@ -62,7 +58,7 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
     for (id, value) in [
         ("scenario.seed", o.seed.map(|s| s as f64)),
         ("scenario.samples", o.samples.map(|s| s as f64)),
-        ("scenario.confidence", o.confidence),
+        ("scenario.confidence", o.confidence.map(|c| c.get())),
     ] {
         if let Some(v) = value {
             doc.apply(&Edit {
@@ -158,7 +154,6 @@ pub fn watch_in_place(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, 
     let path = PathBuf::from(&options.scenario);
     let doc = LiveDocument::open(&options.scenario)?;
     let mut last_text = doc.text();
-    let mut last_seen = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
     let live_view = ViewOptions {
         overrides: options.overrides.clone(),
         ..options.clone()
@@ -169,10 +164,8 @@ pub fn watch_in_place(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, 
     }
     eprintln!("Watching {} for changes (Ctrl-C stops).", path.display());
     let limit = serve_limit(&options.serve)?;
-    let start = std::time::Instant::now();
     let mut reported = 0;
-    while !cancel.load(Ordering::Relaxed) && limit.is_none_or(|l| start.elapsed() < l) {
-        std::thread::sleep(WATCH_POLL);
+    watch_file(&path, false, cancel, limit, |changed| {
         let status = live.status();
         if let (Some(shown), true) = (status.shown, status.done)
             && shown >= reported
@@ -185,25 +178,23 @@ pub fn watch_in_place(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, 
             );
             reported = shown + 1;
         }
-        let modified = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
-        if modified == last_seen {
-            continue;
+        if !changed {
+            return Ok(None);
         }
-        last_seen = modified;
         let Ok(text) = std::fs::read_to_string(&path) else {
-            continue;
+            return Ok(None);
         };
-        if text == last_text {
-            continue;
+        if text != last_text {
+            last_text.clone_from(&text);
+            if let Err(err) = live.replace_source(&text) {
+                eprintln!(
+                    "error: {err}\n(the last good picture stays; waiting for the next change of {})",
+                    path.display()
+                );
+            }
         }
-        last_text.clone_from(&text);
-        if let Err(err) = live.replace_source(&text) {
-            eprintln!(
-                "error: {err}\n(the last good picture stays; waiting for the next change of {})",
-                path.display()
-            );
-        }
-    }
+        Ok(None)
+    })?;
     live.finish()?;
     Ok(0)
 }

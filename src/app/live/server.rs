@@ -360,12 +360,11 @@ pub(super) fn write_atomically(path: &std::path::Path, text: &str) -> std::io::R
 
 fn download(app: &App) -> Response {
     let (text, origin) = app.live.with_doc(|d| (d.text(), d.origin().to_owned()));
-    let stem: String = std::path::Path::new(origin.split(' ').next().unwrap_or("scenario"))
-        .file_stem()
-        .map_or_else(|| "scenario".into(), |s| s.to_string_lossy().into_owned())
-        .chars()
-        .filter(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
-        .collect();
+    let stem: String =
+        crate::app::sinks::scenario_name(origin.split(' ').next().unwrap_or("scenario"))
+            .chars()
+            .filter(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+            .collect();
     let mut response = asset_owned(text, "application/toml; charset=utf-8");
     if let Ok(v) = HeaderValue::from_str(&format!("attachment; filename=\"{stem}_live.toml\"")) {
         response

@@ -6,8 +6,8 @@ use std::fmt::Write;
 use crate::eval::bag::{BagEvaluation, PoseState};
 use crate::input::Format;
 use crate::interop::RosReading;
-use crate::plan::bag::{BagPlan, Class, Issue, TopicPlan};
-use crate::uncertain::chi2_radius;
+use crate::plan::bag::{Class, Issue, LogSummary, TopicPlan};
+use crate::uncertain::Confidence;
 
 /// A stamp in seconds, as the timeline shows it.
 fn secs(ns: i64) -> String {
@@ -123,7 +123,12 @@ pub fn issue_sentence(issue: Issue, t: &TopicPlan) -> String {
 /// topics.
 ///
 /// See [`bag_scene`](super::bag_scene) for an example.
-pub fn description(plan: &BagPlan, format: Format, e: &BagEvaluation, confidence: f64) -> String {
+pub fn description(
+    plan: &LogSummary,
+    format: Format,
+    e: &BagEvaluation,
+    confidence: Confidence,
+) -> String {
     let mut s = String::new();
     let format = format.name();
     let defects: u64 = plan
@@ -181,7 +186,7 @@ pub fn description(plan: &BagPlan, format: Format, e: &BagEvaluation, confidence
          - Regions at {:.1} %; the `stamp` timeline is the message stamp (a date, or the time \
          since the clock's zero when the stamps are simulated time).",
         reading_words(e.reading),
-        confidence * 100.0
+        confidence.get() * 100.0
     );
     s
 }
@@ -207,7 +212,7 @@ fn topic(
     s: &mut String,
     t: &TopicPlan,
     e: &crate::eval::bag::TopicEvaluation,
-    p: f64,
+    p: Confidence,
     reading: RosReading,
 ) {
     let _ = write!(s, "\n---\n\n**{}** ({}", t.name, t.kind.ros1_name());
@@ -251,7 +256,7 @@ fn topic(
         .iter()
         .filter(|q| matches!(&q.state, PoseState::Invalid { issues } if issues == &[Issue::PlaceholderUsedAxis]))
         .count();
-    let r2 = |d| chi2_radius(p, d).unwrap_or(f64::NAN);
+    let r2 = |d| p.radius(d);
     let shape = if t.planar {
         format!(
             "**planar** (z, roll and pitch are zero or placeholders in every usable message): \

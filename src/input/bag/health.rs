@@ -5,12 +5,9 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use crate::plan::bag::{COV_LEN, Issue, Stretch};
+use crate::uncertain::{psd_tolerance, symmetry_tolerance};
 
 pub use crate::plan::bag::PLACEHOLDER;
-/// Relative tolerance of the symmetry check: |Σᵢⱼ − Σⱼᵢ| ≤ tol · max(1, max |Σᵢᵢ|).
-pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
-/// Relative tolerance of the PSD check: λ_min ≥ −tol · max(λ_max, tiny).
-pub const PSD_TOLERANCE: f64 = 1e-9;
 /// A drop: the position trace divided by at least this from one usable message to the next.
 pub const DROP_FACTOR: f64 = 5.0;
 /// Growth: the position trace at least this many times its value after the last drop.
@@ -91,7 +88,9 @@ pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHeal
         issues.push(Issue::Placeholder);
     }
     let scale = kept.iter().map(|&i| diag[i].abs()).fold(0.0, f64::max);
-    let tol = SYMMETRY_TOLERANCE * scale.max(1.0);
+    // The symmetry and PSD rules are evaluation's (`uncertain`): what health calls PSD,
+    // evaluation accepts.
+    let tol = symmetry_tolerance(scale);
     let asymmetric = kept.iter().any(|&i| {
         kept.iter()
             .any(|&j| (cov[i * 6 + j] - cov[j * 6 + i]).abs() > tol)
@@ -111,7 +110,7 @@ pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHeal
             .fold(f64::INFINITY, f64::min);
         let hi = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
         min_eigenvalue = Some(lo);
-        if lo < -PSD_TOLERANCE * hi.max(f64::MIN_POSITIVE) {
+        if lo < -psd_tolerance(hi) {
             issues.push(Issue::NotPsd);
         }
     }

@@ -16,7 +16,7 @@ use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
 use crate::plan::{
     AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, limits,
 };
-use crate::uncertain::{Method, Side, UncertainPose, chi2_radius};
+use crate::uncertain::{Confidence, Method, Side, UncertainPose};
 
 /// Most loop closures evaluated and drawn with their uncertainty (evenly chosen); the rest
 /// are counted in the text panel.
@@ -314,7 +314,7 @@ fn residuals<G: LieGroup<N>, const N: usize>(
     edges: &[Edge<G, N>],
     loops: &[usize],
 ) -> Vec<Residual> {
-    let radius_95 = chi2_radius(0.95, N).unwrap_or(f64::NAN);
+    let radius_95 = Confidence::DEFAULT.radius(N);
     loops
         .iter()
         .map(|&i| {

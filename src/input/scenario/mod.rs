@@ -36,7 +36,7 @@ mod parse_errors;
 pub mod schema;
 mod values;
 
-pub use lower::{OPERATION_KINDS, lower};
+pub use lower::{OPERATION_KINDS, OperationKind, lower};
 pub use schema::{GroupName, ScenarioFile};
 pub use values::{SpecGroup, ValueError};
 

@@ -73,8 +73,10 @@ pub enum ValueError {
         lengths: Vec<usize>,
     },
     /// A negative standard deviation.
-    #[error("std[{index}] = {value} is negative; a standard deviation is ≥ 0")]
+    #[error("{key}[{index}] = {value} is negative; a standard deviation is ≥ 0")]
     NegativeStd {
+        /// The key as the file writes it (`std` or `std_deg`).
+        key: &'static str,
         /// Position in the list.
         index: usize,
         /// The value.
@@ -403,6 +405,7 @@ pub(crate) fn cov_for<G: SpecGroup<N>, const N: usize>(
         let std = tangent_of::<N>(key, std, "one per tangent axis")?;
         if let Some(index) = std.iter().position(|s| *s < 0.0) {
             return Err(ValueError::NegativeStd {
+                key,
                 index,
                 value: std[index],
             });

@@ -61,7 +61,7 @@ pub const INT_EDGES: &[i64] = &[
 pub fn kinds() -> Vec<&'static str> {
     posecov::input::scenario::OPERATION_KINDS
         .iter()
-        .map(|(k, ..)| *k)
+        .map(|k| k.kind)
         .collect()
 }
 

@@ -22,25 +22,82 @@ use crate::lie::{GroupKind, LieGroup, Se2, Se3, So2, So3, TangentMatrix};
 use crate::plan::{AnyPlan, Op, Operand, Plan, limits};
 use crate::uncertain::{Side, UncertainPose};
 
+/// An operation kind, with the keys it requires and the keys it accepts besides `kind` and
+/// `output`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OperationKind {
+    /// The kind, as the file writes it (`kind = "compose"`).
+    pub kind: &'static str,
+    /// Keys it requires.
+    pub required: &'static [&'static str],
+    /// Keys it accepts besides those.
+    pub optional: &'static [&'static str],
+}
+
+impl OperationKind {
+    /// The kind named `kind`, if any.
+    ///
+    /// ```
+    /// use posecov::input::scenario::OperationKind;
+    /// assert_eq!(OperationKind::named("fuse").unwrap().required, &["inputs"]);
+    /// assert!(OperationKind::named("invert").is_none());
+    /// ```
+    pub fn named(kind: &str) -> Option<&'static OperationKind> {
+        OPERATION_KINDS.iter().find(|k| k.kind == kind)
+    }
+}
+
 /// Every operation kind, with the keys it requires and the keys it accepts besides `kind`
 /// and `output`. The one table of operation keys.
-pub const OPERATION_KINDS: &[(&str, &[&str], &[&str])] = &[
-    ("inverse", &["input"], &[]),
-    ("change_frame_left", &["input", "by"], &[]),
-    ("change_frame_right", &["input", "by"], &[]),
-    ("compose", &["lhs", "rhs"], &[]),
-    ("between", &["lhs", "rhs"], &[]),
-    ("compose_correlated", &["lhs", "rhs", "cross_cov"], &[]),
-    ("between_correlated", &["lhs", "rhs", "cross_cov"], &[]),
-    (
-        "odometry",
-        &["input", "controls", "noise", "model"],
-        &["steps"],
-    ),
-    ("compound", &["input", "by", "noise", "steps"], &[]),
-    (
-        "diff_drive",
-        &[
+pub const OPERATION_KINDS: &[OperationKind] = &[
+    OperationKind {
+        kind: "inverse",
+        required: &["input"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "change_frame_left",
+        required: &["input", "by"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "change_frame_right",
+        required: &["input", "by"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "compose",
+        required: &["lhs", "rhs"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "between",
+        required: &["lhs", "rhs"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "compose_correlated",
+        required: &["lhs", "rhs", "cross_cov"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "between_correlated",
+        required: &["lhs", "rhs", "cross_cov"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "odometry",
+        required: &["input", "controls", "noise", "model"],
+        optional: &["steps"],
+    },
+    OperationKind {
+        kind: "compound",
+        required: &["input", "by", "noise", "steps"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "diff_drive",
+        required: &[
             "wheel_radius",
             "wheelbase",
             "duration",
@@ -48,11 +105,23 @@ pub const OPERATION_KINDS: &[(&str, &[&str], &[&str])] = &[
             "speed",
             "turn_rate",
         ],
-        &["input", "dt"],
-    ),
-    ("point_through_pose", &["input", "point"], &["point_cov"]),
-    ("fuse", &["inputs"], &[]),
-    ("euler_vs_exp", &["rate", "dt", "steps"], &["input"]),
+        optional: &["input", "dt"],
+    },
+    OperationKind {
+        kind: "point_through_pose",
+        required: &["input", "point"],
+        optional: &["point_cov"],
+    },
+    OperationKind {
+        kind: "fuse",
+        required: &["inputs"],
+        optional: &[],
+    },
+    OperationKind {
+        kind: "euler_vs_exp",
+        required: &["rate", "dt", "steps"],
+        optional: &["input"],
+    },
 ];
 
 /// Lowers a parsed scenario: the plan of its group, its text, the file's settings and drawing
@@ -130,30 +199,27 @@ impl Lowering<'_> {
     fn settings(&self) -> Result<FileSettings, ScenarioError> {
         let h = &self.file.scenario;
         if let Some(n) = &h.samples
-            && !(limits::MIN_SAMPLES..=limits::MAX_SAMPLES).contains(n.get_ref())
+            && let Err(expected) = limits::check_samples(*n.get_ref())
         {
             return Err(self.err(
                 n.span(),
                 "scenario.samples",
-                format!(
-                    "{} is out of range: use {} ..= {}",
-                    n.get_ref(),
-                    limits::MIN_SAMPLES,
-                    limits::MAX_SAMPLES
-                ),
+                format!("{} is out of range: {expected}", n.get_ref()),
             ));
         }
-        if let Some(c) = &h.confidence
-            && let Err(e) = crate::uncertain::Confidence::new(*c.get_ref())
-        {
-            return Err(self.err(c.span(), "scenario.confidence", e.to_string()));
-        }
+        let confidence = match &h.confidence {
+            Some(c) => Some(
+                crate::uncertain::Confidence::new(*c.get_ref())
+                    .map_err(|e| self.err(c.span(), "scenario.confidence", e.to_string()))?,
+            ),
+            None => None,
+        };
         let mut methods = h.methods.clone();
         methods.dedup();
         Ok(FileSettings {
             seed: h.seed,
             samples: h.samples.as_ref().map(|s| *s.get_ref()),
-            confidence: h.confidence.as_ref().map(|c| *c.get_ref()),
+            confidence,
             methods,
             sigma_points: self.sigma_points(&self.file.methods.sigma_points, h.group.dof())?,
         })
@@ -272,9 +338,11 @@ impl Lowering<'_> {
     /// The keys set are the kind's: none foreign, none missing.
     fn check_keys(&self, op: &OperationSpec, field: &str) -> Result<(), ScenarioError> {
         let kind = op.kind.get_ref().as_str();
-        let Some((_, required, optional)) = OPERATION_KINDS.iter().find(|(k, ..)| *k == kind)
+        let Some(OperationKind {
+            required, optional, ..
+        }) = OperationKind::named(kind)
         else {
-            let kinds: Vec<&str> = OPERATION_KINDS.iter().map(|(k, ..)| *k).collect();
+            let kinds: Vec<&str> = OPERATION_KINDS.iter().map(|k| k.kind).collect();
             return Err(self.err(
                 op.kind.span(),
                 &format!("{field}.kind"),

@@ -1,0 +1,122 @@
+//! Validation of covariances: finite, symmetric and positive semi-definite within the one
+//! pair of tolerances every stage uses (files, evaluation, the health of robot logs).
+
+use nalgebra::{DMatrix, SymmetricEigen};
+
+use crate::error::{Error, Result, check_finite};
+use crate::lie::TangentMatrix;
+
+/// Tolerance on |Σᵢⱼ − Σⱼᵢ|, relative to max(1, max |Σ|): inputs typed with a few decimals or
+/// produced by f64 arithmetic pass; a transposed entry does not.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-9;
+
+/// Allowance for round-off in the positive-semi-definite check: the smallest eigenvalue of Σ
+/// may be as low as −`PSD_TOLERANCE` · max(1, λ_max) and still be accepted (as 0).
+pub const PSD_TOLERANCE: f64 = 1e-12;
+
+/// The asymmetry |Σᵢⱼ − Σⱼᵢ| accepted in a covariance whose largest magnitude is `scale`:
+/// [`SYMMETRY_TOLERANCE`] · max(1, scale). The one rule for files, evaluation and the health
+/// of robot logs.
+///
+/// ```
+/// use posecov::uncertain::symmetry_tolerance;
+/// assert_eq!(symmetry_tolerance(0.01), 1e-9);
+/// assert_eq!(symmetry_tolerance(100.0), 1e-7);
+/// ```
+pub fn symmetry_tolerance(scale: f64) -> f64 {
+    SYMMETRY_TOLERANCE * scale.max(1.0)
+}
+
+/// How far below zero the smallest eigenvalue of a symmetric matrix whose largest eigenvalue
+/// is `largest` may lie and the matrix still count as positive semi-definite:
+/// [`PSD_TOLERANCE`] · max(1, λ_max). The one rule for files, evaluation and the health of
+/// robot logs.
+///
+/// ```
+/// use posecov::uncertain::psd_tolerance;
+/// assert_eq!(psd_tolerance(0.5), 1e-12);
+/// assert_eq!(psd_tolerance(1e6), 1e-6);
+/// ```
+pub fn psd_tolerance(largest: f64) -> f64 {
+    PSD_TOLERANCE * largest.max(1.0)
+}
+
+/// Validates a covariance: finite, symmetric within [`SYMMETRY_TOLERANCE`], positive
+/// semi-definite by its eigenvalues within [`PSD_TOLERANCE`]. Returns the symmetrised matrix
+/// ½(Σ + Σᵀ).
+///
+/// ```
+/// use posecov::uncertain::validate_covariance;
+/// use nalgebra::Matrix2;
+/// assert!(validate_covariance("Σ", &Matrix2::new(1.0, 0.5, 0.5, 1.0)).is_ok());
+/// assert!(validate_covariance("Σ", &Matrix2::new(1.0, 2.0, 2.0, 1.0)).is_err()); // eigenvalue −1
+/// assert!(validate_covariance("Σ", &Matrix2::new(1.0, 0.5, 0.4, 1.0)).is_err()); // asymmetric
+/// ```
+pub fn validate_covariance<const N: usize>(
+    what: &'static str,
+    cov: &TangentMatrix<N>,
+) -> Result<TangentMatrix<N>> {
+    let sym = validate_covariance_dyn(what, &DMatrix::from_iterator(N, N, cov.iter().copied()))?;
+    Ok(TangentMatrix::<N>::from_iterator(sym.iter().copied()))
+}
+
+/// [`validate_covariance`] for a matrix whose size is known only at run time (a joint
+/// covariance of several poses): square, finite, symmetric within [`SYMMETRY_TOLERANCE`],
+/// positive semi-definite within [`PSD_TOLERANCE`]. Returns ½(Σ + Σᵀ).
+///
+/// ```
+/// use posecov::uncertain::validate_covariance_dyn;
+/// use nalgebra::DMatrix;
+/// assert!(validate_covariance_dyn("joint", &DMatrix::<f64>::identity(4, 4)).is_ok());
+/// assert!(validate_covariance_dyn("joint", &DMatrix::<f64>::identity(4, 3)).is_err()); // not square
+/// ```
+pub fn validate_covariance_dyn(what: &'static str, cov: &DMatrix<f64>) -> Result<DMatrix<f64>> {
+    let (n, cols) = cov.shape();
+    if n != cols {
+        return Err(Error::WrongShape {
+            what,
+            expected_rows: n.max(cols),
+            expected_cols: n.max(cols),
+            rows: n,
+            cols,
+        });
+    }
+    check_finite(what, cov.transpose().iter().copied())?;
+    let tolerance = symmetry_tolerance(cov.amax());
+    let mut worst = (0, 0, 0.0);
+    for row in 0..n {
+        for col in row + 1..n {
+            let difference = (cov[(row, col)] - cov[(col, row)]).abs();
+            if difference > worst.2 {
+                worst = (row, col, difference);
+            }
+        }
+    }
+    let (row, col, difference) = worst;
+    if difference > tolerance {
+        return Err(Error::NotSymmetric {
+            what,
+            row,
+            col,
+            upper: cov[(row, col)],
+            lower: cov[(col, row)],
+            difference,
+            tolerance,
+        });
+    }
+    let sym = (cov + cov.transpose()) * 0.5;
+    if n == 0 {
+        return Ok(sym);
+    }
+    let eigenvalues = SymmetricEigen::new(sym.clone()).eigenvalues;
+    let min_eigenvalue = eigenvalues.min();
+    let tolerance = psd_tolerance(eigenvalues.max());
+    if min_eigenvalue < -tolerance {
+        return Err(Error::NotPositiveSemiDefinite {
+            what,
+            min_eigenvalue,
+            tolerance,
+        });
+    }
+    Ok(sym)
+}
