@@ -19,7 +19,12 @@ fn report(loaded: &posecov::app::Loaded, samples: u64) -> Value {
         ..Default::default()
     };
     let (evaluation, _) = pipeline(loaded, &overrides, None).expect("evaluates");
-    report_json("t", loaded, &evaluation, 0.95)
+    report_json(
+        "t",
+        loaded,
+        &evaluation,
+        posecov::uncertain::Confidence::DEFAULT,
+    )
 }
 
 /// The `results[]` entry of `label` and `method`.
@@ -222,7 +227,12 @@ fn a_blocked_sample_counts_the_same_as_a_whole_one() {
             ..Default::default()
         };
         let (evaluation, _) = pipeline(&loaded, &overrides, None).expect("evaluates");
-        report_json("t", &loaded, &evaluation, 0.95)
+        report_json(
+            "t",
+            &loaded,
+            &evaluation,
+            posecov::uncertain::Confidence::DEFAULT,
+        )
     };
     let (whole, blocked) = (run(None), run(Some(2048)));
     for method in ["exact", "sigma_points", "vector_space"] {

@@ -191,7 +191,7 @@ pub fn resolve(
             methods: file.methods.clone(),
             block_samples: overrides.block_samples.map(|b| b as usize),
             steps,
-            confidence,
+            confidence: confidence.get(),
             unscented: file.sigma_points.unwrap_or_default(),
             cancel,
             graph: GraphSettings {

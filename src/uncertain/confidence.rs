@@ -191,6 +191,8 @@ impl Coverage {
             inside: q,
             stderr: (q * (1.0 - q) / n).sqrt(),
         }
+    }
+}
 
 /// A confidence: the probability p ∈ (0, 1) a drawn region holds (`--confidence`,
 /// `[scenario] confidence`). Checked once, here, wherever it is given.
