@@ -15,8 +15,6 @@ use crate::plan::{StepPolicy, limits};
 use crate::uncertain::Confidence;
 
 pub use crate::plan::limits::DEFAULT_SAMPLES;
-/// Probability inside drawn regions when neither the command line nor the file says.
-pub const DEFAULT_CONFIDENCE: Confidence = Confidence::DEFAULT;
 /// At most this many cloud samples per drawn message of a robot log (`--samples`).
 pub const MAX_CLOUD_SAMPLES: u64 = 10_000;
 
@@ -182,7 +180,7 @@ pub fn resolve(
     let confidence = overrides
         .confidence
         .or(file.confidence)
-        .unwrap_or(DEFAULT_CONFIDENCE);
+        .unwrap_or(Confidence::DEFAULT);
     let steps = overrides.steps.unwrap_or_default();
     Ok(Settings {
         eval: EvalSettings {
@@ -191,7 +189,7 @@ pub fn resolve(
             methods: file.methods.clone(),
             block_samples: overrides.block_samples.map(|b| b as usize),
             steps,
-            confidence: confidence.get(),
+            confidence,
             unscented: file.sigma_points.unwrap_or_default(),
             cancel,
             graph: GraphSettings {
@@ -249,6 +247,6 @@ pub fn resolve_log(overrides: &Overrides) -> Result<LogSettings, SettingsError> 
             cloud_samples: samples as usize,
             reading: overrides.ros_reading.unwrap_or_default(),
         },
-        confidence: overrides.confidence.unwrap_or(DEFAULT_CONFIDENCE),
+        confidence: overrides.confidence.unwrap_or(Confidence::DEFAULT),
     })
 }

@@ -291,7 +291,7 @@ fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
             Some(rviz_position(&flat_rviz, &c, r, p.extent, t.planar).0)
         })
         .collect();
-    let region = super::legend::percent(p.confidence());
+    let region = p.confidence().to_string();
     p.legend(
         format!("RViz's picture: the {region} ellipse of the numbers as given"),
         RVIZ,

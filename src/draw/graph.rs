@@ -3,13 +3,14 @@
 
 use std::fmt::Write;
 
-use super::shapes::{self, chi2_radius};
+use super::shapes;
 use super::{Painter, v3};
 use crate::eval::Finding;
 use crate::eval::graph::{Anchor, GraphEvaluation, Optimizer, Part, Stop};
 use crate::lie::LieGroup;
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, QuatXyzw, Triads, Vec3,
+    WORLD,
 };
 use crate::uncertain::{Side, UncertainPose};
 
@@ -51,7 +52,7 @@ pub(super) fn finding_text(f: &Finding) -> Option<String> {
             confidence,
         } => format!(
             "**Loop closure v{from} → v{to} (line {line}) is an outlier**: after the optimisation its residual is d = {mahalanobis:.2} (Mahalanobis, under the edge's own Σ), beyond the {:.0} % radius {radius:.2} (it was {mahalanobis_before:.2} at the file's estimates).",
-            100.0 * confidence
+            100.0 * confidence.get()
         ),
         Finding::MoreLoopClosureOutliers {
             more,
@@ -141,14 +142,14 @@ pub(super) fn describe<G: LieGroup<N>, const N: usize>(g: &GraphEvaluation<G, N>
         d,
         " {} loop closures; {outliers} lie beyond the {:.0} % radius {:.2} of their own Σ after the optimisation.",
         g.loop_closures.len(),
-        100.0 * g.confidence,
+        100.0 * g.confidence.get(),
         g.radius
     );
     d
 }
 
-/// The subtree of the "after" picture.
-pub(super) const AFTER: &str = "world/optimized";
+/// The subtree of the "after" picture, under [`WORLD`].
+pub(super) const AFTER: &str = "optimized";
 
 /// Most optimised poses drawn with their marginal ellipse (evenly chosen, plus the loop
 /// closures' ends).
@@ -176,7 +177,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     let position = |x: &G| x.to_se3().translation().to_owned();
     let radius = 0.003 * p.extent.max(0.25);
     p.push(
-        "world/optimized/trajectory".to_owned(),
+        format!("{WORLD}/{AFTER}/trajectory"),
         None,
         ItemKind::LineStrips(LineStrips {
             strips: vec![s.poses.iter().map(|x| v3(&position(x))).collect()],
@@ -209,13 +210,13 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
             Some(shapes::ellipsoid_of(
                 &position(&s.poses[k]),
                 &cov,
-                chi2_radius(p.confidence(), d),
+                p.confidence().radius(d),
             ))
         })
         .collect();
     if !shapes.is_empty() {
         p.push(
-            "world/optimized/marginals".to_owned(),
+            format!("{WORLD}/{AFTER}/marginals"),
             None,
             ItemKind::Ellipsoids(Ellipsoids {
                 shapes,
@@ -227,7 +228,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         );
     }
     p.push(
-        "world/optimized/poses".to_owned(),
+        format!("{WORLD}/{AFTER}/poses"),
         None,
         ItemKind::Triads(Triads {
             translations: drawn.iter().map(|&k| v3(&position(&s.poses[k]))).collect(),
@@ -250,7 +251,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         if let Some(pose) = uncertain(k) {
             shapes::banana(
                 p,
-                &format!("world/optimized/bananas/v{}", g.ids[k]),
+                &format!("{WORLD}/{AFTER}/bananas/v{}", g.ids[k]),
                 None,
                 &pose,
                 OPTIMIZED,
@@ -270,7 +271,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         }
         let ends = |l: &crate::eval::graph::LoopClosure<N>| (index_of[&l.from], index_of[&l.to]);
         p.push(
-            format!("world/optimized/loop_closures/{name}"),
+            format!("{WORLD}/{AFTER}/loop_closures/{name}"),
             None,
             ItemKind::LineStrips(LineStrips {
                 strips: chosen
@@ -296,7 +297,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
             })
             .unzip();
         p.push(
-            format!("world/optimized/loop_closures/{name}_residuals"),
+            format!("{WORLD}/{AFTER}/loop_closures/{name}_residuals"),
             None,
             ItemKind::Arrows(Arrows {
                 origins,
@@ -322,9 +323,9 @@ fn labels<G: LieGroup<N>, const N: usize>(
     after: bool,
 ) {
     let (poses, prefix) = if after {
-        (&g.solution.poses, "world/optimized/labels")
+        (&g.solution.poses, format!("{WORLD}/{AFTER}/labels"))
     } else {
-        (&g.initial, "world/labels")
+        (&g.initial, format!("{WORLD}/labels"))
     };
     let n = poses.len();
     let index_of = |id: u64| g.ids.iter().position(|&x| x == id);

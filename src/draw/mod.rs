@@ -339,7 +339,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
                 format!(
                     "{}: {} ellipsoid of the point",
                     method.label(),
-                    legend::percent(p.confidence())
+                    p.confidence()
                 ),
                 method.color(),
                 Swatch::Dashed,
@@ -411,7 +411,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         camera: choices.camera,
     };
     p.scene.views = if e.graph.is_some() {
-        views::before_after(&p.scene, &plan, graph::AFTER)
+        views::before_after(&p.scene, &plan, &format!("{WORLD}/{}", graph::AFTER))
     } else {
         views::views(&p.scene, &plan)
     };

@@ -105,7 +105,7 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &
             }
             shapes::position_ellipsoid(p, &base, node.step, &pose, color);
         }
-        let region = legend::percent(p.confidence());
+        let region = p.confidence().to_string();
         if bananas && !rotation_only && method != Method::VectorSpace {
             let point_of = |x: &G| *x.to_se3().translation();
             if is_primary || p.layout == Layout::PerMethod {
@@ -172,7 +172,7 @@ fn coinciding(
         if !(same_matrix && same_centre) {
             continue;
         }
-        let region = legend::percent(p.confidence());
+        let region = p.confidence().to_string();
         p.legend(
             format!(
                 "{who}: Cartesian {region} ellipse = the vector-space one here (same matrix; drawn under it)"
@@ -194,7 +194,7 @@ fn coinciding(
 /// The legend entry of a method's Cartesian position ellipse (the vector-space baseline's is
 /// its whole Gaussian in (x, y[, z])).
 fn cartesian_legend(p: &mut Painter, who: String, method: Method) {
-    let region = legend::percent(p.confidence());
+    let region = p.confidence().to_string();
     let label = if method == Method::VectorSpace {
         format!("{who}: {region} ellipse")
     } else {

@@ -187,7 +187,7 @@ fn consistency_lines<G: LieGroup<N>, const N: usize>(
                 .filter_map(|(m, c)| Some((m, c.anees?.value))),
         );
         if let Some((_, c)) = measured.clone().next() {
-            claimed.push((step, c.confidence));
+            claimed.push((step, c.confidence.get()));
         }
         if let Some(a) = measured.filter_map(|(_, c)| c.anees).find(|a| a.dof == N) {
             band[0].push((step, a.band[0]));

@@ -147,7 +147,7 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
             s,
             "; the share of the {} samples inside {region}, both drawn at {:.1} % (standard error ≤ {:.1} %)",
             first.samples,
-            first.confidence * 100.0,
+            first.confidence.get() * 100.0,
             worst * 100.0
         );
         if let Some(a) = measured.iter().find_map(|c| c.anees) {

@@ -138,7 +138,7 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
 /// A pose graph's two views side by side: "before" (the file's estimates and the odometry
 /// chain, everything but `after`) and "after" (the subtree `after`: optimised poses and
 /// marginals), each with its own camera.
-pub(super) fn before_after(scene: &Scene, plan: &ViewPlan, after: &str) -> Vec<View3d> {
+pub(super) fn before_after(scene: &Scene, plan: &ViewInputs, after: &str) -> Vec<View3d> {
     let mut views = vec![
         View3d {
             name: "before: file estimates, odometry chain".to_owned(),

@@ -4,6 +4,7 @@
 //! mean), and in the first pass the sums behind the uncentred left covariance about the
 //! nominal and the Cartesian position mean; per point node the points' mean and covariance.
 
+use crate::uncertain::Confidence;
 use nalgebra::{Matrix3, Vector3};
 
 use super::consistency::ConsistencySums;
@@ -156,7 +157,7 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
         index: usize,
         estimates: &[Estimate<G, N>],
         particles: &[G],
-        confidence: f64,
+        confidence: Confidence,
     ) where
         G: EvalGroup<N>,
     {

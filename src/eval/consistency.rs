@@ -24,6 +24,7 @@
 //! The samples of a node are independent, so the count inside is binomial and n · ANEES is
 //! χ²_{n·d} when the estimate is exact ([`anees_band`]).
 
+use crate::uncertain::Confidence;
 use nalgebra::{Matrix2, Matrix3, SVector, Vector3};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -47,7 +48,7 @@ pub struct Consistency {
     /// The samples counted.
     pub samples: usize,
     /// The confidence p the regions are drawn at.
-    pub confidence: f64,
+    pub confidence: Confidence,
     /// Per region the estimate draws: the fraction of samples inside and its standard error.
     pub coverage: Vec<Coverage>,
     /// The average NEES of the samples under the estimate's Gaussian (`None` where its Σ is
@@ -93,7 +94,7 @@ pub struct CoverageSummary {
     /// The method's label.
     pub method: &'static str,
     /// The confidence p the regions are drawn at.
-    pub confidence: f64,
+    pub confidence: Confidence,
     /// Its regions' coverage.
     pub coverage: Vec<Coverage>,
     /// Its ANEES, where Σ is regular.
@@ -169,7 +170,7 @@ pub(super) struct ConsistencySums<G: LieGroup<N>, const N: usize> {
     tests: Vec<EstimateTest<G, N>>,
     counts: Vec<Counts>,
     samples: usize,
-    confidence: f64,
+    confidence: Confidence,
     /// χ²_d(p) of the tangent and χ²_k(p) of the position regions.
     thresholds: [f64; 2],
 }
@@ -177,9 +178,9 @@ pub(super) struct ConsistencySums<G: LieGroup<N>, const N: usize> {
 impl<G: EvalGroup<N>, const N: usize> ConsistencySums<G, N> {
     /// Empty counts for every estimate of `estimates` at confidence `p`; `None` when p is not
     /// a probability.
-    pub(super) fn new(estimates: &[Estimate<G, N>], confidence: f64) -> Option<Self> {
+    pub(super) fn new(estimates: &[Estimate<G, N>], confidence: Confidence) -> Option<Self> {
         let k = G::KIND.position_dims();
-        let squared = |d: usize| chi2_radius(confidence, d).ok().map(|r| r * r);
+        let squared = |d: usize| chi2_radius(confidence.get(), d).ok().map(|r| r * r);
         let thresholds = [squared(N)?, if k > 0 { squared(k)? } else { 0.0 }];
         let tests: Vec<_> = estimates
             .iter()
@@ -391,7 +392,7 @@ mod tests {
         .unwrap();
         let samples = Sampler::new(&pose).unwrap().draw_par(40_000, 3);
         let mut estimates = vec![estimate(pose, Method::FirstOrder)];
-        let mut sums = ConsistencySums::new(&estimates, 0.9).unwrap();
+        let mut sums = ConsistencySums::new(&estimates, Confidence::new(0.9).unwrap()).unwrap();
         sums.add(&samples[..15_000]);
         sums.add(&samples[15_000..]);
         sums.finish(&mut estimates);
@@ -428,7 +429,7 @@ mod tests {
             estimate(small, Method::FirstOrder),
             estimate(singular, Method::SigmaPoints),
         ];
-        let mut sums = ConsistencySums::new(&estimates, 0.95).unwrap();
+        let mut sums = ConsistencySums::new(&estimates, Confidence::DEFAULT).unwrap();
         sums.add(&samples);
         sums.finish(&mut estimates);
         let c = estimates[0].consistency.as_ref().unwrap();

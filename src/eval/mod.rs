@@ -40,6 +40,7 @@ pub mod bag;
 mod blocked;
 pub mod consistency;
 mod engine;
+mod findings;
 pub mod graph;
 pub mod groups;
 mod model;
@@ -57,7 +58,7 @@ pub use model::{
 use crate::lie::{Se2, Se3, So2, So3};
 use crate::plan::{AnyPlan, Op, Plan, PoseValue, StepPolicy, limits};
 use crate::sample::CHUNK_SIZE;
-use crate::uncertain::Method;
+use crate::uncertain::{Confidence, Method};
 use blocked::BlockedStats;
 use engine::{Engine, StatsMode};
 use groups::EvalGroup;
@@ -69,10 +70,6 @@ pub const PARTICLE_MEMORY_BUDGET: usize = 128 << 20;
 pub const MAX_BLOCK_SAMPLES: usize = 64 * CHUNK_SIZE;
 /// At least this many particles per block, however many nodes hold particles.
 pub const MIN_BLOCK_SAMPLES: usize = 4 * CHUNK_SIZE;
-
-/// The probability inside drawn regions when neither the command line nor the file says
-/// ([`Confidence::DEFAULT`](crate::uncertain::Confidence::DEFAULT)).
-pub const DEFAULT_CONFIDENCE: f64 = crate::uncertain::Confidence::DEFAULT.get();
 
 /// What an evaluation needs besides the plan, resolved once by the caller.
 #[derive(Debug, Clone)]
@@ -89,8 +86,8 @@ pub struct EvalSettings {
     /// Which steps of long propagations keep numbers and particles.
     pub steps: StepPolicy,
     /// The probability p of the regions whose coverage is measured against Monte Carlo
-    /// ([`consistency`]), 0 < p < 1 (default [`DEFAULT_CONFIDENCE`]).
-    pub confidence: f64,
+    /// ([`consistency`]), 0 < p < 1 (default [`Confidence::DEFAULT`]).
+    pub confidence: Confidence,
     /// Sigma-point parameters α, β, κ (default 1, 2, 0).
     pub unscented: crate::propagate::sigma_point::Unscented,
     /// Set to stop early (Ctrl-C): the evaluation returns what it has, with
@@ -108,7 +105,7 @@ impl Default for EvalSettings {
             methods: Vec::new(),
             block_samples: None,
             steps: StepPolicy::default(),
-            confidence: DEFAULT_CONFIDENCE,
+            confidence: Confidence::DEFAULT,
             unscented: Default::default(),
             cancel: None,
             graph: Default::default(),

@@ -402,7 +402,7 @@ pub struct Scene {
     /// What each colour and mark means, in drawing order (one entry per label).
     pub legend: Vec<LegendEntry>,
     /// The probability inside every drawn region, if the scene draws regions.
-    pub confidence: Option<f64>,
+    pub confidence: Option<crate::uncertain::Confidence>,
 }
 
 impl Scene {

@@ -264,3 +264,19 @@ impl Confidence {
         self.0
     }
 }
+
+/// The probability as people write it: "95 %", "99.7 %" (at most two decimals, no trailing
+/// zeros; a thin space would not survive every font, so a plain one).
+///
+/// ```
+/// use posecov::uncertain::Confidence;
+/// assert_eq!(Confidence::DEFAULT.to_string(), "95 %");
+/// assert_eq!(Confidence::new(0.997).unwrap().to_string(), "99.7 %");
+/// assert_eq!(Confidence::new(0.5).unwrap().to_string(), "50 %");
+/// ```
+impl std::fmt::Display for Confidence {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let text = format!("{:.2}", 100.0 * self.0);
+        write!(f, "{} %", text.trim_end_matches('0').trim_end_matches('.'))
+    }
+}

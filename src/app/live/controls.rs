@@ -157,7 +157,7 @@ fn setting_control(key: &'static str, value: Option<f64>) -> Control {
         }
         "seed" => (value.unwrap_or(0.0), 0.0, 1000.0, 1.0, true),
         _ => (
-            value.unwrap_or(crate::app::DEFAULT_CONFIDENCE.get()),
+            value.unwrap_or(crate::uncertain::Confidence::DEFAULT.get()),
             0.5,
             0.999,
             0.001,

@@ -2,12 +2,12 @@
 //! before and after at the chosen confidence, and the findings to tell (outliers, parts,
 //! duplicated edges, a solve that did not converge).
 
+use crate::uncertain::Confidence;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::lie::{LieGroup, Tangent, TangentMatrix};
 use crate::plan::graph::PoseGraph;
-use crate::uncertain::chi2_radius;
 
 use super::{
     GraphReading, Iteration, Optimizer, Solution, SolverSettings, SparseError, Stop,
@@ -22,7 +22,7 @@ pub struct GraphSettings {
     /// g2o's or GTSAM's reading of the information matrices.
     pub reading: GraphReading,
     /// Probability inside the region a loop closure's residual is measured against.
-    pub confidence: f64,
+    pub confidence: Confidence,
 }
 
 impl Default for GraphSettings {
@@ -30,7 +30,7 @@ impl Default for GraphSettings {
         Self {
             optimizer: Optimizer::default(),
             reading: GraphReading::default(),
-            confidence: 0.95,
+            confidence: Confidence::DEFAULT,
         }
     }
 }
@@ -71,7 +71,7 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
     /// Every loop closure.
     pub loop_closures: Vec<LoopClosure<N>>,
     /// The confidence the residuals are measured at.
-    pub confidence: f64,
+    pub confidence: Confidence,
     /// √χ²_N(confidence): a residual beyond it is an outlier.
     pub radius: f64,
     /// Edges whose (from, to) pair appeared before: (line, line of the first).
@@ -144,7 +144,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         solution,
         loop_closures,
         confidence: settings.confidence,
-        radius: chi2_radius(settings.confidence, N).unwrap_or(f64::NAN),
+        radius: settings.confidence.radius(N),
         duplicates,
         edge_chi2,
     })

@@ -1,6 +1,7 @@
 //! A graph evaluation as plain records for `report --json` (`optimized`).
 
 use crate::lie::{LieGroup, TangentMatrix};
+use crate::uncertain::Confidence;
 
 use super::{GraphEvaluation, GraphReading, Iteration, Optimizer, Part, Stop};
 
@@ -70,7 +71,7 @@ pub struct OptimizedReport {
     /// Every loop closure.
     pub loop_closures: Vec<LoopClosureRecord>,
     /// The confidence of `radius`.
-    pub confidence: f64,
+    pub confidence: Confidence,
     /// χ² of each edge at the optimised poses, in file order.
     pub edge_chi2: Vec<f64>,
     /// Scalar unknowns.

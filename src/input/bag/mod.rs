@@ -21,15 +21,17 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::plan::bag::{
-    DrawnMessage, Health, Issue, IssueCount, LogSummary, PoseMessage, PoseMessageKind,
-    SeriesPoint, SkippedTopic, TopicPlan, is_odom_frame,
+    DrawnMessage, Health, Issue, IssueCount, LogSummary, PoseMessage, PoseMessageKind, SeriesPoint,
+    SkippedTopic, TopicPlan, is_odom_frame,
 };
 
 use super::format::{self, Format};
 use super::suggest;
 use super::{InputError, Located, Place};
+use decimate::Decimator;
 
 pub mod bundled;
+mod decimate;
 pub mod decode;
 pub mod health;
 mod mcap;
@@ -183,41 +185,6 @@ struct TopicState {
     drawn: Decimator<DrawnMessage>,
     trajectory: Decimator<(i64, [f64; 3])>,
     series: Decimator<SeriesPoint>,
-}
-
-/// Keeps items at indices that are multiples of `stride`; when more than `cap` are kept, the
-/// stride doubles and every other one is dropped. Memory stays bounded by `cap`.
-struct Decimator<T> {
-    items: Vec<(u64, T)>,
-    stride: u64,
-    cap: usize,
-}
-
-impl<T> Decimator<T> {
-    fn new(stride: u64, cap: usize) -> Self {
-        Self {
-            items: Vec::new(),
-            stride: stride.max(1),
-            cap: cap.max(1),
-        }
-    }
-    fn wants(&self, index: u64) -> bool {
-        index.is_multiple_of(self.stride)
-    }
-    fn push(&mut self, index: u64, item: T) {
-        if !self.wants(index) {
-            return;
-        }
-        self.items.push((index, item));
-        while self.items.len() > self.cap {
-            self.stride *= 2;
-            let stride = self.stride;
-            self.items.retain(|(i, _)| i.is_multiple_of(stride));
-        }
-    }
-    fn into_items(self) -> Vec<T> {
-        self.items.into_iter().map(|(_, t)| t).collect()
-    }
 }
 
 /// Receives every message of a log in file order.
@@ -409,7 +376,7 @@ impl<'a> Collector<'a> {
 
 /// Why a log has nothing to draw: the topics it has (type and count), its pose topics without
 /// messages, and the types posecov reads.
-fn no_pose_topic(plan: &BagPlan) -> String {
+fn no_pose_topic(plan: &LogSummary) -> String {
     const SHOWN: usize = 12;
     let mut has: Vec<String> = plan
         .skipped
@@ -561,7 +528,7 @@ impl TopicState {
     }
 
     fn into_plan(self, name: String) -> TopicPlan {
-        let stride = self.drawn.stride;
+        let stride = self.drawn.stride();
         let mut trajectory = self.trajectory.into_items();
         trajectory.sort_by_key(|p| p.0);
         let mut series = self.series.into_items();
@@ -626,18 +593,5 @@ mod tests {
         assert!(!plan.topics[0].planar);
         assert_eq!(plan.skipped[0].count, 0);
         // Evaluating and drawing it: tests/bag_mcap.rs (`a_topic_without_messages_is_drawn`).
-    }
-
-    #[test]
-    fn decimation_is_bounded_and_even() {
-        let mut d = Decimator::new(1, 200);
-        for i in 0..100_000u64 {
-            d.push(i, i);
-        }
-        let kept = d.into_items();
-        assert!(kept.len() <= 200 && kept.len() > 100, "{}", kept.len());
-        let stride = kept[1] - kept[0];
-        assert!(kept.windows(2).all(|w| w[1] - w[0] == stride));
-        assert_eq!(kept[0], 0);
     }
 }

@@ -163,7 +163,7 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
     let (right, up) = options.plane.names();
     let mut about = vec![format!("{right}–{up} plane")];
     if let Some(p) = scene.confidence {
-        about.insert(0, format!("regions at {} confidence", percent(p)));
+        about.insert(0, format!("regions at {} confidence", p));
     }
     let steps = scene.steps();
     match (options.steps, steps.first(), steps.last()) {
@@ -232,12 +232,6 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
         );
     }
     out.finish()
-}
-
-/// A probability as "95 %".
-fn percent(p: f64) -> String {
-    let text = format!("{:.2}", 100.0 * p);
-    format!("{} %", text.trim_end_matches('0').trim_end_matches('.'))
 }
 
 /// The items a figure draws: geometry only (no text), shown in some view and not hidden in
