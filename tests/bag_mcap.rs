@@ -432,31 +432,65 @@ fn a_falsified_chunk_size_ends_with_an_error() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A declared topic without messages is listed, evaluated and drawn: a scene that validates
-/// and says "0 messages" (the stages after reading, through the public API).
+/// A declared topic without messages beside one with messages is listed, evaluated and
+/// drawn: a scene that validates and says "0 messages" (the stages after reading, through
+/// the public API). Alone, it is no pose topic to draw: an error naming it.
 #[test]
 fn a_topic_without_messages_is_drawn() {
     use posecov::draw::bag::{BagDrawSettings, bag_scene, description};
     use posecov::eval::bag::evaluate_bag;
     use posecov::input::{About, Format};
     use posecov::uncertain::Confidence;
-    let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
-    let schema = w
-        .add_schema(
-            "geometry_msgs/msg/PoseWithCovarianceStamped",
-            "ros2msg",
-            b"",
-        )
-        .unwrap();
-    w.add_channel(schema, "/empty", "cdr", &BTreeMap::new())
-        .unwrap();
-    w.finish().unwrap();
-    let plan = read(&w.into_inner().into_inner(), &BagOptions::default());
-    assert_eq!(plan.topics.len(), 1);
-    assert_eq!(
-        (plan.topics[0].name.as_str(), plan.topics[0].count),
-        ("/empty", 0)
+    let log = |with_messages: bool| {
+        let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
+        let schema = w
+            .add_schema(
+                "geometry_msgs/msg/PoseWithCovarianceStamped",
+                "ros2msg",
+                b"",
+            )
+            .unwrap();
+        w.add_channel(schema, "/empty", "cdr", &BTreeMap::new())
+            .unwrap();
+        if with_messages {
+            let full = w
+                .add_channel(schema, "/amcl_pose", "cdr", &BTreeMap::new())
+                .unwrap();
+            let msg = PoseWithCovarianceStamped {
+                header: header(5, 0, "map"),
+                pose: PoseWithCovariance {
+                    pose: Pose {
+                        position: [1.0, 2.0, 0.0],
+                        orientation: [0.0, 0.0, 0.0, 1.0],
+                    },
+                    covariance: nested(&full_cov(0)),
+                },
+            };
+            let header = mcap::records::MessageHeader {
+                channel_id: full,
+                sequence: 1,
+                log_time: 5_000_000_000,
+                publish_time: 5_000_000_000,
+            };
+            w.write_to_known_channel(&header, &cdr(&msg)).unwrap();
+        }
+        w.finish().unwrap();
+        w.into_inner().into_inner()
+    };
+    let path = std::env::temp_dir().join(format!("posecov-mcap-empty-{}.mcap", std::process::id()));
+    std::fs::write(&path, log(false)).unwrap();
+    let err = read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None)
+        .unwrap_err()
+        .to_string();
+    std::fs::remove_file(&path).ok();
+    assert!(
+        err.contains("pose topics without messages: /empty"),
+        "{err}"
     );
+    let plan = read(&log(true), &BagOptions::default());
+    assert_eq!(plan.topics.len(), 2);
+    let empty = plan.topics.iter().find(|t| t.name == "/empty").unwrap();
+    assert_eq!(empty.count, 0);
     let e = evaluate_bag(&plan, &Default::default());
     let text = description(&plan, Format::Mcap, &e, Confidence::DEFAULT);
     assert!(text.contains("0 messages"), "{text}");

@@ -33,9 +33,10 @@ pub(super) fn finding_text(f: &Finding) -> Option<String> {
             for i in log {
                 let _ = write!(
                     s,
-                    " #{} χ² {:.4e}{}{};",
+                    " #{} χ² {}{}{};",
                     i.iteration,
-                    i.chi2,
+                    i.chi2
+                        .map_or("not finite (no step)".to_owned(), |c| format!("{c:.4e}")),
                     i.lambda.map_or(String::new(), |l| format!(" λ {l:.0e}")),
                     if i.accepted { "" } else { " (rejected)" }
                 );

@@ -73,8 +73,8 @@ impl Consistency {
     ///
     /// ```
     /// use posecov::eval::Consistency;
-    /// use posecov::uncertain::{Coverage, Region};
-    /// let c = Consistency { samples: 10, confidence: 0.95, anees: None,
+    /// use posecov::uncertain::{Confidence, Coverage, Region};
+    /// let c = Consistency { samples: 10, confidence: Confidence::DEFAULT, anees: None,
     ///     coverage: vec![Coverage::from_counts(Region::Cartesian, 2, 7, 10)] };
     /// assert_eq!(c.region(Region::Cartesian).unwrap().inside, 0.7);
     /// assert!(c.region(Region::Tangent).is_none());

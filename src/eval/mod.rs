@@ -285,7 +285,7 @@ pub fn evaluate(plan: &AnyPlan, settings: &EvalSettings) -> Result<AnyEvaluation
 /// let plan = lower(&Scenario::load_any("so3_sampling").unwrap()).unwrap().plan;
 /// let settings = EvalSettings { samples: 5000, block_samples: Some(2048), methods: vec![Method::MonteCarlo], ..Default::default() };
 /// let main = evaluate(&plan, &settings).unwrap();
-/// assert_eq!(main.run().2, 2048);
+/// assert_eq!(main.ran_with().block_samples, 2048);
 /// assert!(evaluate_block(&plan, &settings, &main, 2).unwrap().is_some()); // samples 4096..5000
 /// assert!(evaluate_block(&plan, &settings, &main, 3).unwrap().is_none());
 /// ```

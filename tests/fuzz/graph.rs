@@ -195,6 +195,10 @@ fn judge(text: &str, run: Run<Result<Output, String>>, limits: &Limits) -> Vec<F
                 "anees",
                 "anees_dof",
                 "anees_band",
+                // No marginal: a vertex held fixed, one not connected, or marginals that
+                // failed (then a finding says why).
+                ".optimized.poses[#].covariance",
+                ".optimized.loop_closures[#].relative_covariance",
             ];
             if let Some(path) = json_null(&out.json, &optional) {
                 found.push(finding("nonfinite_json", format!("null at {path}")));

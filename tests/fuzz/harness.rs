@@ -336,12 +336,38 @@ pub fn json_null(v: &serde_json::Value, optional: &[&str]) -> Option<String> {
             serde_json::Value::Object(o) => stack.extend(
                 o.iter()
                     .filter(|(k, _)| !optional.contains(&k.as_str()))
-                    .map(|(k, x)| (format!("{path}.{k}"), x)),
+                    .map(|(k, x)| (format!("{path}.{k}"), x))
+                    // A whole path (indices as `[#]`) may be null by design; its value is
+                    // still checked when it is not.
+                    .filter(|(p, x)| {
+                        !(x.is_null() && optional.contains(&indices_hidden(p).as_str()))
+                    }),
             ),
             _ => {}
         }
     }
     None
+}
+
+/// A JSON path with its array indices written `[#]`: `.a[3].b` → `.a[#].b`.
+fn indices_hidden(path: &str) -> String {
+    let mut out = String::with_capacity(path.len());
+    let mut in_index = false;
+    for c in path.chars() {
+        match c {
+            '[' => {
+                in_index = true;
+                out.push_str("[#");
+            }
+            ']' => {
+                in_index = false;
+                out.push(']');
+            }
+            _ if in_index => {}
+            _ => out.push(c),
+        }
+    }
+    out
 }
 
 /// Results compared with a Monte Carlo run of the same label whose relative error is `null`

@@ -134,12 +134,15 @@ impl SolverSettings {
 pub struct Iteration {
     /// The outer iteration (1-based).
     pub iteration: usize,
-    /// χ² after the step (∞ when the damped system could not be factored).
-    pub chi2: f64,
+    /// χ² after the step (absent when the damped system could not be factored, or the step
+    /// overflowed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub chi2: Option<f64>,
     /// LM's λ for this try.
     pub lambda: Option<f64>,
-    /// ‖δ‖ (NaN when there was no step).
-    pub step_norm: f64,
+    /// ‖δ‖ (absent when there was no step).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub step_norm: Option<f64>,
     /// Whether the step was kept.
     pub accepted: bool,
 }

@@ -197,16 +197,16 @@ pub(super) fn run<G: LieGroup<N>, const N: usize>(
                         let candidate = problem.retract(&poses, delta);
                         let new_chi2 = problem.chi2(&candidate);
                         let norm = delta.iter().map(|v| v * v).sum::<f64>().sqrt();
-                        (Some(candidate), new_chi2, norm)
+                        (Some(candidate), new_chi2, Some(norm))
                     }
-                    None => (None, f64::INFINITY, f64::NAN),
+                    None => (None, f64::INFINITY, None),
                 };
                 let accepted = new_chi2.is_finite() && new_chi2 <= chi2;
                 let entry = Iteration {
                     iteration,
-                    chi2: new_chi2,
+                    chi2: Some(new_chi2).filter(|c| c.is_finite()),
                     lambda: lm.then_some(lambda),
-                    step_norm: norm,
+                    step_norm: norm.filter(|n| n.is_finite()),
                     accepted,
                 };
                 progress(&entry);
