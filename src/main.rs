@@ -228,6 +228,9 @@ impl EvalArgs {
 struct ViewArgs {
     #[command(flatten)]
     scenario: ScenarioArgs,
+    /// Further inputs: refused in a sentence (the viewer shows one input at a time).
+    #[arg(hide = true, value_name = "MORE")]
+    more: Vec<String>,
     #[command(flatten)]
     sink: SinkArgs,
     #[command(flatten)]
@@ -336,6 +339,34 @@ impl LiveArgs {
 }
 
 impl ViewArgs {
+    /// The default command shows one input. Further words are refused in a sentence (clap
+    /// would say "unexpected argument"), naming the command meant when the first word is a
+    /// near miss of one (`posecov lve x.toml`).
+    fn one_input(&self) -> anyhow::Result<()> {
+        if self.more.is_empty() {
+            return Ok(());
+        }
+        let first = self.scenario.scenario();
+        let cli = <Cli as clap::CommandFactory>::command();
+        let commands = cli.get_subcommands().map(clap::Command::get_name);
+        if let Some(command) = posecov::input::suggest::nearest(first, commands) {
+            anyhow::bail!(
+                "`{first}` is not a command; did you mean `posecov {command} {}`?",
+                self.more.join(" ")
+            );
+        }
+        let inputs: Vec<String> = std::iter::once(first)
+            .chain(self.more.iter().map(String::as_str))
+            .map(|i| format!("`{i}`"))
+            .collect();
+        anyhow::bail!(
+            "posecov shows one input at a time, and was given {}: {}. Show each with its own \
+             `posecov FILE`; `posecov report FILE --json` prints the numbers of one.",
+            inputs.len(),
+            inputs.join(", ")
+        )
+    }
+
     fn options(&self) -> ViewOptions {
         let sink = &self.sink;
         let serve = self.serve.options();
@@ -389,14 +420,31 @@ fn main() -> ExitCode {
 }
 
 fn try_main() -> anyhow::Result<ExitCode> {
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| {
+        // `report --json` answers a usage error in JSON on stdout too.
+        let args: Vec<String> = std::env::args().skip(1).collect();
+        let report_json =
+            args.first().is_some_and(|a| a == "report") && args.iter().any(|a| a == "--json");
+        if e.use_stderr() && report_json {
+            let json = posecov::app::usage_error_json(&e.render().to_string(), EXIT_CANNOT);
+            let _ = write_out(&format!("{json}\n"));
+        }
+        e.exit()
+    });
     match cli.command {
         Some(Command::List) => emit(&commands::list()?),
-        Some(Command::Report { scenario, json }) => emit(&commands::report(
-            scenario.scenario(),
-            &scenario.overrides(),
-            json,
-        )?),
+        Some(Command::Report { scenario, json }) => {
+            match commands::report(scenario.scenario(), &scenario.overrides(), json) {
+                Ok(text) => emit(&text),
+                Err(err) => {
+                    // Scripts reading `--json` get the error as JSON too; people get stderr.
+                    if json {
+                        write_out(&format!("{}\n", err.to_json()))?;
+                    }
+                    Err(err.into())
+                }
+            }
+        }
         Some(Command::Check { scenario, allow }) => {
             let allow = commands::allowed(&allow)?;
             let checked = commands::check(scenario.scenario(), &scenario.overrides(), &allow)?;
@@ -427,6 +475,7 @@ fn try_main() -> anyhow::Result<ExitCode> {
             Ok(ExitCode::from(live::live(&args.options(), &cancel)?))
         }
         None => {
+            cli.view.one_input()?;
             let cancel = install_ctrl_c()?;
             Ok(ExitCode::from(view(&cli.view.options(), &cancel)?))
         }

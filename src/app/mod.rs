@@ -107,6 +107,82 @@ impl AppError {
             _ => EXIT_CANNOT,
         }
     }
+
+    /// What `report --json` prints on stdout when the report fails (the text still goes to
+    /// stderr): one object `{"error": {…}}` with the `message`, the whole `text` as stderr
+    /// shows it, the `exit_code`, and where known the `file`, `line`, `column` (1-based),
+    /// `key` (the field in the file's words) or `place` (inside a binary log).
+    ///
+    /// ```
+    /// use posecov::app::load_text;
+    /// let text = "[scenario]\ntitle = \"t\"\ngroup = \"se2\"\nsamples = 1\n";
+    /// let json = load_text(text, "t.toml").unwrap_err().to_json();
+    /// assert_eq!(json["error"]["file"], "t.toml");
+    /// assert_eq!((&json["error"]["line"], &json["error"]["column"]), (&4.into(), &11.into()));
+    /// assert_eq!(json["error"]["key"], "scenario.samples");
+    /// assert_eq!(json["error"]["exit_code"], 1);
+    /// ```
+    pub fn to_json(&self) -> serde_json::Value {
+        let mut error = serde_json::Map::new();
+        let mut put = |key: &str, value: serde_json::Value| {
+            error.insert(key.to_owned(), value);
+        };
+        let message = match self {
+            AppError::Input(InputError::Read { path, reason }) => {
+                put("file", path.as_str().into());
+                reason.clone()
+            }
+            AppError::Input(InputError::Format { file, message }) => {
+                put("file", file.as_str().into());
+                message.clone()
+            }
+            AppError::Input(InputError::In {
+                file,
+                place,
+                message,
+            }) => {
+                put("file", file.as_str().into());
+                put("place", place.as_str().into());
+                message.clone()
+            }
+            AppError::Input(InputError::At {
+                file,
+                line,
+                column,
+                field,
+                message,
+                ..
+            }) => {
+                put("file", file.as_str().into());
+                put("line", (*line).into());
+                put("column", (*column).into());
+                put("key", field.as_str().into());
+                message.clone()
+            }
+            other => other.to_string(),
+        };
+        put("message", message.into());
+        put("text", self.to_string().into());
+        put("exit_code", self.exit_code().into());
+        serde_json::json!({ "error": error })
+    }
+}
+
+/// The object of [`AppError::to_json`] for an error found before any input was read (a
+/// command-line usage error): only its `message`, `text` and `exit_code`.
+///
+/// ```
+/// let json = posecov::app::usage_error_json("--confidence 95: did you mean 0.95?", 2);
+/// assert_eq!(json["error"]["exit_code"], 2);
+/// assert!(json["error"].get("file").is_none());
+/// ```
+pub fn usage_error_json(text: &str, exit_code: u8) -> serde_json::Value {
+    let message = text.trim().trim_start_matches("error: ");
+    serde_json::json!({ "error": {
+        "message": message.lines().next().unwrap_or_default(),
+        "text": text.trim(),
+        "exit_code": exit_code,
+    } })
 }
 
 /// An input and the file it came from (to locate evaluation errors in it), of any format.

@@ -17,15 +17,14 @@
 use nalgebra::{Matrix2, Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
 
 use super::shapes::{self, AXIS_COLORS, ellipsoid_of};
-use super::{DrawSettings, Painter, v3, views};
+use super::{Painter, v3, views};
 use crate::eval::bag::{BagEvaluation, PoseState, RvizNumbers, TopicEvaluation};
-use crate::input::{About, DrawChoices, Layout};
+use crate::input::{About, Layout};
 use crate::lie::{GroupKind, LieGroup, Se3};
-use crate::plan::StepPolicy;
 use crate::scene::WORLD;
 use crate::scene::{
     Color, Ellipsoid, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, Plot, PointCloud,
-    ScalarSeries, Scene, SceneItem, Swatch, Timeline, Timing, Vec3,
+    ScalarSeries, Scene, Swatch, Timeline, Timing, Vec3,
 };
 use crate::uncertain::{Confidence, Method};
 
@@ -74,16 +73,10 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
     let axis_length = settings
         .axis_length
         .unwrap_or((0.08 * extent).clamp(0.05, 2.0));
-    let draw = DrawSettings {
-        about: settings.about.clone(),
-        confidence: settings.confidence,
-        choices: DrawChoices::default(),
-        steps: StepPolicy::default(),
-    };
     let planar = !e.topics.is_empty() && e.topics.iter().all(|t| t.planar);
     let mut p = Painter {
         scene: Scene::new(settings.about.title.clone(), summary.to_owned()),
-        settings: &draw,
+        confidence: settings.confidence,
         kind: if planar {
             GroupKind::Se2
         } else {
@@ -157,19 +150,6 @@ fn extent(e: &BagEvaluation) -> f64 {
     super::extent_of(&points)
 }
 
-/// Pushes items made by a shape helper (which logs on steps) at a stamp instead.
-fn at_stamp(p: &mut Painter, ns: i64, draw: impl FnOnce(&mut Painter)) {
-    let start = p.scene.items.len();
-    draw(p);
-    for item in &mut p.scene.items[start..] {
-        item.timing = Timing::Stamp(ns);
-    }
-}
-
-fn put(p: &mut Painter, path: String, timing: Timing, kind: ItemKind) {
-    p.scene.push(SceneItem::new(path, timing, kind));
-}
-
 fn flat(planar: bool, v: &Vector3<f64>) -> Vec3 {
     if planar { [v.x, v.y, 0.0] } else { v3(v) }
 }
@@ -185,8 +165,7 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
         .collect();
     if !strip.is_empty() {
         p.legend(format!("{}: trajectory", t.name), color, Swatch::Line);
-        put(
-            p,
+        p.place(
             format!("{base}/trajectory"),
             Timing::Static,
             ItemKind::LineStrips(LineStrips {
@@ -214,8 +193,7 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
                 UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z))
             }
         };
-        put(
-            p,
+        p.place(
             format!("{base}/pose"),
             at,
             ItemKind::Frame(Frame {
@@ -244,24 +222,20 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
         }
         match &pose.state {
             PoseState::Planar { pose: g, cloud } => {
-                at_stamp(p, pose.stamp_ns, |p| {
-                    shapes::banana(p, &format!("{base}/meaning"), None, g, MEANING, |x| {
-                        x.to_se3().translation().to_owned()
-                    });
-                    shapes::position_ellipsoid(p, &format!("{base}/meaning"), None, g, MEANING);
+                let meaning = format!("{base}/meaning");
+                p.region_banana(&meaning, at, g, MEANING, |x| {
+                    x.to_se3().translation().to_owned()
                 });
+                p.region_ellipsoid(&meaning, at, g, MEANING);
                 let points = cloud.iter().map(|x| v3(x.to_se3().translation())).collect();
                 cloud_item(p, &base, at, points);
                 sprays(p, &base, at, &[]);
                 clear_invalid(p, &base, at);
             }
             PoseState::Spatial { pose: g, cloud } => {
-                at_stamp(p, pose.stamp_ns, |p| {
-                    shapes::banana(p, &format!("{base}/meaning"), None, g, MEANING, |x| {
-                        *x.translation()
-                    });
-                    shapes::position_ellipsoid(p, &format!("{base}/meaning"), None, g, MEANING);
-                });
+                let meaning = format!("{base}/meaning");
+                p.region_banana(&meaning, at, g, MEANING, |x| *x.translation());
+                p.region_ellipsoid(&meaning, at, g, MEANING);
                 let points = cloud.iter().map(|x| v3(x.translation())).collect();
                 cloud_item(p, &base, at, points);
                 sprays(p, &base, at, cloud);
@@ -302,8 +276,7 @@ fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
         MEANING,
         Swatch::Line,
     );
-    put(
-        p,
+    p.place(
         format!("{base}/history/rviz"),
         Timing::Static,
         ItemKind::Ellipsoids(Ellipsoids {
@@ -314,39 +287,22 @@ fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
             label: None,
         }),
     );
-    let start = p.scene.items.len();
-    for q in &t.poses {
-        match &q.state {
-            PoseState::Planar { pose, .. } => shapes::outlines(
-                p,
-                &format!("{base}/history/meaning"),
-                None,
-                pose,
-                MEANING,
-                |x| x.to_se3().translation().to_owned(),
-            ),
-            PoseState::Spatial { pose, .. } => shapes::outlines(
-                p,
-                &format!("{base}/history/meaning"),
-                None,
-                pose,
-                MEANING,
-                |x| *x.translation(),
-            ),
-            PoseState::Invalid { .. } => {}
-        }
-    }
     // One static item with every outline, faint.
-    let outlines: Vec<SceneItem> = p.scene.items.drain(start..).collect();
-    let strips: Vec<Vec<Vec3>> = outlines
-        .into_iter()
-        .flat_map(|i| match i.kind {
-            ItemKind::LineStrips(l) => l.strips,
-            _ => Vec::new(),
+    let confidence = p.confidence();
+    let strips: Vec<Vec<Vec3>> = t
+        .poses
+        .iter()
+        .flat_map(|q| match &q.state {
+            PoseState::Planar { pose, .. } => {
+                shapes::outline_strips(pose, confidence, |x| x.to_se3().translation().to_owned())
+            }
+            PoseState::Spatial { pose, .. } => {
+                shapes::outline_strips(pose, confidence, |x| *x.translation())
+            }
+            PoseState::Invalid { .. } => Vec::new(),
         })
         .collect();
-    put(
-        p,
+    p.place(
         format!("{base}/history/meaning"),
         Timing::Static,
         ItemKind::LineStrips(LineStrips {
@@ -396,8 +352,7 @@ fn rviz_picture(
 ) {
     let center = Vector3::from(origin);
     let (shape, _) = rviz_position(rviz, &center, r_pos, p.extent, planar);
-    put(
-        p,
+    p.place(
         format!("{base}/rviz/position"),
         at,
         ItemKind::Ellipsoids(Ellipsoids {
@@ -420,8 +375,7 @@ fn rviz_picture(
         let mut fan = vec![origin];
         fan.extend(arc);
         fan.push(origin);
-        put(
-            p,
+        p.place(
             format!("{base}/rviz/orientation"),
             at,
             ItemKind::LineStrips(LineStrips {
@@ -456,8 +410,7 @@ fn rviz_picture(
         let q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(frame));
         let h = [spread(eig.eigenvalues[0]), spread(eig.eigenvalues[1])];
         let thin = 0.01 * h[0].max(h[1]).max(1e-6);
-        put(
-            p,
+        p.place(
             format!("{base}/rviz/orientation_{}", ["x", "y", "z"][axis]),
             at,
             ItemKind::Ellipsoids(Ellipsoids {
@@ -483,8 +436,7 @@ fn cloud_item(p: &mut Painter, base: &str, at: Timing, positions: Vec<Vec3>) {
             Swatch::Dots,
         );
     }
-    put(
-        p,
+    p.place(
         format!("{base}/meaning/cloud"),
         at,
         ItemKind::Points(PointCloud {
@@ -506,8 +458,7 @@ fn sprays(p: &mut Painter, base: &str, at: Timing, cloud: &[Se3]) {
             .iter()
             .map(|x| v3(&(x.translation() + l * x.rotation().to_matrix().column(axis))))
             .collect();
-        put(
-            p,
+        p.place(
             format!("{base}/meaning/spray_{name}"),
             at,
             ItemKind::Points(PointCloud {
@@ -528,8 +479,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
     );
     let s = 0.5 * p.axis_length;
     let [x, y, z] = origin;
-    put(
-        p,
+    p.place(
         format!("{base}/invalid"),
         at,
         ItemKind::LineStrips(LineStrips {
@@ -548,14 +498,8 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
             radius: 0.001,
         })
     };
-    put(
-        p,
-        format!("{base}/meaning/banana_outline"),
-        at,
-        empty_strips(),
-    );
-    put(
-        p,
+    p.place(format!("{base}/meaning/banana_outline"), at, empty_strips());
+    p.place(
         format!("{base}/meaning/ellipsoid"),
         at,
         ItemKind::Ellipsoids(Ellipsoids {
@@ -566,8 +510,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
             label: None,
         }),
     );
-    put(
-        p,
+    p.place(
         format!("{base}/meaning/banana"),
         at,
         ItemKind::Surface(crate::scene::Surface {
@@ -582,8 +525,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
 }
 
 fn clear_invalid(p: &mut Painter, base: &str, at: Timing) {
-    put(
-        p,
+    p.place(
         format!("{base}/invalid"),
         at,
         ItemKind::LineStrips(LineStrips {

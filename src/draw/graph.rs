@@ -9,8 +9,8 @@ use crate::eval::Finding;
 use crate::eval::graph::{Anchor, GraphEvaluation, Optimizer, Part, Stop};
 use crate::lie::LieGroup;
 use crate::scene::{
-    self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, QuatXyzw, Triads, Vec3,
-    WORLD,
+    self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, QuatXyzw, Timing,
+    Triads, Vec3, WORLD,
 };
 use crate::uncertain::{Side, UncertainPose};
 
@@ -250,10 +250,9 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     banana_poses.retain(|k| seen.insert(*k));
     for &k in banana_poses.iter().take(MAX_BANANAS) {
         if let Some(pose) = uncertain(k) {
-            shapes::banana(
-                p,
+            p.region_banana(
                 &format!("{WORLD}/{AFTER}/bananas/v{}", g.ids[k]),
-                None,
+                Timing::Static,
                 &pose,
                 OPTIMIZED,
                 |x: &G| x.to_se3().translation().to_owned(),

@@ -38,7 +38,7 @@ use crate::plan::StepPolicy;
 use crate::scene::WORLD;
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, Scene,
-    SceneItem, Swatch, Timing, Triads, Vec3,
+    Swatch, Triads, Vec3,
 };
 use crate::uncertain::{Confidence, Method};
 
@@ -46,7 +46,9 @@ pub mod bag;
 mod graph;
 mod legend;
 mod node;
+mod painter;
 use node::{draw_node, draw_particles};
+use painter::{Painter, at_step, detailed};
 mod plots;
 mod shapes;
 mod text;
@@ -135,15 +137,19 @@ fn part_of<G: LieGroup<N>, const N: usize>(
     settings: &DrawSettings,
 ) -> Scene {
     // A part is logged after the main scene: its items only, no description.
-    let mut p = Painter::new(main, settings, String::new());
+    let mut p = Painter::for_plan(main, settings, String::new());
     let shown = Shown::new(main, &settings.choices);
     for node in block
         .nodes
         .iter()
         .filter(|n| n.role != Role::Fixed && shown.node(n))
     {
-        if let Some(particles) = node.particles.as_ref().filter(|_| p.detailed(node)) {
-            draw_particles(&mut p, node, particles, Some(part));
+        if let Some(particles) = node
+            .particles
+            .as_ref()
+            .filter(|_| detailed(&settings.steps, node))
+        {
+            draw_particles(&mut p, node, particles, Some(part), &settings.choices);
         }
     }
     if settings.choices.clouds {
@@ -206,70 +212,8 @@ fn parent_frame(name: &str) -> Option<&str> {
     name.split_once("_from_").map(|(parent, _)| parent)
 }
 
-/// Context shared by the drawing helpers of one scene.
-struct Painter<'s> {
-    scene: Scene,
-    settings: &'s DrawSettings,
-    kind: GroupKind,
-    axis_length: f64,
-    /// Size of the drawing, metres ([`scene_extent`]).
-    extent: f64,
-    /// How the 3-D views split methods and poses (decided before drawing: one view per method
-    /// draws every method's banana as a surface).
-    layout: Layout,
-    /// Per drawn uncertain pose, the methods drawn for it (for the views).
-    methods: Vec<(String, views::PoseMethods)>,
-}
-
-impl<'s> Painter<'s> {
-    fn new<G: LieGroup<N>, const N: usize>(
-        e: &Evaluation<G, N>,
-        settings: &'s DrawSettings,
-        description: String,
-    ) -> Self {
-        let extent = scene_extent(e);
-        let axis_length = settings
-            .choices
-            .axis_length
-            .unwrap_or(if G::KIND.is_rotation_only() {
-                1.0
-            } else {
-                (0.12 * extent).clamp(0.05, 2.0)
-            });
-        Painter {
-            scene: Scene::new(settings.about.title.clone(), description),
-            settings,
-            kind: G::KIND,
-            axis_length,
-            extent,
-            methods: Vec::new(),
-            layout: settings.choices.layout.unwrap_or(Layout::Main),
-        }
-    }
-
-    fn confidence(&self) -> Confidence {
-        self.settings.confidence
-    }
-
-    /// Adds a legend entry (once per label and colour).
-    fn legend(&mut self, label: String, color: Color, swatch: Swatch) {
-        self.scene.add_legend(legend::entry(label, color, swatch));
-    }
-
-    /// Whether a node's step is drawn in full (clouds, surfaces), not only its ellipsoid.
-    fn detailed<G: LieGroup<N>, const N: usize>(&self, node: &Node<G, N>) -> bool {
-        node.step
-            .is_none_or(|k| self.settings.steps.detailed(k, node.last_step.unwrap_or(k)))
-    }
-
-    fn push(&mut self, path: String, step: Option<u64>, kind: ItemKind) {
-        let timing = step.map_or(Timing::Static, |k| Timing::Step(k as i64));
-        self.scene.push(SceneItem::new(path, timing, kind));
-    }
-}
-
 fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSettings) -> Scene {
-    let mut p = Painter::new(e, settings, text::description(e, settings));
+    let mut p = Painter::for_plan(e, settings, text::description(e, settings));
     p.scene.confidence = Some(settings.confidence);
     let choices = &settings.choices;
     p.scene.planar = choices.top_view.unwrap_or(G::KIND.is_planar());
@@ -295,7 +239,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         p.layout = views::default_layout(G::KIND.is_rotation_only(), names.len(), most_methods);
     }
     for node in e.nodes.iter().filter(|n| shown.node(n)) {
-        draw_node(&mut p, node);
+        draw_node(&mut p, node, settings);
     }
     if choices.trajectories {
         let radius = 0.004 * p.extent.max(0.25);
@@ -329,7 +273,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
             );
         }
     }
-    links(&mut p, e);
+    links(&mut p, e, &choices.links);
     if let Some(g) = &e.graph {
         graph::draw_optimized(&mut p, g);
     }
@@ -423,17 +367,18 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
 
 /// The lines the input asks for between two poses (a graph's loop closures), at
 /// `world/links`, between the poses' nominal positions.
-fn links<G: LieGroup<N>, const N: usize>(p: &mut Painter, e: &Evaluation<G, N>) {
+fn links<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    e: &Evaluation<G, N>,
+    links: &[(String, String)],
+) {
     let position = |name: &str| {
         e.nodes
             .iter()
             .find(|n| n.name == name)
             .map(|n| v3(n.nominal.to_se3().translation()))
     };
-    let strips: Vec<Vec<Vec3>> = p
-        .settings
-        .choices
-        .links
+    let strips: Vec<Vec<Vec3>> = links
         .iter()
         .filter_map(|(a, b)| Some(vec![position(a)?, position(b)?]))
         .collect();

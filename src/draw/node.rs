@@ -6,8 +6,12 @@ use super::*;
 /// Colour of the Monte Carlo heading arrows of planar poses (light red).
 const HEADING_COLOR: Color = Color::rgb(255, 120, 120);
 
-pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>) {
-    let choices = &p.settings.choices;
+pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    node: &Node<G, N>,
+    settings: &DrawSettings,
+) {
+    let choices = &settings.choices;
     let (axes, ellipsoids, bananas, orientation) = (
         choices.axes,
         choices.ellipsoids,
@@ -33,7 +37,8 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &
     }
     let rotation_only = p.kind.is_rotation_only();
     let primary = primary_method(node);
-    if !p.detailed(node) {
+    let timing = at_step(node.step);
+    if !detailed(&settings.steps, node) {
         // Between detailed steps only the (light) frame and the primary ellipsoid are logged,
         // so the step slider still shows the growth.
         if let Some(e) = node
@@ -45,10 +50,9 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &
         {
             let who = e.result.method.label().to_owned();
             cartesian_legend(p, who, e.result.method);
-            shapes::position_ellipsoid(
-                p,
+            p.region_ellipsoid(
                 &format!("{WORLD}/{}/{}", node.name, e.result.method.slug()),
-                node.step,
+                timing,
                 &e.result.pose,
                 e.result.method.color(),
             );
@@ -103,7 +107,7 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &
                 let centre = v3(pose.mean().to_se3().translation());
                 cartesian.push((method, who.clone(), centre, cov));
             }
-            shapes::position_ellipsoid(p, &base, node.step, &pose, color);
+            p.region_ellipsoid(&base, timing, &pose, color);
         }
         let region = p.confidence().to_string();
         if bananas && !rotation_only && method != Method::VectorSpace {
@@ -114,17 +118,16 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &
                     color,
                     Swatch::Region,
                 );
-                shapes::banana(p, &base, node.step, &pose, color, point_of);
+                p.region_banana(&base, timing, &pose, color, point_of);
             } else {
                 p.legend(
                     format!("{who}: Exp-mapped {region} region, principal outlines"),
                     color,
                     Swatch::Line,
                 );
-                shapes::outlines(
-                    p,
+                p.region_outlines(
                     &format!("{base}/banana_outline"),
-                    node.step,
+                    timing,
                     &pose,
                     color,
                     point_of,
@@ -140,7 +143,7 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &
             for (k, axis) in ["axis_x", "axis_y", "axis_z"].iter().enumerate() {
                 let len = p.axis_length;
                 let path = format!("{base}/{axis}");
-                shapes::outlines(p, &path, node.step, &pose, color, move |x| {
+                p.region_outlines(&path, timing, &pose, color, move |x| {
                     let s = x.to_se3();
                     s.translation() + s.rotation().act(&(Vector3::ith(k, 1.0) * len))
                 });
@@ -149,7 +152,7 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &
     }
     coinciding(p, &node.name, &cartesian);
     if let Some(particles) = &node.particles {
-        draw_particles(p, node, particles, None);
+        draw_particles(p, node, particles, None, choices);
     }
 }
 
@@ -208,8 +211,8 @@ pub(super) fn draw_particles<G: LieGroup<N>, const N: usize>(
     node: &Node<G, N>,
     particles: &[G],
     part: Option<usize>,
+    choices: &DrawChoices,
 ) {
-    let choices = p.settings.choices.clone();
     let base = format!("{WORLD}/{}/monte_carlo", node.name);
     // Later blocks of a blocked sample: their points only, as children of the first block's.
     let suffix = part.map_or_else(String::new, |k| format!("/block_{k}"));

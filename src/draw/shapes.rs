@@ -1,13 +1,11 @@
-//! The shapes of uncertainty: Cartesian ellipsoids, Exp-mapped banana surfaces and their
-//! principal outlines.
+//! The shapes of uncertainty as geometry (the caller places them): Cartesian ellipsoids,
+//! Exp-mapped banana surfaces and their principal outlines.
 
 use nalgebra::{DMatrix, Matrix3, Rotation3, SymmetricEigen, UnitQuaternion, Vector3};
 
-use super::{Painter, v3};
+use super::v3;
 use crate::lie::{LieGroup, Tangent, TangentMatrix};
-use crate::scene::{
-    self, Color, Ellipsoid, Ellipsoids, FillMode, ItemKind, LineStrips, Surface, Vec3,
-};
+use crate::scene::{self, Ellipsoid, Vec3};
 use crate::uncertain::{Confidence, UncertainPose};
 
 /// Sphere-mesh resolution of banana surfaces (latitude bands, meridians).
@@ -44,35 +42,20 @@ pub(super) fn ellipsoid_of(center: &Vector3<f64>, cov: &Matrix3<f64>, radius: f6
     }
 }
 
-/// The world-frame Cartesian position region of a pose's first-order Gaussian, d = 2 for
-/// planar groups and 3 otherwise, at `base/ellipsoid`.
-pub(super) fn position_ellipsoid<G: LieGroup<N>, const N: usize>(
-    p: &mut Painter,
-    base: &str,
-    step: Option<u64>,
+/// The world-frame Cartesian position region of a pose's first-order Gaussian at
+/// `confidence`: half sizes √χ²_d(p)·√λ along the eigenvectors of the world-frame position
+/// covariance, d = 2 for planar groups and 3 otherwise; `None` for a rotation-only pose.
+pub(super) fn position_region<G: LieGroup<N>, const N: usize>(
     pose: &UncertainPose<G, N>,
-    color: Color,
-) {
-    let Some(cov) = pose.position_cov_in_world_3d() else {
-        return;
-    };
+    confidence: Confidence,
+) -> Option<Ellipsoid> {
+    let cov = pose.position_cov_in_world_3d()?;
     let d = G::KIND.position_dims().max(1);
-    let shape = ellipsoid_of(
+    Some(ellipsoid_of(
         pose.mean().to_se3().translation(),
         &cov,
-        p.confidence().radius(d),
-    );
-    p.push(
-        format!("{base}/ellipsoid"),
-        step,
-        ItemKind::Ellipsoids(Ellipsoids {
-            shapes: vec![shape],
-            color,
-            fill: FillMode::MajorWireframe,
-            line_radius: 0.002 * p.axis_length / 0.15,
-            label: None,
-        }),
-    );
+        confidence.radius(d),
+    ))
 }
 
 /// Principal axes of a symmetric matrix: (eigenvalues ≥ 0, eigenvectors), sorted by
@@ -122,50 +105,32 @@ impl<const N: usize> PrincipalFrame<N> {
     }
 }
 
-/// The Exp-image surface and its principal outlines.
-pub(super) fn banana<G: LieGroup<N>, const N: usize>(
-    p: &mut Painter,
-    base: &str,
-    step: Option<u64>,
+/// The Exp-image of the tangent ellipsoid's principal 3-D slice at `confidence`: the unit
+/// sphere's mesh mapped by u ↦ point_of(μ · Exp(Σᵢ uᵢ r√λᵢ eᵢ)) (right; Exp(·) · μ left), as
+/// (vertices, triangles).
+pub(super) fn banana_surface<G: LieGroup<N>, const N: usize>(
     pose: &UncertainPose<G, N>,
-    color: Color,
-    point_of: impl Fn(&G) -> Vector3<f64> + Copy,
-) {
-    let frame = PrincipalFrame::of(pose, p.confidence());
+    confidence: Confidence,
+    point_of: impl Fn(&G) -> Vector3<f64>,
+) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let frame = PrincipalFrame::of(pose, confidence);
     let (sphere, triangles) = scene::unit_sphere_mesh(BANANA_MESH.0, BANANA_MESH.1);
-    let vertices: Vec<Vec3> = sphere
+    let vertices = sphere
         .iter()
         .map(|u| v3(&point_of(&frame.apply(pose, [u[0], u[1], u[2]]))))
         .collect();
-    let surface = Surface {
-        vertices,
-        triangles,
-        normals: Vec::new(),
-        color: color.with_alpha(70),
-    }
-    .with_computed_normals();
-    p.push(format!("{base}/banana"), step, ItemKind::Surface(surface));
-    outlines(
-        p,
-        &format!("{base}/banana_outline"),
-        step,
-        pose,
-        color,
-        point_of,
-    );
+    (vertices, triangles)
 }
 
-/// Images of the three principal great circles of the tangent ellipsoid.
-pub(super) fn outlines<G: LieGroup<N>, const N: usize>(
-    p: &mut Painter,
-    path: &str,
-    step: Option<u64>,
+/// Images of the three principal great circles of the tangent ellipsoid at `confidence`
+/// (one strip each, [`OUTLINE_POINTS`] + 1 points).
+pub(super) fn outline_strips<G: LieGroup<N>, const N: usize>(
     pose: &UncertainPose<G, N>,
-    color: Color,
+    confidence: Confidence,
     point_of: impl Fn(&G) -> Vector3<f64>,
-) {
-    let frame = PrincipalFrame::of(pose, p.confidence());
-    let strips: Vec<Vec<Vec3>> = [(0, 1), (0, 2), (1, 2)]
+) -> Vec<Vec<Vec3>> {
+    let frame = PrincipalFrame::of(pose, confidence);
+    [(0, 1), (0, 2), (1, 2)]
         .iter()
         .map(|&(a, b)| {
             (0..=OUTLINE_POINTS)
@@ -178,15 +143,5 @@ pub(super) fn outlines<G: LieGroup<N>, const N: usize>(
                 })
                 .collect()
         })
-        .collect();
-    p.push(
-        path.to_owned(),
-        step,
-        ItemKind::LineStrips(LineStrips {
-            strips,
-            color,
-            // Thin: outlines sit on top of clouds and surfaces.
-            radius: 0.004 * p.axis_length.min(0.5),
-        }),
-    );
+        .collect()
 }

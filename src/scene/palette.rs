@@ -83,7 +83,7 @@ impl Method {
     ///
     /// ```
     /// use posecov::uncertain::Method;
-    /// assert_eq!(Self::MonteCarlo.label(), "Monte Carlo");
+    /// assert_eq!(Method::MonteCarlo.label(), "Monte Carlo");
     /// ```
     pub fn label(self) -> &'static str {
         match self {

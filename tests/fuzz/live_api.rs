@@ -296,6 +296,9 @@ fn send(port: u16, request: &[u8], limits: &Limits) -> Result<(u16, String), Str
     // Read until the answer is whole (its head and as much body as it says), or the server
     // closes: a kept-alive connection (a request whose `Connection: close` was mutated away)
     // stays open after a whole answer.
+    // The answer to a HEAD request has a `Content-Length` and, rightly, no body (RFC 9110
+    // §9.3.2): it is whole once its head ends.
+    let head_only = request.starts_with(b"HEAD ");
     let mut answer = Vec::new();
     let mut piece = [0u8; 8192];
     loop {
@@ -303,7 +306,7 @@ fn send(port: u16, request: &[u8], limits: &Limits) -> Result<(u16, String), Str
             Ok(0) => break,
             Ok(n) => {
                 answer.extend_from_slice(&piece[..n]);
-                if whole(&answer) {
+                if whole(&answer, head_only) {
                     break;
                 }
             }
@@ -328,12 +331,16 @@ fn send(port: u16, request: &[u8], limits: &Limits) -> Result<(u16, String), Str
     Ok((status, body))
 }
 
-/// Whether an answer has its head and the body its `Content-Length` gives.
-fn whole(answer: &[u8]) -> bool {
+/// Whether an answer has its head and the body its `Content-Length` gives (the head alone
+/// for the answer to a HEAD request).
+fn whole(answer: &[u8], head_only: bool) -> bool {
     let text = String::from_utf8_lossy(answer);
     let Some((head, body)) = text.split_once("\r\n\r\n") else {
         return false;
     };
+    if head_only {
+        return true;
+    }
     head.split("\r\n")
         .filter_map(|l| l.split_once(':'))
         .find(|(k, _)| k.trim().eq_ignore_ascii_case("content-length"))

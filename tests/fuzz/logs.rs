@@ -145,6 +145,10 @@ fn judge(file: &str, run: Run<Result<serde_json::Value, String>>, limits: &Limit
     match result {
         Err(e) => {
             let first = e.lines().next().unwrap_or("").to_owned();
+            // In the user's words: no Rust paths or type names (`rosbag::Error: …`).
+            if first.contains("::") {
+                found.push(finding("error_rust_speak", first.clone()));
+            }
             if first.starts_with(file) {
                 found.push(finding("error_ok", first));
             } else {

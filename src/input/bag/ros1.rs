@@ -176,7 +176,7 @@ pub(super) fn read(
             }
             Ok(IndexRecord::ChunkInfo(info)) => chunk_positions.push(info.chunk_pos),
             Ok(_) => {}
-            Err(e) => return Err(fail(format!("index section: {e}"))),
+            Err(e) => return Err(fail(format!("index section: {}", words(&e)))),
         }
     }
     if chunk_positions.is_empty() {
@@ -214,11 +214,11 @@ pub(super) fn read(
                 let mut records = bag.chunk_records();
                 records
                     .seek(pos)
-                    .map_err(|e| format!("at byte {pos}: {e}"))?;
+                    .map_err(|e| format!("at byte {pos}: {}", words(&e)))?;
                 match records.next() {
                     Some(Ok(ChunkRecord::Chunk(chunk))) => Ok(chunk),
                     Some(Ok(_)) => Err(format!("at byte {pos}: the index points at no chunk")),
-                    Some(Err(e)) => Err(format!("at byte {pos}: {e}")),
+                    Some(Err(e)) => Err(format!("at byte {pos}: {}", words(&e))),
                     None => Err(format!("at byte {pos}: past the end of the chunks")),
                 }
             })
@@ -247,11 +247,40 @@ pub(super) fn read(
                             )
                             .map_err(|e| fail(format!("chunk {done} of {total}: {e}")))?;
                     }
-                    Err(e) => return Err(fail(format!("chunk {done} of {total}: {e}"))),
+                    Err(e) => {
+                        return Err(fail(format!("chunk {done} of {total}: {}", words(&e))));
+                    }
                 }
             }
             progress(done, total);
         }
     }
     Ok(())
+}
+
+/// A `rosbag` error in the user's words (the crate's own text starts with its Rust type name).
+///
+/// Only the bag's own records are named: a damaged header, a record that runs past the end
+/// of the file, a compressed chunk that does not decompress.
+fn words(e: &rosbag::Error) -> String {
+    use rosbag::Error as E;
+    match e {
+        E::InvalidHeader => "a record header is damaged (a field length or name is invalid)".into(),
+        E::InvalidRecord => "a record is damaged (its header does not match its kind)".into(),
+        E::UnsupportedVersion => "not a ROS 1 bag of format version 2.0".into(),
+        E::OutOfBounds => {
+            "a record runs past the end of the file (the bag is truncated or damaged)".into()
+        }
+        E::UnexpectedChunkSectionRecord(kind) => {
+            format!("an unexpected {kind} record among the chunks")
+        }
+        E::UnexpectedIndexSectionRecord(kind) => {
+            format!("an unexpected {kind} record in the index section")
+        }
+        E::UnexpectedMessageRecord(kind) => {
+            format!("an unexpected {kind} record inside a chunk")
+        }
+        E::Bzip2DecompressionError(why) => format!("a bz2 chunk does not decompress ({why})"),
+        E::Lz4DecompressionError(why) => format!("an lz4 chunk does not decompress ({why})"),
+    }
 }
