@@ -200,6 +200,18 @@ const WORDS: &[(&str, &str)] = &[
     ("struct DrawSpec", "a [draw] table"),
     ("struct Header", "a [scenario] table"),
     ("struct ScenarioFile", "a scenario file"),
+    (
+        "struct MethodsSpec",
+        "a [methods] table of method parameters (the methods compared go in [scenario]: methods = [\"first_order\", …])",
+    ),
+    (
+        "struct SigmaPointsSpec",
+        "a [methods.sigma_points] table such as { alpha = 1, beta = 2, kappa = 0 }",
+    ),
+    (
+        "struct CameraSpec",
+        "a camera table such as { direction = [x, y, z] }",
+    ),
     ("u64", "a whole number ≥ 0"),
     ("i64", "a whole number"),
     ("f64", "a number"),
@@ -218,6 +230,12 @@ fn type_words(s: &str) -> String {
     }
     for (rust, words) in WORDS {
         out = out.replace(rust, words);
+    }
+    // A structure not listed above is still a table to the file, never a Rust type name.
+    if let Some(rest) = out.strip_prefix("struct ")
+        && rest.chars().all(|c| c.is_ascii_alphanumeric())
+    {
+        return "a table".to_owned();
     }
     out
 }
@@ -250,6 +268,17 @@ mod tests {
         assert!(
             !in_file_words("invalid type: integer `3`, expected struct MeanSpec")
                 .contains("struct")
+        );
+        // Found by the fuzz harness: `methods = [...]` above `[scenario]`.
+        let e =
+            in_file_words("invalid type: string \"first_order\", expected struct SigmaPointsSpec");
+        assert!(
+            e.starts_with("expected a [methods.sigma_points] table"),
+            "{e}"
+        );
+        assert_eq!(
+            in_file_words("invalid type: integer `3`, expected struct SomethingNew"),
+            "expected a table, found integer `3`"
         );
     }
 
