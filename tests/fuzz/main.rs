@@ -53,6 +53,7 @@ mod harness;
 #[cfg(feature = "viewer")]
 mod live_api;
 mod logs;
+mod oracle;
 mod scenario;
 
 use harness::{Family, Summary, campaign, env_u64};
