@@ -194,3 +194,43 @@ fn help_shows_the_exit_codes_and_a_closed_stdout_is_quiet() {
         "a closed stdout ends quietly with 0"
     );
 }
+
+#[test]
+fn values_beyond_f32_are_drawn_clipped_and_said() {
+    let dir = scratch("overflow");
+    let planar = [(7, 0.01), (14, 1e6), (21, 1e6), (28, 1e6), (35, 0.03)];
+    for (name, entries) in [
+        // A variance of 4.5e153 on x (σ = 6.7e76 m, beyond f32) on a planar topic: a
+        // placeholder on an axis in use, drawn as RViz's clipped picture and a cross.
+        ("huge_x", vec![(0, 4.5e153)]),
+        // On z of a planar topic: a placeholder like 1e6.
+        ("huge_z", vec![(0, 0.01), (14, 4.5e153)]),
+    ] {
+        let log = dir.join(format!("{name}.mcap"));
+        let mut cov = [0.0; 36];
+        for (i, v) in planar.into_iter().chain(entries) {
+            cov[i] = v;
+        }
+        write_log(&log, Some(cov));
+        let rrd = dir.join(format!("{name}.rrd"));
+        let (code, out, err) = run(&[log.to_str().unwrap(), "--save", rrd.to_str().unwrap()]);
+        let log = log.display().to_string();
+        assert_eq!(code, Some(0), "{name}: {out}{err}");
+        let (code, out, err) = run(&["report", "--json", &log]);
+        assert_eq!(code, Some(0), "{err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let topic = &v["topics"][0];
+        if name == "huge_x" {
+            assert_eq!(
+                topic["health"]["placeholder_used_axis"]["count"], 30,
+                "{topic}"
+            );
+            assert_eq!(topic["drawn_invalid"], 30, "{topic}");
+            assert!(topic["sigma"].get("x").is_none(), "not estimated: {topic}");
+        } else {
+            assert_eq!(topic["drawn_invalid"], 0, "{topic}");
+            assert_eq!(topic["health"]["placeholder"]["class"], "note", "{topic}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -17,12 +17,14 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::AppError;
 use super::commands::Checked;
 use super::settings::LogSettings;
-use crate::draw::bag::{BagDrawSettings, bag_scene, description, issue_sentence, issue_word};
+use crate::draw::bag::{
+    BagDrawSettings, bag_scene, description, issue_sentence, issue_word, topic_entity,
+};
 use crate::eval::bag::{BagEvaluation, evaluate_bag};
 use crate::input::bag::{BagOptions, bundled, read_located};
-use crate::input::{About, Located, Place};
+use crate::input::{About, InputError, Located, Place};
 use crate::plan::bag::{Class, Issue, LogSummary};
-use crate::scene::Scene;
+use crate::scene::{Scene, SceneError, Timing};
 
 /// A read, evaluated and drawn log.
 #[derive(Debug, Clone)]
@@ -66,13 +68,46 @@ pub fn run(
     };
     let summary = description(&plan, located.format, &evaluation, settings.confidence);
     let scene = bag_scene(&evaluation, &draw, &summary);
-    scene.validate()?;
+    scene
+        .validate()
+        .map_err(|e| undrawable(located, &evaluation, &scene, e))?;
     Ok(LogRun {
         located: located.clone(),
         settings: settings.clone(),
         plan,
         evaluation,
         scene,
+    })
+}
+
+/// A log's scene that cannot be drawn (a number beyond what the viewer holds, `f32`, that
+/// evaluation let through), located in the log's words: the topic from the item's entity path,
+/// the message from its stamp (a static overview names the topic only).
+fn undrawable(located: &Located, e: &BagEvaluation, scene: &Scene, error: SceneError) -> AppError {
+    let item = scene.items.iter().find(|i| i.validate().is_err());
+    let topic = item.and_then(|item| {
+        e.topics.iter().find(|t| {
+            item.path
+                .starts_with(&format!("{}/", topic_entity(&t.name)))
+        })
+    });
+    let place = match (topic, item.map(|i| i.timing)) {
+        (Some(t), Some(Timing::Stamp(ns))) => match t.poses.iter().find(|p| p.stamp_ns == ns) {
+            Some(p) => format!(
+                "topic {}, message {} (stamp {:.3} s)",
+                t.name,
+                p.index,
+                stamp_seconds(ns)
+            ),
+            None => format!("topic {}, stamp {:.3} s", t.name, stamp_seconds(ns)),
+        },
+        (Some(t), _) => format!("topic {} (its overview of every drawn message)", t.name),
+        (None, _) => "the log's drawing".to_owned(),
+    };
+    AppError::Input(InputError::In {
+        file: located.origin(),
+        place,
+        message: format!("a value beyond what the viewer can draw (f32): {error}"),
     })
 }
 
@@ -107,8 +142,56 @@ fn read(
     Ok(plan)
 }
 
-fn secs(ns: i64) -> f64 {
-    ns as f64 * 1e-9
+/// A stamp in seconds to the microsecond, without float noise: the integer microseconds
+/// (rounded half away from zero) divided once, so that 108 764 000 000 ns prints as
+/// `108.764`, not `108.76400000000001`.
+///
+/// ```
+/// use posecov::app::bag::stamp_seconds;
+/// assert_eq!(serde_json::json!(stamp_seconds(108_764_000_000)).to_string(), "108.764");
+/// assert_eq!(stamp_seconds(1_499_999), 0.0015);
+/// assert_eq!(stamp_seconds(-1_500), -0.000002);
+/// ```
+pub fn stamp_seconds(ns: i64) -> f64 {
+    let whole = ns / 1000;
+    let rest = ns % 1000;
+    let us = whole + i64::from(rest >= 500) - i64::from(rest <= -500);
+    us as f64 / 1e6
+}
+
+/// The units of a log report's numbers (`units` in `report --json`).
+const LOG_UNITS: [(&str, &str); 7] = [
+    ("stamps", "s (suffix _s), to the microsecond"),
+    ("sigma_position", "m (sigma.x, .y, .z: parent frame's axes)"),
+    ("sigma_rotation", "rad (sigma.roll, .pitch, .yaw)"),
+    ("position_trace", "m^2 (suffix _m2)"),
+    ("distance", "m (suffix _m)"),
+    (
+        "eigenvalue",
+        "the covariance's own units (m^2, m·rad, rad^2)",
+    ),
+    (
+        "twist_sigma",
+        "m/s (vx, vy, vz), rad/s (wx, wy, wz), child frame",
+    ),
+];
+
+/// A topic's σ statistics per ROS axis with their units; an axis no message estimates is
+/// absent.
+fn sigma_json(e: &crate::eval::bag::TopicEvaluation) -> serde_json::Value {
+    let axes = crate::plan::bag::ROS_AXES;
+    let map: serde_json::Map<String, serde_json::Value> = axes
+        .iter()
+        .zip(&e.sigma)
+        .enumerate()
+        .filter_map(|(i, (axis, s))| {
+            let s = s.as_ref()?;
+            let mut value = serde_json::to_value(s).ok()?;
+            value["unit"] = serde_json::json!(if i < 3 { "m" } else { "rad" });
+            Some(((*axis).to_owned(), value))
+        })
+        .collect();
+    serde_json::Value::Object(map)
 }
 
 /// The JSON report of a log: per topic its type, frames, counts, stamps (s), planar or 3-D
@@ -133,7 +216,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                         serde_json::json!({
                             "class": t.class(*issue),
                             "count": c.count,
-                            "first_stamp_s": secs(c.first_stamp_ns),
+                            "first_stamp_s": stamp_seconds(c.first_stamp_ns),
                             "first_message": c.first_index,
                             "word": issue_word(*issue),
                             "sentence": issue_sentence(*issue, t),
@@ -148,8 +231,8 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 "child_frame_id": t.child_frame_id,
                 "messages": t.count,
                 "stamps": {
-                    "first_s": t.stamp_range.map(|r| secs(r.0)),
-                    "last_s": t.stamp_range.map(|r| secs(r.1)),
+                    "first_s": t.stamp_range.map(|r| stamp_seconds(r.0)),
+                    "last_s": t.stamp_range.map(|r| stamp_seconds(r.1)),
                     "from_log_time": t.stamps_from_log_time,
                     "out_of_order": t.stamps_out_of_order,
                 },
@@ -164,18 +247,32 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 "constant_stretch": t.health.constant.map(|c| serde_json::json!({
                     "messages": c.messages,
                     "first_message": c.first_index,
-                    "first_stamp_s": secs(c.first_stamp_ns),
-                    "last_stamp_s": secs(c.last_stamp_ns),
+                    "first_stamp_s": stamp_seconds(c.first_stamp_ns),
+                    "last_stamp_s": stamp_seconds(c.last_stamp_ns),
                     "distance_m": c.distance_m,
                 })),
                 "min_eigenvalue": t.health.min_eigenvalue,
-                "twist_sigma_last": t.twist_sigmas(),
+                "twist_sigma_last": t.twist_sigmas().map(|s| {
+                    ["vx", "vy", "vz", "wx", "wy", "wz"]
+                        .iter()
+                        .zip(s)
+                        .map(|(k, v)| ((*k).to_owned(), serde_json::json!(v)))
+                        .collect::<serde_json::Map<_, _>>()
+                }),
+                "sigma": sigma_json(e),
+                "position_trace": {
+                    "stamps_s": e.series.iter().filter(|p| p.position_trace.is_some()).map(|p| stamp_seconds(p.stamp_ns)).collect::<Vec<_>>(),
+                    "values_m2": e.series.iter().filter_map(|p| p.position_trace).collect::<Vec<_>>(),
+                },
                 "ros_reading": run.evaluation.reading,
                 "ros_readings_apart": e.reading_difference,
             })
         })
         .collect();
     serde_json::json!({
+        "schema_version": super::REPORT_SCHEMA_VERSION,
+        "posecov_version": super::POSECOV_VERSION,
+        "units": LOG_UNITS.iter().map(|(k, u)| ((*k).to_owned(), serde_json::json!(u))).collect::<serde_json::Map<_, _>>(),
         "scenario": name,
         "format": run.located.format,
         "meta": {
@@ -248,7 +345,7 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
                 "{file}: topic {}, message {} (stamp {:.3} s): {} — {} ({} message(s); `--allow {}` accepts it{others})",
                 t.name,
                 c.first_index,
-                secs(c.first_stamp_ns),
+                stamp_seconds(c.first_stamp_ns),
                 issue.name(),
                 issue_sentence(*issue, t),
                 c.count,
@@ -275,4 +372,46 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
         )
     };
     Checked { line, defects }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::{
+        Overrides,
+        run::{Run, open},
+    };
+    use crate::scene::{Color, ItemKind, LineStrips, SceneItem};
+
+    #[test]
+    fn an_undrawable_value_is_located_in_the_log() {
+        let Ok(Run::Log(run)) = Run::start(
+            open("covariance_health").unwrap(),
+            &Overrides::default(),
+            None,
+        ) else {
+            panic!("a log")
+        };
+        let topic = &run.evaluation.topics[1];
+        let pose = &topic.poses[2];
+        let mut scene = run.scene.clone();
+        scene.items.push(SceneItem::new(
+            format!("{}/meaning/banana_outline", topic_entity(&topic.name)),
+            Timing::Stamp(pose.stamp_ns),
+            ItemKind::LineStrips(LineStrips {
+                strips: vec![vec![[0.0; 3], [1e39, 0.0, 0.0]]],
+                color: Color::rgb(0, 0, 0),
+                radius: 0.01,
+            }),
+        ));
+        let error = scene.validate().unwrap_err();
+        let e = undrawable(&run.located, &run.evaluation, &scene, error).to_string();
+        let expected = format!(
+            "health_cases.mcap (bundled): topic {}, message {} (stamp {:.3} s): a value beyond what the viewer can draw (f32): ",
+            topic.name,
+            pose.index,
+            stamp_seconds(pose.stamp_ns)
+        );
+        assert!(e.starts_with(&expected), "{e}");
+    }
 }

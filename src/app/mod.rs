@@ -280,6 +280,14 @@ fn evaluate_and_draw(
     Ok((settings, evaluation, scene))
 }
 
+/// The layout version of `report --json` (top-level `schema_version`): raised only when a key
+/// is removed, renamed or changes meaning; new keys do not raise it. Every key is documented
+/// in `docs/report.schema.json`, which every bundled example's report validates against.
+pub const REPORT_SCHEMA_VERSION: u32 = 1;
+
+/// The posecov that wrote a report (`posecov_version`).
+pub const POSECOV_VERSION: &str = env!("CARGO_PKG_VERSION");
+
 /// The JSON report of an evaluation: the settings it ran with (`meta`, with the sigma-point
 /// parameters), every estimate with its error against Monte Carlo (`results`), every node's
 /// Monte Carlo statistics (`monte_carlo`: Lie mean, centred covariance, uncentred covariance
@@ -302,6 +310,8 @@ pub fn report_json(
     let ran = evaluation.ran_with();
     let sigma = loaded.input.defaults.sigma_points.unwrap_or_default();
     let mut report = serde_json::json!({
+        "schema_version": REPORT_SCHEMA_VERSION,
+        "posecov_version": POSECOV_VERSION,
         "scenario": name,
         "format": loaded.source.format(),
         "input": loaded.source.facts(),

@@ -116,6 +116,16 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
     p.scene
 }
 
+/// The entity path under which a topic is drawn: `world/` and its name's segments (`/a/b` →
+/// `world/a/b`; characters other than letters, digits, `_`, `-` and `.` → `_`).
+///
+/// ```
+/// assert_eq!(posecov::draw::bag::topic_entity("/amcl pose"), "world/amcl_pose");
+/// ```
+pub fn topic_entity(name: &str) -> String {
+    format!("{WORLD}/{}", topic_path(name))
+}
+
 /// An entity path segment list for a topic name (`/a/b` → `a/b`; other characters → `_`).
 fn topic_path(name: &str) -> String {
     let cleaned: Vec<String> = name
@@ -155,7 +165,7 @@ fn flat(planar: bool, v: &Vector3<f64>) -> Vec3 {
 }
 
 fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
-    let base = format!("{WORLD}/{}", topic_path(&t.name));
+    let base = topic_entity(&t.name);
     let color = Method::ALL[k % Method::ALL.len()].color();
     let strip: Vec<Vec3> = t
         .trajectory

@@ -21,7 +21,9 @@ use nalgebra::{Matrix3, Matrix6, Vector2};
 
 use crate::interop::{RosReading, ros_cov_to_right};
 use crate::lie::{Se2, Se3, So2, So3};
-use crate::plan::bag::{Issue, LogSummary, SeriesPoint, TopicPlan};
+use serde::Serialize;
+
+use crate::plan::bag::{AxisStats, Issue, LogSummary, SeriesPoint, TopicPlan};
 use crate::sample::{Sampler, chunk_rng};
 use crate::uncertain::{Side, UncertainPose};
 
@@ -108,6 +110,68 @@ pub struct PoseEvaluation {
     pub rviz: Option<RvizNumbers>,
 }
 
+/// One axis's σ over a topic: first, last, smallest and largest over every message where the
+/// axis is estimated (streamed while reading, [`AxisStats`]), and the median over the kept
+/// series (the values a median needs are only kept there, bounded).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SigmaSummary {
+    /// Messages counted (every message where the axis is estimated).
+    pub messages: u64,
+    /// σ of the first such message.
+    pub first: f64,
+    /// σ of the last.
+    pub last: f64,
+    /// Smallest σ.
+    pub min: f64,
+    /// The median σ of the kept series (`None` when none of its points estimates the axis).
+    pub median_of_kept: Option<f64>,
+    /// Largest σ.
+    pub max: f64,
+}
+
+/// The σ summary of ROS axis `axis` (0..6) of a topic: its streamed statistics and the median
+/// of the kept series (the mean of the two middle values for an even count).
+///
+/// ```
+/// use posecov::eval::bag::sigma_summary;
+/// use posecov::plan::bag::{AxisStats, SeriesPoint};
+/// let mut stats = None;
+/// let series: Vec<SeriesPoint> = [0.3, 0.1, 0.2, 0.4]
+///     .into_iter()
+///     .map(|s| {
+///         AxisStats::add(&mut stats, s);
+///         SeriesPoint { stamp_ns: 0, sigma: [Some(s), None, None, None, None, None], position_trace: None }
+///     })
+///     .collect();
+/// let x = sigma_summary(stats, &series, 0).unwrap();
+/// assert_eq!((x.first, x.last, x.min, x.max), (0.3, 0.4, 0.1, 0.4));
+/// assert!((x.median_of_kept.unwrap() - 0.25).abs() < 1e-15);
+/// assert_eq!(sigma_summary(None, &series, 1), None);
+/// ```
+pub fn sigma_summary(
+    stats: Option<AxisStats>,
+    series: &[SeriesPoint],
+    axis: usize,
+) -> Option<SigmaSummary> {
+    let stats = stats?;
+    let mut kept: Vec<f64> = series.iter().filter_map(|p| p.sigma[axis]).collect();
+    kept.sort_by(f64::total_cmp);
+    let n = kept.len();
+    let median_of_kept = match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(kept[n / 2]),
+        _ => Some(0.5 * (kept[n / 2 - 1] + kept[n / 2])),
+    };
+    Some(SigmaSummary {
+        messages: stats.messages,
+        first: stats.first,
+        last: stats.last,
+        min: stats.min,
+        median_of_kept,
+        max: stats.max,
+    })
+}
+
 /// One topic's numbers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TopicEvaluation {
@@ -128,6 +192,8 @@ pub struct TopicEvaluation {
     pub trajectory: Vec<(i64, [f64; 3])>,
     /// Time series.
     pub series: Vec<SeriesPoint>,
+    /// σ per ROS axis (x, y, z, roll, pitch, yaw; m and rad), `None` where never estimated.
+    pub sigma: [Option<SigmaSummary>; 6],
 }
 
 /// A log's numbers.
@@ -218,14 +284,18 @@ fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) ->
         reading_difference,
         trajectory: topic.trajectory.clone(),
         series: topic.series.clone(),
+        sigma: std::array::from_fn(|axis| {
+            sigma_summary(topic.sigma_stats[axis], &topic.series, axis)
+        }),
     }
 }
 
 /// The right-form Gaussian of a usable message. Planar: the unestimated z / roll / pitch rows
 /// and columns are dropped (they are placeholders or zero, not variances), the pose is
 /// projected to (x, y, yaw), and the one ROS conversion is applied at R = Rz(yaw); the
-/// (ρx, ρy, θz) block is SE(2)'s tangent. 3-D: the conversion at the message's rotation; a
-/// placeholder there cannot be drawn.
+/// (ρx, ρy, θz) block is SE(2)'s tangent. A placeholder (≥ 1e6, "not estimated") on an axis
+/// the motion uses — x, y or yaw when planar, any axis in 3-D — is no variance: such a message
+/// cannot be drawn as a Gaussian (RViz's clipped picture and a cross say it instead).
 fn meaning(
     mean: &Se3,
     cov_ros: &Matrix6<f64>,
@@ -234,6 +304,17 @@ fn meaning(
     reading: RosReading,
 ) -> Result<PoseState, Vec<Issue>> {
     let invalid = |_| vec![Issue::NotPsd];
+    let used: &[usize] = if planar {
+        &[0, 1, 5]
+    } else {
+        &[0, 1, 2, 3, 4, 5]
+    };
+    if used
+        .iter()
+        .any(|&i| unestimated[i] && cov_ros[(i, i)] != 0.0)
+    {
+        return Err(vec![Issue::PlaceholderUsedAxis]);
+    }
     if planar {
         let yaw = mean.rotation().to_rpy()[2];
         let mut cov = *cov_ros;
@@ -253,13 +334,6 @@ fn meaning(
             })
             .map_err(invalid)
     } else {
-        if unestimated
-            .iter()
-            .zip(cov_ros.diagonal().iter())
-            .any(|(u, v)| *u && *v != 0.0)
-        {
-            return Err(vec![Issue::PlaceholderUsedAxis]);
-        }
         let right = ros_cov_to_right(cov_ros, mean.rotation(), reading);
         UncertainPose::try_new(*mean, right, Side::Right)
             .map(|pose| PoseState::Spatial {
@@ -356,6 +430,18 @@ mod tests {
         let expect = c * c * 0.04 + s * s * 0.01 + 2.0 * s * c * 0.005;
         assert!((pose.cov()[(0, 0)] - expect).abs() < 1e-15);
         assert!((pose.mean().rotation().angle() - yaw).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_placeholder_on_a_planar_axis_in_use_is_not_drawn() {
+        // σ² = 4.5e153 on x: no variance (and its banana would overflow the viewer's f32).
+        let mut cov = Matrix6::identity() * 0.01;
+        cov[(0, 0)] = 4.5e153;
+        let un = [true, false, true, true, true, false];
+        assert_eq!(
+            meaning(&Se3::identity(), &cov, &un, true, RosReading::Tf2).unwrap_err(),
+            vec![Issue::PlaceholderUsedAxis]
+        );
     }
 
     #[test]

@@ -332,6 +332,56 @@ pub struct SeriesPoint {
     pub position_trace: Option<f64>,
 }
 
+/// Statistics of one axis's σ, streamed over every message where the axis is estimated (a
+/// usable message, the axis neither a placeholder nor zero): memory does not grow with the
+/// log. The median needs the values, so it is taken over the kept series in `eval::bag`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AxisStats {
+    /// Messages counted.
+    pub messages: u64,
+    /// σ of the first such message (in file order).
+    pub first: f64,
+    /// σ of the last.
+    pub last: f64,
+    /// Smallest σ.
+    pub min: f64,
+    /// Largest σ.
+    pub max: f64,
+}
+
+impl AxisStats {
+    /// Adds the next message's σ to `stats` (starting them with the first).
+    ///
+    /// ```
+    /// use posecov::plan::bag::AxisStats;
+    /// let mut s = None;
+    /// for sigma in [0.2, 0.1, 0.3] {
+    ///     AxisStats::add(&mut s, sigma);
+    /// }
+    /// let s = s.unwrap();
+    /// assert_eq!((s.messages, s.first, s.last, s.min, s.max), (3, 0.2, 0.3, 0.1, 0.3));
+    /// ```
+    pub fn add(stats: &mut Option<AxisStats>, sigma: f64) {
+        match stats {
+            Some(s) => {
+                s.messages += 1;
+                s.last = sigma;
+                s.min = s.min.min(sigma);
+                s.max = s.max.max(sigma);
+            }
+            None => {
+                *stats = Some(AxisStats {
+                    messages: 1,
+                    first: sigma,
+                    last: sigma,
+                    min: sigma,
+                    max: sigma,
+                })
+            }
+        }
+    }
+}
+
 /// A message kept for drawing: its number on the topic (0-based), the message, and whether
 /// it can be drawn as a Gaussian (else the issues that prevent it).
 #[derive(Debug, Clone, PartialEq)]
@@ -378,6 +428,9 @@ pub struct TopicPlan {
     pub trajectory: Vec<(i64, [f64; 3])>,
     /// Time series (bounded, in stamp order).
     pub series: Vec<SeriesPoint>,
+    /// σ statistics per ROS axis (x, y, z, roll, pitch, yaw) over every message where the
+    /// axis is estimated; `None` where it never is.
+    pub sigma_stats: [Option<AxisStats>; 6],
 }
 
 /// Whether `frame_id` names an odometry frame as REP 105 does (`odom`, or a namespaced

@@ -326,6 +326,21 @@ fn check_surface(path: &str, surface: &Surface) -> Result<(), SceneError> {
     Ok(())
 }
 
+impl SceneItem {
+    /// Checks this item alone as [`Scene::validate`] does (every number finite, also as
+    /// `f32`; sizes; quaternions; its path): to find which item of an invalid scene fails.
+    ///
+    /// ```
+    /// use posecov::scene::{ItemKind, LineStrips, SceneItem, Timing, Color};
+    /// let strips = LineStrips { strips: vec![vec![[0.0, 0.0, 0.0], [1e39, 0.0, 0.0]]], color: Color::rgb(0, 0, 0), radius: 0.01 };
+    /// let item = SceneItem::new("world/t", Timing::Stamp(5), ItemKind::LineStrips(strips));
+    /// assert!(item.validate().is_err());
+    /// ```
+    pub fn validate(&self) -> Result<(), SceneError> {
+        check_item(self)
+    }
+}
+
 fn check_item(item: &SceneItem) -> Result<(), SceneError> {
     check_path(&item.path)?;
     match &item.kind {

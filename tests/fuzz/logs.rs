@@ -157,7 +157,8 @@ fn judge(file: &str, run: Run<Result<serde_json::Value, String>>, limits: &Limit
         }
         Ok(json) => {
             // Absent by design: no eigenvalue for a covariance that is not finite, no twist
-            // σ where the messages have none, no stamps for a topic without messages.
+            // σ where the messages have none, no stamps for a topic without messages, no
+            // median where no kept point estimates an axis.
             let optional = [
                 "step",
                 "min_eigenvalue",
@@ -166,6 +167,7 @@ fn judge(file: &str, run: Run<Result<serde_json::Value, String>>, limits: &Limit
                 ".topics[#].constant_stretch",
                 "first_s",
                 "last_s",
+                "median_of_kept",
             ];
             if let Some(path) = json_null(&json, &optional) {
                 found.push(finding("nonfinite_json", format!("null at {path}")));

@@ -49,7 +49,7 @@ pub fn issue_word(issue: Issue) -> &'static str {
 /// # let t = TopicPlan { name: "/odom".into(), kind: PoseMessageKind::Odometry, frame_id: "odom".into(),
 /// #     child_frame_id: String::new(), count: 0, stamps_from_log_time: 0, stamps_out_of_order: 0,
 /// #     stamp_range: None, health: Default::default(), planar: true, drawn: vec![], stride: 1,
-/// #     trajectory: vec![], series: vec![] };
+/// #     trajectory: vec![], series: vec![], sigma_stats: [None; 6] };
 /// assert!(issue_sentence(Issue::AllZero, &t).starts_with("every estimated entry is 0"));
 /// ```
 pub fn issue_sentence(issue: Issue, t: &TopicPlan) -> String {

@@ -20,15 +20,11 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::plan::bag::{
-    DrawnMessage, Health, Issue, IssueCount, LogSummary, PoseMessage, PoseMessageKind, SeriesPoint,
-    SkippedTopic, TopicPlan, is_odom_frame,
-};
+use crate::plan::bag::{LogSummary, PoseMessageKind, SkippedTopic};
 
 use super::format::{self, Format};
 use super::suggest;
 use super::{InputError, Located, Place};
-use decimate::Decimator;
 
 pub mod bundled;
 mod decimate;
@@ -37,8 +33,10 @@ pub mod health;
 mod mcap;
 mod mcap_records;
 mod ros1;
+mod topic;
 
 use decode::{DecodeError, Decoded};
+use topic::TopicState;
 
 /// The largest record or decompressed chunk of a log read (1 GiB): larger ones are refused,
 /// not allocated.
@@ -165,26 +163,6 @@ struct Stream {
 enum Codec {
     Ros1,
     Cdr,
-}
-
-/// The per-topic streaming state.
-struct TopicState {
-    kind: PoseMessageKind,
-    frame_id: Option<String>,
-    child_frame_id: Option<String>,
-    count: u64,
-    from_log: u64,
-    out_of_order: u64,
-    last_stamp: Option<i64>,
-    range: Option<(i64, i64)>,
-    health: Health,
-    trend: health::Trend,
-    constancy: health::Constancy,
-    usable: u64,
-    planar: bool,
-    drawn: Decimator<DrawnMessage>,
-    trajectory: Decimator<(i64, [f64; 3])>,
-    series: Decimator<SeriesPoint>,
 }
 
 /// Receives every message of a log in file order.
@@ -407,166 +385,6 @@ fn no_pose_topic(plan: &LogSummary) -> String {
         "no pose-with-covariance topic to draw; the log has {has}; posecov reads {}",
         reads.join(", ")
     )
-}
-
-impl TopicState {
-    fn new(kind: PoseMessageKind, every: Option<u64>) -> Self {
-        TopicState {
-            kind,
-            frame_id: None,
-            child_frame_id: None,
-            count: 0,
-            from_log: 0,
-            out_of_order: 0,
-            last_stamp: None,
-            range: None,
-            health: Health::default(),
-            trend: health::Trend::default(),
-            constancy: health::Constancy::default(),
-            usable: 0,
-            planar: true,
-            drawn: match every {
-                Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
-                None => Decimator::new(1, DEFAULT_MAX_DRAWN),
-            },
-            trajectory: Decimator::new(1, MAX_SERIES),
-            series: Decimator::new(1, MAX_SERIES),
-        }
-    }
-
-    fn add(&mut self, decoded: Result<Decoded, DecodeError>, log_time_ns: i64) {
-        let index = self.count;
-        self.count += 1;
-        let d = match decoded {
-            Ok(d) => d,
-            Err(_) => {
-                self.health.note(Issue::Undecodable, log_time_ns, index);
-                return;
-            }
-        };
-        let (stamp_ns, from_log_time) = match d.stamp_ns {
-            Some(s) => (s, false),
-            None => (log_time_ns, true),
-        };
-        let headed = self.kind != PoseMessageKind::PoseWithCovariance;
-        if from_log_time && headed {
-            self.from_log += 1;
-            self.health.note(Issue::StampFallback, stamp_ns, index);
-        }
-        if self.last_stamp.is_some_and(|last| stamp_ns < last) {
-            self.out_of_order += 1;
-            self.health.note(Issue::StampOrder, stamp_ns, index);
-        }
-        if headed && !from_log_time && self.last_stamp == Some(stamp_ns) {
-            self.health.note(Issue::FrozenStamp, stamp_ns, index);
-        }
-        self.last_stamp = Some(stamp_ns);
-        self.range = Some(match self.range {
-            Some((a, b)) => (a.min(stamp_ns), b.max(stamp_ns)),
-            None => (stamp_ns, stamp_ns),
-        });
-        if self.frame_id.is_none() && !d.frame_id.is_empty() {
-            self.frame_id = Some(d.frame_id.clone());
-        }
-        if self.child_frame_id.is_none() && !d.child_frame_id.is_empty() {
-            self.child_frame_id = Some(d.child_frame_id.clone());
-        }
-        let mut h = health::classify(&d.covariance, d.orientation_xyzw);
-        if let Some(trace) = h.position_trace {
-            h.issues.extend(self.trend.next(trace));
-        }
-        for issue in &h.issues {
-            self.health.note(*issue, stamp_ns, index);
-        }
-        if h.issues.contains(&Issue::NotPsd) {
-            let lo = h.min_eigenvalue.unwrap_or(0.0);
-            self.health.min_eigenvalue = Some(self.health.min_eigenvalue.map_or(lo, |m| m.min(lo)));
-        }
-        let usable = h.usable();
-        if usable {
-            self.usable += 1;
-            self.planar &= h.unestimated[2] && h.unestimated[3] && h.unestimated[4];
-            let dead_reckoned = self.kind == PoseMessageKind::Odometry
-                && self.frame_id.as_deref().is_some_and(is_odom_frame);
-            self.constancy
-                .next(index, stamp_ns, &d.covariance, d.position, dead_reckoned);
-            if d.position.iter().all(|v| v.is_finite()) {
-                self.trajectory.push(index, (stamp_ns, d.position));
-            }
-        }
-        let sigma = std::array::from_fn(|i| {
-            let v = d.covariance[i * 7];
-            (usable && !h.unestimated[i]).then(|| v.max(0.0).sqrt())
-        });
-        self.series.push(
-            index,
-            SeriesPoint {
-                stamp_ns,
-                sigma,
-                position_trace: h.position_trace,
-            },
-        );
-        if self.drawn.wants(index) {
-            let unusable = h.issues.iter().copied().filter(|i| i.unusable()).collect();
-            self.drawn.push(
-                index,
-                DrawnMessage {
-                    index,
-                    message: PoseMessage {
-                        stamp_ns,
-                        from_log_time,
-                        position: d.position,
-                        orientation_xyzw: d.orientation_xyzw,
-                        covariance: d.covariance,
-                        twist_covariance: d.twist_covariance,
-                    },
-                    unusable,
-                    unestimated: h.unestimated,
-                },
-            );
-        }
-    }
-
-    fn into_plan(self, name: String) -> TopicPlan {
-        let stride = self.drawn.stride();
-        let mut trajectory = self.trajectory.into_items();
-        trajectory.sort_by_key(|p| p.0);
-        let mut series = self.series.into_items();
-        series.sort_by_key(|p| p.stamp_ns);
-        let planar = self.planar && self.usable > 0;
-        let mut health = self.health;
-        if !planar && let Some(on_used_axes) = health.issues.remove(&Issue::Placeholder) {
-            // z, roll and pitch are axes a 3-D topic uses.
-            health.add(Issue::PlaceholderUsedAxis, on_used_axes);
-        }
-        if let Some(stretch) = self.constancy.finding() {
-            health.add(
-                Issue::Constant,
-                IssueCount {
-                    count: stretch.messages,
-                    first_stamp_ns: stretch.first_stamp_ns,
-                    first_index: stretch.first_index,
-                },
-            );
-            health.constant = Some(stretch);
-        }
-        TopicPlan {
-            name,
-            kind: self.kind,
-            frame_id: self.frame_id.unwrap_or_default(),
-            child_frame_id: self.child_frame_id.unwrap_or_default(),
-            count: self.count,
-            stamps_from_log_time: self.from_log,
-            stamps_out_of_order: self.out_of_order,
-            stamp_range: self.range,
-            health,
-            planar,
-            drawn: self.drawn.into_items(),
-            stride,
-            trajectory,
-            series,
-        }
-    }
 }
 
 #[cfg(test)]
