@@ -199,6 +199,27 @@ struct EvalArgs {
     /// Pose graphs: the optimiser, `lm` (Levenberg–Marquardt, default) or `gn` (Gauss–Newton).
     #[arg(long, value_name = "NAME", value_parser = ["lm", "gn"])]
     optimizer: Option<String>,
+    /// Pose graphs: the joint marginal of vertices A and B (ids), e.g. `--joint 5,9`
+    /// (repeatable): reported in `report --json` (`optimized.joints`) and drawn as the
+    /// relative pose's uncertainty, B as A sees it.
+    #[arg(long = "joint", value_name = "A,B", value_parser = parse_joint)]
+    joints: Vec<(u64, u64)>,
+}
+
+/// `A,B`: two vertex ids.
+fn parse_joint(text: &str) -> Result<(u64, u64), String> {
+    let parse = |s: &str| s.trim().parse::<u64>().ok();
+    match text.split_once(',') {
+        Some((a, b)) => match (parse(a), parse(b)) {
+            (Some(a), Some(b)) => Ok((a, b)),
+            _ => Err(format!(
+                "expected two vertex ids A,B (non-negative integers), got `{text}`"
+            )),
+        },
+        None => Err(format!(
+            "expected two vertex ids separated by a comma, A,B, got `{text}`"
+        )),
+    }
 }
 
 impl EvalArgs {
@@ -220,6 +241,7 @@ impl EvalArgs {
                 "gn" => Optimizer::GaussNewton,
                 _ => Optimizer::LevenbergMarquardt,
             }),
+            joints: self.joints.clone(),
         }
     }
 }

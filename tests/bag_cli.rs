@@ -164,7 +164,7 @@ fn errors_name_the_file_and_the_flag() {
     let (code, _, err) = run(&["camera_on_robot", "--every", "3", "--save", "x.rrd"]);
     assert_eq!(code, Some(2));
     assert!(
-        err.contains("--every 3: applies to robot logs (ROS 1 bags, MCAP files) only (it draws every N-th message of a log); this input is a scenario or a pose graph"),
+        err.contains("--every 3: applies to robot logs (ROS 1 bags, MCAP files) only (it draws every N-th message of a log); this input is a scenario"),
         "{err}"
     );
     let (code, _, err) = run(&["report", TEST2, "--block-samples", "4096"]);

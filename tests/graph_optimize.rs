@@ -9,30 +9,19 @@ use posecov::eval::graph::{
     Anchor, GraphReading, Optimizer, SolverSettings, Stop, edge_jacobians, optimize,
     relative_covariance,
 };
-use posecov::input::graph::read_text;
 use posecov::lie::{LieGroup, Se2, Se3, TangentMatrix};
+use posecov::plan::StepNoise;
 use posecov::plan::graph::{GraphEdge, GraphPrior, GraphVertex, PoseGraph};
-use posecov::plan::{AnyPlan, StepNoise};
 use posecov::propagate::odometry::propagate_increments_each;
 use posecov::uncertain::UncertainPose;
 use rand::{Rng, SeedableRng};
 
+#[path = "common/graph.rs"]
+mod graph_common;
+use graph_common::{block, dense_information, pose2_slam_example, se2_graph, se3_graph};
+
 const POSE2: &str = include_str!("data/gtsam/pose2example.txt");
 const POSE3: &str = include_str!("data/gtsam/pose3example.txt");
-
-fn se2_graph(text: &str) -> PoseGraph<Se2, 3> {
-    match read_text(text, "g.g2o").expect("valid").1.plan {
-        AnyPlan::Se2(p) => p.graph.expect("a graph"),
-        _ => panic!("planar"),
-    }
-}
-
-fn se3_graph(text: &str) -> PoseGraph<Se3, 6> {
-    match read_text(text, "g.g2o").expect("valid").1.plan {
-        AnyPlan::Se3(p) => p.graph.expect("a graph"),
-        _ => panic!("spatial"),
-    }
-}
 
 fn random_tangent<const N: usize>(rng: &mut impl Rng, scale: f64) -> SVector<f64, N> {
     SVector::<f64, N>::from_fn(|_, _| rng.random_range(-scale..scale))
@@ -51,7 +40,6 @@ fn check_jacobians<G: LieGroup<N>, const N: usize>(seed: u64) {
             to: 1,
             measurement: G::exp(&random_tangent(&mut rng, 2.0)),
             information: TangentMatrix::<N>::identity(),
-            information_gtsam: TangentMatrix::<N>::identity(),
             line: 1,
         };
         let (ji, jj) = edge_jacobians(&edge, &poses);
@@ -79,7 +67,6 @@ fn check_jacobians<G: LieGroup<N>, const N: usize>(seed: u64) {
             vertex: 0,
             measurement: edge.measurement,
             information: TangentMatrix::<N>::identity(),
-            information_gtsam: TangentMatrix::<N>::identity(),
             line: 1,
         };
         let analytic = G::jr_inv(&prior.residual(&poses));
@@ -100,42 +87,6 @@ fn check_jacobians<G: LieGroup<N>, const N: usize>(seed: u64) {
 fn edge_and_prior_jacobians_match_central_differences() {
     check_jacobians::<Se2, 3>(1);
     check_jacobians::<Se3, 6>(2);
-}
-
-/// H at `poses` as a dense matrix over the unknown vertices (tests only: tiny graphs).
-fn dense_information<G: LieGroup<N>, const N: usize>(
-    graph: &PoseGraph<G, N>,
-    poses: &[G],
-    unknown: &[usize],
-) -> DMatrix<f64> {
-    let n = unknown.len() * N;
-    let at = |v: usize| unknown.iter().position(|&u| u == v);
-    let mut h = DMatrix::<f64>::zeros(n, n);
-    let mut add = |a: Option<usize>, b: Option<usize>, m: SMatrix<f64, N, N>| {
-        if let (Some(a), Some(b)) = (a, b) {
-            let mut view = h.view_mut((a * N, b * N), (N, N));
-            view += m;
-        }
-    };
-    for e in &graph.edges {
-        let (ji, jj) = edge_jacobians(e, poses);
-        let l = e.information;
-        let (a, b) = (at(e.from), at(e.to));
-        add(a, a, ji.transpose() * l * ji);
-        add(b, b, jj.transpose() * l * jj);
-        add(a, b, ji.transpose() * l * jj);
-        add(b, a, jj.transpose() * l * ji);
-    }
-    for p in &graph.priors {
-        let j = G::jr_inv(&p.residual(poses));
-        let a = at(p.vertex);
-        add(a, a, j.transpose() * p.information * j);
-    }
-    h
-}
-
-fn block<const N: usize>(m: &DMatrix<f64>, a: usize, b: usize) -> SMatrix<f64, N, N> {
-    SMatrix::<f64, N, N>::from_fn(|p, q| m[(a * N + p, b * N + q)])
 }
 
 #[test]
@@ -253,7 +204,6 @@ fn a_chain_without_loop_closures_equals_first_order_propagation() {
             to: k as usize + 1,
             measurement: z,
             information,
-            information_gtsam: information,
             line: 0,
         });
         increments.push(z);
@@ -340,7 +290,6 @@ fn manhattan_walk(poses: usize, seed: u64) -> PoseGraph<Se2, 3> {
                 to: k,
                 measurement: z,
                 information: info,
-                information_gtsam: info,
                 line: 0,
             });
             guess = guess.compose(&z);
@@ -361,7 +310,6 @@ fn manhattan_walk(poses: usize, seed: u64) -> PoseGraph<Se2, 3> {
                     to: j,
                     measurement: z,
                     information: info,
-                    information_gtsam: info,
                     line: 0,
                 });
             }
@@ -404,7 +352,10 @@ fn levenberg_marquardt_converges_where_gauss_newton_is_stopped_as_diverged() {
         Stop::Diverged => {
             assert!(gn.chi2_after <= gn.chi2_before);
             assert!(!gn.log.last().unwrap().accepted);
-            assert!((graph.chi2(&gn.poses, false) - gn.chi2_after).abs() < 1e-9 * gn.chi2_after);
+            assert!(
+                (graph.chi2(&gn.poses, GraphReading::G2o) - gn.chi2_after).abs()
+                    < 1e-9 * gn.chi2_after
+            );
         }
         other => panic!("Gauss–Newton stopped as {other:?}"),
     }
@@ -513,16 +464,7 @@ fn gtsam_reading_changes_only_the_rotation_weight_in_3d() {
 /// result).marginalCovariance(i)`, numpy's 5 significant digits).
 #[test]
 fn gtsam_tutorial_pose2_slam_marginals() {
-    let info = "25 0 0 25 0 100";
-    let text = format!(
-        "VERTEX_SE2 1 0.5 0.0 0.2\nVERTEX_SE2 2 2.3 0.1 -0.2\nVERTEX_SE2 3 4.1 0.1 1.5707963267948966\n\
-         VERTEX_SE2 4 4.0 2.0 3.141592653589793\nVERTEX_SE2 5 2.1 2.1 -1.5707963267948966\n\
-         EDGE_PRIOR_SE2 1 0 0 0 11.111111111111111 0 0 11.111111111111111 0 100\n\
-         EDGE_SE2 1 2 2 0 0 {info}\nEDGE_SE2 2 3 2 0 1.5707963267948966 {info}\n\
-         EDGE_SE2 3 4 2 0 1.5707963267948966 {info}\nEDGE_SE2 4 5 2 0 1.5707963267948966 {info}\n\
-         EDGE_SE2 5 2 2 0 1.5707963267948966 {info}\n"
-    );
-    let graph = se2_graph(&text);
+    let graph = se2_graph(&pose2_slam_example());
     let s = optimize(&graph, &SolverSettings::default(), &mut |_| {}).unwrap();
     assert!(s.converged());
     let printed: [[[f64; 3]; 3]; 5] = [

@@ -498,88 +498,6 @@ fn formats_are_decided_by_content_and_extension() {
 }
 
 #[test]
-fn loop_closure_residuals_measure_the_estimates_with_the_edge_covariance() {
-    // Edge 0 → 2 says v2 = v0 · (2, 0, 0); v2's estimate is 0.1 m off in y, σ_y = 0.1 m: d = 1.
-    let text = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0.1 0\n\
-                EDGE_SE2 0 1 1 0 0 100 0 0 100 0 100\nEDGE_SE2 1 2 1 0.1 0 100 0 0 100 0 100\n\
-                EDGE_SE2 0 2 2 0 0 1 0 0 100 0 1\n";
-    let (graph, _) = read_text(text, "g.g2o").expect("valid");
-    let s = graph.summary();
-    assert_eq!(
-        (s.chain_edges, s.loop_closures, s.loop_closures_inconsistent),
-        (2, 1, 0)
-    );
-    let r = &s.worst_loop_closures[0];
-    assert_eq!((r.from, r.to, r.line), (0, 2, 6));
-    // r = Log(Z⁻¹ X_0⁻¹ X_2) = Log((0, 0.1, 0)) = (0, 0.1, 0) exactly (no rotation).
-    assert!((r.mahalanobis - 1.0).abs() < 1e-12, "{}", r.mahalanobis);
-    assert!((r.radius_95 - 2.795_483).abs() < 1e-6);
-
-    // GTSAM's pose3example: edge 3 → 0 (line 11) puts v0 about 1 m from v3, the estimates are
-    // 2.24 m apart: hundreds of σ. Edge 1 → 4 agrees.
-    let (graph, _) = read_text(POSE3, "pose3example.txt").expect("valid");
-    let s = graph.summary();
-    assert_eq!(s.loop_closures_inconsistent, 1);
-    let worst = &s.worst_loop_closures[0];
-    assert_eq!((worst.from, worst.to, worst.line), (3, 0, 11));
-    assert!(worst.mahalanobis > 100.0, "{}", worst.mahalanobis);
-    assert!(s.worst_loop_closures[1].mahalanobis < s.worst_loop_closures[1].radius_95);
-}
-
-#[test]
-fn mutated_graphs_are_refused_or_drawn_never_a_panic_or_a_bad_scene() {
-    // Replace each number of the GTSAM files, one at a time, by awkward values; every result
-    // is a located error or a valid scene.
-    use posecov::app::{AppError, Overrides};
-    let awkward = [
-        "0",
-        "-0",
-        "1e308",
-        "-1e308",
-        "1e-308",
-        "nan",
-        "-inf",
-        "18446744073709551616",
-        "",
-        "1e6",
-        "-1",
-    ];
-    let overrides = Overrides {
-        samples: Some(16),
-        ..Default::default()
-    };
-    let (mut drawn, mut refused) = (0, 0);
-    for text in [POSE2, OFFDIAGONAL, TOY] {
-        let tokens: Vec<&str> = text.split_whitespace().collect();
-        for (k, _) in tokens.iter().enumerate().skip(1).step_by(3) {
-            for value in awkward {
-                let mut mutated = tokens.clone();
-                mutated[k] = value;
-                let mutated = mutated
-                    .join(" ")
-                    .replace(" VERTEX", "\nVERTEX")
-                    .replace(" EDGE", "\nEDGE");
-                let Ok((source, input)) = open_text(&mutated, "m.g2o", Format::Graph) else {
-                    refused += 1;
-                    continue;
-                };
-                let loaded = posecov::app::Loaded { source, input };
-                match posecov::app::pipeline(&loaded, &overrides, None) {
-                    Ok(_) => drawn += 1,
-                    Err(AppError::Input(_)) => refused += 1,
-                    Err(e) => panic!("token {k} = {value:?}: {e}\n{mutated}"),
-                }
-            }
-        }
-    }
-    println!("{drawn} drawn, {refused} refused");
-    assert!(
-        drawn > 100 && refused > 100,
-        "{drawn} drawn, {refused} refused"
-    );
-}
-
-#[test]
 fn large_graphs_are_drawn_bounded_and_said_so() {
     let mut text = String::new();
     for k in 0..1000 {
@@ -607,7 +525,6 @@ fn large_graphs_are_drawn_bounded_and_said_so() {
         "{}",
         s.vertices_drawn
     );
-    assert_eq!(s.loop_closures_inconsistent, 0);
     assert!(!input.draw.labels);
     assert_eq!(input.draw.links.len(), s.loop_closures_drawn);
     let d = &input.about.description;

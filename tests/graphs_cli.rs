@@ -120,3 +120,36 @@ fn a_bad_graph_exits_1_naming_file_line_and_field() {
     assert!(stderr.starts_with(&want), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn joint_flag_reports_the_pair_and_refuses_what_is_not_a_pair_of_vertices() {
+    let file = "tests/data/gtsam/pose2example.txt";
+    let (ok, stdout, stderr) = run(&[
+        "report",
+        file,
+        "--json",
+        "--samples",
+        "64",
+        "--joint",
+        "3,10",
+    ]);
+    assert!(ok, "{stderr}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).expect("JSON");
+    assert_eq!(json["optimized"]["joints"][0]["b"], 10);
+    for (value, expected) in [
+        ("3", "expected two vertex ids separated by a comma"),
+        ("3,x", "expected two vertex ids A,B"),
+        (
+            "3,12",
+            "--joint 3,12: this pose graph has no vertex 12 (11 vertices, ids 0 ..= 10)",
+        ),
+    ] {
+        let (ok, _, stderr) = run(&["report", file, "--json", "--joint", value]);
+        assert!(!ok && stderr.contains(expected), "{value}: {stderr}");
+    }
+    let (ok, _, stderr) = run(&["report", "camera_on_robot", "--json", "--joint", "1,2"]);
+    assert!(
+        !ok && stderr.contains("--joint 1,2: applies to pose graphs"),
+        "{stderr}"
+    );
+}

@@ -43,6 +43,78 @@ pub struct Overrides {
     pub graph_reading: Option<GraphReading>,
     /// `--optimizer` (pose graphs).
     pub optimizer: Option<Optimizer>,
+    /// `--joint A,B` (repeatable; pose graphs): vertex ids whose joint marginal is wanted.
+    pub joints: Vec<(u64, u64)>,
+}
+
+/// What an input is, as far as flags go: a scenario or a pose graph (both plans), or a robot
+/// log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Given {
+    /// A TOML scenario.
+    Scenario,
+    /// A g2o / GTSAM pose graph.
+    PoseGraph,
+    /// A robot log.
+    Log,
+}
+
+impl Given {
+    /// The input in words ("this input is a robot log").
+    ///
+    /// ```
+    /// assert_eq!(posecov::app::Given::PoseGraph.name(), "a pose graph");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            Given::Scenario => "a scenario",
+            Given::PoseGraph => "a pose graph",
+            Given::Log => InputKind::Log.name(),
+        }
+    }
+
+    /// What a plan input is: a pose graph if its plan carries one.
+    fn of(input: &Input) -> Self {
+        if input.plan.graph_vertex_ids().is_some() {
+            Given::PoseGraph
+        } else {
+            Given::Scenario
+        }
+    }
+}
+
+/// The inputs a flag applies to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AppliesTo {
+    /// Scenarios and pose graphs ([`InputKind::Plan`]).
+    Plans,
+    /// Pose graphs only.
+    PoseGraphs,
+    /// Robot logs ([`InputKind::Log`]).
+    Logs,
+}
+
+impl AppliesTo {
+    /// Those inputs in words ("applies to pose graphs").
+    ///
+    /// ```
+    /// assert_eq!(posecov::app::AppliesTo::PoseGraphs.name_plural(), "pose graphs (g2o / GTSAM files)");
+    /// ```
+    pub fn name_plural(self) -> &'static str {
+        match self {
+            AppliesTo::Plans => InputKind::Plan.name_plural(),
+            AppliesTo::PoseGraphs => "pose graphs (g2o / GTSAM files)",
+            AppliesTo::Logs => InputKind::Log.name_plural(),
+        }
+    }
+
+    fn admits(self, given: Given) -> bool {
+        match self {
+            AppliesTo::Plans => given != Given::Log,
+            AppliesTo::PoseGraphs => given == Given::PoseGraph,
+            AppliesTo::Logs => given == Given::Log,
+        }
+    }
 }
 
 /// A command-line value the input cannot take: names the flag, the value and why.
@@ -58,19 +130,29 @@ pub enum SettingsError {
         /// What is accepted.
         expected: String,
     },
-    /// A flag for the other kind of input (`--every` on a scenario).
+    /// A flag for another kind of input (`--every` on a scenario, `--optimizer` on a log).
     #[error("{flag} {value}: applies to {} only ({why}); this input is {}", .applies_to.name_plural(), .given.name())]
     DoesNotApply {
         /// The flag.
         flag: &'static str,
         /// The value given.
         value: String,
-        /// The kind of input it applies to.
-        applies_to: InputKind,
-        /// The kind of input given.
-        given: InputKind,
+        /// The inputs it applies to.
+        applies_to: AppliesTo,
+        /// The input given.
+        given: Given,
         /// What the flag does.
         why: &'static str,
+    },
+    /// `--joint` names a vertex the pose graph does not have, or the same vertex twice.
+    #[error("{flag} {value}: {reason}")]
+    Vertex {
+        /// The flag.
+        flag: &'static str,
+        /// The value given.
+        value: String,
+        /// What is wrong, with the ids the graph has.
+        reason: String,
     },
 }
 
@@ -78,41 +160,93 @@ pub enum SettingsError {
 /// table every input's flags are checked against.
 fn kind_flags(
     overrides: &Overrides,
-) -> [(&'static str, InputKind, &'static str, Option<String>); 4] {
+) -> [(&'static str, AppliesTo, &'static str, Option<String>); 7] {
     [
         (
             "--topic",
-            InputKind::Log,
+            AppliesTo::Logs,
             "it picks which of a log's topics to read",
             overrides.topics.first().cloned(),
         ),
         (
             "--every",
-            InputKind::Log,
+            AppliesTo::Logs,
             "it draws every N-th message of a log",
             overrides.every.map(|n| n.to_string()),
         ),
         (
             "--ros-reading",
-            InputKind::Log,
+            AppliesTo::Logs,
             "it says how a log's PoseWithCovariance covariances are read (a scenario says it with `reading` in a pose's `cov`)",
             overrides.ros_reading.map(|r| r.name().to_owned()),
         ),
         (
             "--block-samples",
-            InputKind::Plan,
+            AppliesTo::Plans,
             "Monte Carlo particles held at once; a log draws one cloud of --samples points per message",
             overrides.block_samples.map(|n| n.to_string()),
+        ),
+        (
+            "--graph-reading",
+            AppliesTo::PoseGraphs,
+            "it says how a g2o file's information matrices are read, as g2o or as GTSAM does",
+            overrides.graph_reading.map(|r| r.name().to_owned()),
+        ),
+        (
+            "--optimizer",
+            AppliesTo::PoseGraphs,
+            "it picks the optimiser of a pose graph, Levenberg–Marquardt or Gauss–Newton",
+            overrides.optimizer.map(|o| o.name().to_owned()),
+        ),
+        (
+            "--joint",
+            AppliesTo::PoseGraphs,
+            "it asks for the joint marginal of two poses of a pose graph",
+            overrides.joints.first().map(|&(a, b)| joint_text(a, b)),
         ),
     ]
 }
 
-/// Refuses the first flag given that does not apply to an input of kind `given`, naming it and
-/// what it is for; then checks the flags every input takes.
-fn check_flags(given: InputKind, overrides: &Overrides) -> Result<(), SettingsError> {
+/// `--joint`'s value as it is written: `A,B`.
+fn joint_text(a: u64, b: u64) -> String {
+    format!("{a},{b}")
+}
+
+/// Checks every `--joint` pair against the graph's vertex ids (ascending): two different
+/// vertices it has.
+fn check_joints(joints: &[(u64, u64)], ids: &[u64]) -> Result<(), SettingsError> {
+    for &(a, b) in joints {
+        let error = |reason: String| SettingsError::Vertex {
+            flag: "--joint",
+            value: joint_text(a, b),
+            reason,
+        };
+        if a == b {
+            return Err(error(format!(
+                "name two different vertices (the marginal of v{a} alone is in every report)"
+            )));
+        }
+        if let Some(id) = [a, b].into_iter().find(|id| ids.binary_search(id).is_err()) {
+            let range = match (ids.first(), ids.last()) {
+                (Some(first), Some(last)) => {
+                    format!("{} vertices, ids {first} ..= {last}", ids.len())
+                }
+                _ => "no vertices".to_owned(),
+            };
+            return Err(error(format!(
+                "this pose graph has no vertex {id} ({range})"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses the first flag given that does not apply to the input `given`, naming it and what
+/// it is for.
+fn check_flags(given: Given, overrides: &Overrides) -> Result<(), SettingsError> {
     for (flag, applies_to, why, value) in kind_flags(overrides) {
         if let Some(value) = value
-            && applies_to != given
+            && !applies_to.admits(given)
         {
             return Err(SettingsError::DoesNotApply {
                 flag,
@@ -154,7 +288,10 @@ pub fn resolve(
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<Settings, SettingsError> {
     let file = &input.defaults;
-    check_flags(InputKind::Plan, overrides)?;
+    check_flags(Given::of(input), overrides)?;
+    if let Some(ids) = input.plan.graph_vertex_ids() {
+        check_joints(&overrides.joints, &ids)?;
+    }
     if let Some(n) = overrides.samples
         && let Err(expected) = limits::check_samples(n)
     {
@@ -196,6 +333,7 @@ pub fn resolve(
                 optimizer: overrides.optimizer.unwrap_or_default(),
                 reading: overrides.graph_reading.unwrap_or_default(),
                 confidence,
+                joints: overrides.joints.clone(),
             },
         },
         draw: DrawSettings {
@@ -228,7 +366,7 @@ pub struct LogSettings {
 /// assert_eq!(resolve_log(&Overrides::default()).unwrap().eval.cloud_samples, 100);
 /// ```
 pub fn resolve_log(overrides: &Overrides) -> Result<LogSettings, SettingsError> {
-    check_flags(InputKind::Log, overrides)?;
+    check_flags(Given::Log, overrides)?;
     let samples = overrides.samples.unwrap_or(DEFAULT_CLOUD_SAMPLES as u64);
     if !(1..=MAX_CLOUD_SAMPLES).contains(&samples) {
         return Err(SettingsError::OutOfRange {

@@ -199,6 +199,8 @@ fn judge(text: &str, run: Run<Result<Output, String>>, limits: &Limits) -> Vec<F
                 // failed (then a finding says why).
                 ".optimized.poses[#].covariance",
                 ".optimized.loop_closures[#].relative_covariance",
+                ".optimized.joints[#].covariance",
+                ".optimized.joints[#].relative_covariance",
             ];
             if let Some(path) = json_null(&out.json, &optional) {
                 found.push(finding("nonfinite_json", format!("null at {path}")));

@@ -1,21 +1,21 @@
 //! A plan's pose graph evaluated: optimised, every marginal, each loop closure's residual
-//! before and after at the chosen confidence, and the findings to tell (outliers, parts,
-//! duplicated edges, a solve that did not converge).
+//! before and after at the chosen confidence, the joint marginals asked for, and the
+//! findings to tell (outliers, parts, duplicated edges, a solve that did not converge).
 
-use crate::uncertain::Confidence;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::lie::{LieGroup, Tangent, TangentMatrix};
 use crate::plan::graph::PoseGraph;
+use crate::uncertain::Confidence;
 
 use super::{
-    GraphReading, Iteration, Optimizer, Solution, SolverSettings, SparseError, Stop,
+    Anchor, GraphReading, Iteration, Joint, Optimizer, Solution, SolverSettings, SparseError, Stop,
     relative_covariance,
 };
 
 /// The settings of a graph's evaluation (resolved by `app/`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct GraphSettings {
     /// Gauss–Newton or Levenberg–Marquardt.
     pub optimizer: Optimizer,
@@ -23,6 +23,8 @@ pub struct GraphSettings {
     pub reading: GraphReading,
     /// Probability inside the region a loop closure's residual is measured against.
     pub confidence: Confidence,
+    /// Pairs of vertex ids (a, b) whose joint marginal is wanted (`--joint a,b`).
+    pub joints: Vec<(u64, u64)>,
 }
 
 impl Default for GraphSettings {
@@ -31,8 +33,42 @@ impl Default for GraphSettings {
             optimizer: Optimizer::default(),
             reading: GraphReading::default(),
             confidence: Confidence::DEFAULT,
+            joints: Vec::new(),
         }
     }
+}
+
+/// Why a graph could not be evaluated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GraphError {
+    /// The linear algebra cannot take it on (too large) or failed.
+    #[error(transparent)]
+    Sparse(#[from] SparseError),
+    /// A joint marginal was asked for a vertex id the graph does not have.
+    #[error("no vertex has id {id} (a joint marginal was asked for it)")]
+    UnknownVertex {
+        /// The id.
+        id: u64,
+    },
+}
+
+/// The joint marginal of two poses a, b and what it says about X_a⁻¹ X_b.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointMarginal<G, const N: usize> {
+    /// Vertex id a.
+    pub a: u64,
+    /// Vertex id b.
+    pub b: u64,
+    /// (Σ_aa, Σ_ab, Σ_bb) over [δ_a; δ_b] (right form; zero blocks for a vertex held fixed;
+    /// None for a vertex nothing reaches, or without marginals).
+    pub blocks: Option<Joint<N>>,
+    /// X_a⁻¹ X_b at the optimised poses.
+    pub relative_pose: G,
+    /// Cov(Log((X̂_a⁻¹ X̂_b)⁻¹ X_a⁻¹ X_b)), the right-form covariance of the relative pose to
+    /// first order ([`relative_covariance`]); None where `blocks` is, or when a and b lie in
+    /// different parts (each part's gauge is its own: the graph does not say where one part
+    /// is from the other).
+    pub relative_cov: Option<TangentMatrix<N>>,
 }
 
 /// A loop closure (every edge but the first between consecutive ids k, k + 1), measured
@@ -55,7 +91,7 @@ pub struct LoopClosure<const N: usize> {
     pub residual: Tangent<N>,
     /// d at the optimised poses.
     pub mahalanobis: f64,
-    /// The covariance of X_i⁻¹ X_j from the joint marginal (None where an end is fixed).
+    /// The covariance of X_i⁻¹ X_j from the joint marginal (None without marginals).
     pub relative_cov: Option<TangentMatrix<N>>,
 }
 
@@ -70,6 +106,8 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
     pub solution: Solution<G, N>,
     /// Every loop closure.
     pub loop_closures: Vec<LoopClosure<N>>,
+    /// The joint marginals asked for ([`GraphSettings::joints`]), in order.
+    pub joints: Vec<JointMarginal<G, N>>,
     /// The confidence the residuals are measured at.
     pub confidence: Confidence,
     /// √χ²_N(confidence): a residual beyond it is an outlier.
@@ -80,21 +118,76 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
     pub edge_chi2: Vec<f64>,
 }
 
-/// Optimises `graph` and measures its loop closures at `settings.confidence`.
+/// Optimises `graph`, measures its loop closures at `settings.confidence` and computes the
+/// joint marginals of `settings.joints`.
+///
+/// ```
+/// use posecov::eval::graph::{GraphSettings, evaluate_graph};
+/// use posecov::input::graph::read_text;
+/// use posecov::plan::AnyPlan;
+/// let text = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0 0\n\
+///             EDGE_SE2 0 1 1 0 0 100 0 0 100 0 400\nEDGE_SE2 1 2 1 0 0 100 0 0 100 0 400\n\
+///             EDGE_SE2 0 2 2.1 0 0 100 0 0 100 0 400\n";
+/// let AnyPlan::Se2(plan) = read_text(text, "g.g2o").unwrap().1.plan else { unreachable!() };
+/// let settings = GraphSettings { joints: vec![(1, 2)], ..Default::default() };
+/// let g = evaluate_graph(plan.graph.as_ref().unwrap(), &settings, None, &mut |_| {}).unwrap();
+/// assert_eq!(g.loop_closures.len(), 1); // 0 → 2
+/// assert!(g.loop_closures[0].mahalanobis < g.loop_closures[0].mahalanobis_before);
+/// let joint = &g.joints[0];
+/// assert!(joint.relative_cov.unwrap()[(0, 0)] > 0.0);
+/// let wrong = GraphSettings { joints: vec![(1, 7)], ..Default::default() };
+/// let e = evaluate_graph(plan.graph.as_ref().unwrap(), &wrong, None, &mut |_| {}).unwrap_err();
+/// assert_eq!(e.to_string(), "no vertex has id 7 (a joint marginal was asked for it)");
+/// ```
 pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
     graph: &PoseGraph<G, N>,
     settings: &GraphSettings,
     cancel: Option<Arc<AtomicBool>>,
     progress: &mut dyn FnMut(&Iteration),
-) -> Result<GraphEvaluation<G, N>, SparseError> {
+) -> Result<GraphEvaluation<G, N>, GraphError> {
+    let index = |id: u64| {
+        graph
+            .vertices
+            .binary_search_by_key(&id, |v| v.id)
+            .map_err(|_| GraphError::UnknownVertex { id })
+    };
+    let pairs = settings
+        .joints
+        .iter()
+        .map(|&(a, b)| Ok((index(a)?, index(b)?)))
+        .collect::<Result<Vec<_>, GraphError>>()?;
     let solver = SolverSettings {
         optimizer: settings.optimizer,
         reading: settings.reading,
+        pairs,
         cancel,
         ..SolverSettings::default()
     };
     let solution = super::optimize(graph, &solver, progress)?;
-    let gtsam = settings.reading == GraphReading::Gtsam;
+    let isolated = |v: usize| {
+        matches!(
+            solution.parts[solution.part_of[v]].anchor,
+            Anchor::Isolated { .. }
+        )
+    };
+    let joints = solver
+        .pairs
+        .iter()
+        .zip(&solution.joints)
+        .map(|(&(a, b), blocks)| {
+            let (xa, xb) = (&solution.poses[a], &solution.poses[b]);
+            let blocks = blocks.filter(|_| !isolated(a) && !isolated(b));
+            JointMarginal {
+                a: graph.vertices[a].id,
+                b: graph.vertices[b].id,
+                blocks,
+                relative_pose: xa.inverse().compose(xb),
+                relative_cov: blocks
+                    .filter(|_| solution.part_of[a] == solution.part_of[b])
+                    .map(|joint| relative_covariance(xa, xb, &joint)),
+            }
+        })
+        .collect();
     let initial = graph.estimates();
     let mut first_of: std::collections::HashMap<(usize, usize), usize> = Default::default();
     let mut duplicates = Vec::new();
@@ -112,7 +205,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         if i.abs_diff(j) == 1 && chain_taken.insert((i.min(j), i.max(j))) {
             continue;
         }
-        let lambda = e.information_in(gtsam);
+        let lambda = e.information_in(settings.reading);
         let distance = |r: &Tangent<N>| (r.transpose() * lambda * r)[(0, 0)].max(0.0).sqrt();
         let residual_before = e.residual(&initial);
         let residual = e.residual(&solution.poses);
@@ -135,7 +228,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         .iter()
         .map(|e| {
             let r = e.residual(&solution.poses);
-            (r.transpose() * e.information_in(gtsam) * r)[(0, 0)]
+            (r.transpose() * e.information_in(settings.reading) * r)[(0, 0)]
         })
         .collect();
     Ok(GraphEvaluation {
@@ -143,6 +236,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         initial,
         solution,
         loop_closures,
+        joints,
         confidence: settings.confidence,
         radius: settings.confidence.radius(N),
         duplicates,

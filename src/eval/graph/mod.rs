@@ -35,7 +35,7 @@
 //! }
 //! let info = nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(100.0, 100.0, 400.0));
 //! for (from, to) in [(0, 1), (1, 2)] {
-//!     graph.edges.push(GraphEdge { from, to, measurement: Se2::from_xy_theta(1.0, 0.0, 0.0), information: info, information_gtsam: info, line: 0 });
+//!     graph.edges.push(GraphEdge { from, to, measurement: Se2::from_xy_theta(1.0, 0.0, 0.0), information: info, line: 0 });
 //! }
 //! let s = optimize(&graph, &SolverSettings::default(), &mut |_| {}).unwrap();
 //! assert!(s.converged() && s.chi2_after < 1e-20);
@@ -61,9 +61,14 @@ mod report;
 mod solve;
 pub mod sparse;
 
-pub use evaluate::{GraphEvaluation, GraphSettings, LoopClosure, evaluate_graph};
-pub use parts::{Anchor, Part};
-pub use report::{LoopClosureRecord, OptimizedReport, PoseRecord, Seconds, StopCriteria};
+pub use crate::plan::graph::GraphReading;
+pub use evaluate::{
+    GraphError, GraphEvaluation, GraphSettings, JointMarginal, LoopClosure, evaluate_graph,
+};
+pub use parts::{Anchor, Part, Parts, parts};
+pub use report::{
+    JointRecord, LoopClosureRecord, OptimizedReport, PoseRecord, Seconds, StopCriteria,
+};
 pub use solve::edge_jacobians;
 pub use sparse::{MAX_FACTOR_NONZEROS, SparseError};
 
@@ -76,19 +81,6 @@ pub enum Optimizer {
     LevenbergMarquardt,
     /// Gauss–Newton: undamped steps; stops as diverged when a step raises χ².
     GaussNewton,
-}
-
-/// How the file's information matrices are read ([CONVENTIONS §10]).
-///
-/// [CONVENTIONS §10]: crate::conventions#10-pose-graphs-g2o-and-gtsam
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum GraphReading {
-    /// As g2o defines them (`EDGE_SE3:QUAT`: over the quaternion's vector part, ≈ θ/2).
-    #[default]
-    G2o,
-    /// As GTSAM's `readG2o` reads them (over the rotation vector, no half-angle factor).
-    Gtsam,
 }
 
 /// The optimiser, its stop criteria and the reading (see the [module docs](self)).
@@ -104,6 +96,9 @@ pub struct SolverSettings {
     pub absolute_tolerance: f64,
     /// The reading of the information matrices.
     pub reading: GraphReading,
+    /// Pairs of vertices (indices into the graph's vertices) whose joint marginal is wanted
+    /// besides every edge's ([`Solution::joints`]).
+    pub pairs: Vec<(usize, usize)>,
     /// Set to stop between iterations (Ctrl-C): the last accepted estimate is kept.
     pub cancel: Option<Arc<AtomicBool>>,
 }
@@ -116,6 +111,7 @@ impl Default for SolverSettings {
             relative_tolerance: 1e-5,
             absolute_tolerance: 1e-5,
             reading: GraphReading::default(),
+            pairs: Vec::new(),
             cancel: None,
         }
     }
@@ -126,6 +122,20 @@ impl SolverSettings {
         self.cancel
             .as_ref()
             .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+}
+
+impl Optimizer {
+    /// The flag's value: `lm` or `gn`.
+    ///
+    /// ```
+    /// assert_eq!(posecov::eval::graph::Optimizer::GaussNewton.name(), "gn");
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            Optimizer::LevenbergMarquardt => "lm",
+            Optimizer::GaussNewton => "gn",
+        }
     }
 }
 
@@ -189,11 +199,15 @@ pub struct Solution<G: LieGroup<N>, const N: usize> {
     /// Each vertex's marginal covariance, right form [ρ; θ] (None: held fixed, isolated, or
     /// the marginals failed, see `marginals_error`).
     pub covariances: Vec<Option<TangentMatrix<N>>>,
-    /// The joint marginal (Σ_ii, Σ_ij, Σ_jj) of each edge's two poses, by edge (None where
-    /// either end is held fixed).
-    pub edge_joints: Vec<Option<[TangentMatrix<N>; 3]>>,
+    /// The joint marginal (Σ_ii, Σ_ij, Σ_jj) of each edge's two poses, by edge (a vertex held
+    /// fixed has zero blocks; None: no marginals).
+    pub edge_joints: Vec<Option<Joint<N>>>,
+    /// The joint marginal of each of [`SolverSettings::pairs`], in order (as `edge_joints`).
+    pub joints: Vec<Option<Joint<N>>>,
     /// The graph's connected parts and their anchors.
     pub parts: Vec<Part>,
+    /// Per vertex: its part (an index into `parts`).
+    pub part_of: Vec<usize>,
     /// Why there are no marginals, if there are none.
     pub marginals_error: Option<String>,
     /// Scalar unknowns.
@@ -222,9 +236,12 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
     settings: &SolverSettings,
     progress: &mut dyn FnMut(&Iteration),
 ) -> Result<Solution<G, N>, SparseError> {
-    let (parts, fixed) = parts::parts(graph);
-    let gtsam = settings.reading == GraphReading::Gtsam;
-    let mut problem = solve::Problem::new(graph, &fixed, gtsam)?;
+    let parts::Parts {
+        parts,
+        fixed,
+        part_of,
+    } = parts::parts(graph);
+    let mut problem = solve::Problem::new(graph, &fixed, settings.reading)?;
     let start = graph.estimates();
     let chi2_before = problem.chi2(&start);
     let clock = Instant::now();
@@ -233,8 +250,16 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
     let clock = Instant::now();
     let mut covariances = vec![None; graph.vertices.len()];
     let mut edge_joints = vec![None; graph.edges.len()];
-    let marginals_error =
-        marginals_at(&mut problem, &run.poses, &mut covariances, &mut edge_joints).err();
+    let mut joints = vec![None; settings.pairs.len()];
+    let marginals_error = marginals_at(
+        &mut problem,
+        &run.poses,
+        &settings.pairs,
+        &mut covariances,
+        &mut edge_joints,
+        &mut joints,
+    )
+    .err();
     let marginals_seconds = clock.elapsed().as_secs_f64();
     Ok(Solution {
         optimizer: settings.optimizer,
@@ -247,7 +272,9 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
         poses: run.poses,
         covariances,
         edge_joints,
+        joints,
         parts,
+        part_of,
         marginals_error,
         unknowns: problem.system.unknowns(),
         factor_nonzeros: problem.system.factor_nonzeros(),
@@ -256,36 +283,57 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
     })
 }
 
-/// Every unknown pose's marginal and every edge's joint marginal from the undamped H at
-/// `poses`.
+/// The joint marginal of two poses a, b: (Σ_aa, Σ_ab, Σ_bb), the blocks of H⁻¹ over
+/// [δ_a; δ_b] (right form, [ρ; θ]; Σ_ba = Σ_abᵀ).
+pub type Joint<const N: usize> = [TangentMatrix<N>; 3];
+
+/// Every unknown pose's marginal, every edge's joint marginal and the joint marginal of each
+/// of `pairs` from the undamped H at `poses`. A block in the factor's pattern (every pose's,
+/// every edge's) comes from the selected inverse; another pair's Σ_ab from two block solves
+/// with the same factor ([`marginals::joint_by_solves`]). A vertex held fixed has zero blocks.
 fn marginals_at<G: LieGroup<N>, const N: usize>(
     problem: &mut solve::Problem<'_, G, N>,
     poses: &[G],
+    pairs: &[(usize, usize)],
     covariances: &mut [Option<TangentMatrix<N>>],
-    edge_joints: &mut [Option<[TangentMatrix<N>; 3]>],
+    edge_joints: &mut [Option<Joint<N>>],
+    joints: &mut [Option<Joint<N>>],
 ) -> Result<(), String> {
     if problem.system.unknowns() == 0 {
+        let zero = [TangentMatrix::<N>::zeros(); 3];
+        edge_joints.iter_mut().for_each(|j| *j = Some(zero));
+        joints.iter_mut().for_each(|j| *j = Some(zero));
         return Ok(());
     }
     problem.linearize(poses);
     problem.system.factorize().map_err(|e| e.to_string())?;
     let inverse = marginals::selected_inverse(&problem.system)
         .ok_or("selected inversion met an entry outside the factor's pattern")?;
-    for (v, block) in problem.block_of.iter().enumerate() {
+    let system = &problem.system;
+    let block_of = &problem.block_of;
+    let diagonal = |v: usize| match block_of[v] {
+        Some(b) => inverse.block::<N>(b, b),
+        None => Some(TangentMatrix::<N>::zeros()),
+    };
+    let joint = |a: usize, b: usize| -> Option<Joint<N>> {
+        let cross = match (block_of[a], block_of[b]) {
+            (Some(ba), Some(bb)) => inverse
+                .block::<N>(ba, bb)
+                .unwrap_or_else(|| marginals::joint_by_solves(system, ba, bb)),
+            _ => TangentMatrix::<N>::zeros(),
+        };
+        Some([diagonal(a)?, cross, diagonal(b)?])
+    };
+    for (v, block) in block_of.iter().enumerate() {
         if let Some(b) = block {
             covariances[v] = inverse.block::<N>(*b, *b);
         }
     }
     for (k, e) in problem.graph.edges.iter().enumerate() {
-        if let (Some(bi), Some(bj)) = (problem.block_of[e.from], problem.block_of[e.to])
-            && let (Some(ii), Some(ij), Some(jj)) = (
-                inverse.block::<N>(bi, bi),
-                inverse.block::<N>(bi, bj),
-                inverse.block::<N>(bj, bj),
-            )
-        {
-            edge_joints[k] = Some([ii, ij, jj]);
-        }
+        edge_joints[k] = joint(e.from, e.to);
+    }
+    for (k, &(a, b)) in pairs.iter().enumerate() {
+        joints[k] = joint(a, b);
     }
     Ok(())
 }

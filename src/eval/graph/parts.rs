@@ -43,8 +43,35 @@ pub struct Part {
     pub anchor: Anchor,
 }
 
-/// The parts and, per vertex, whether it is held fixed (not an unknown).
-pub fn parts<G: LieGroup<N>, const N: usize>(graph: &PoseGraph<G, N>) -> (Vec<Part>, Vec<bool>) {
+/// A graph's parts and what they hold fixed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Parts {
+    /// Every part, in the order of its smallest vertex.
+    pub parts: Vec<Part>,
+    /// Per vertex: whether it is held fixed (not an unknown).
+    pub fixed: Vec<bool>,
+    /// Per vertex: its part (an index into `parts`).
+    pub part_of: Vec<usize>,
+}
+
+/// The parts of `graph`: each is anchored by its priors or `FIX` records, else by holding its
+/// first vertex; a vertex nothing reaches is its own part ([`Anchor`]).
+///
+/// ```
+/// use posecov::eval::graph::{Anchor, parts};
+/// use posecov::lie::{LieGroup, Se2};
+/// use posecov::plan::graph::{GraphEdge, GraphVertex, PoseGraph};
+/// let mut g = PoseGraph::<Se2, 3>::default();
+/// for id in 0..3 {
+///     g.vertices.push(GraphVertex { id, estimate: Se2::identity(), line: 0 });
+/// }
+/// g.edges.push(GraphEdge { from: 0, to: 1, measurement: Se2::identity(), information: nalgebra::Matrix3::identity(), line: 4 });
+/// let p = parts(&g);
+/// assert_eq!(p.part_of, vec![0, 0, 1]);
+/// assert_eq!(p.parts[1].anchor, Anchor::Isolated { id: 2 });
+/// assert_eq!(p.fixed, vec![true, false, true]);
+/// ```
+pub fn parts<G: LieGroup<N>, const N: usize>(graph: &PoseGraph<G, N>) -> Parts {
     let n = graph.vertices.len();
     let mut parent: Vec<usize> = (0..n).collect();
     fn root(parent: &mut [usize], mut a: usize) -> usize {
@@ -77,7 +104,11 @@ pub fn parts<G: LieGroup<N>, const N: usize>(graph: &PoseGraph<G, N>) -> (Vec<Pa
         members.entry(r).or_default().push(v);
     }
     let mut out = Vec::new();
+    let mut part_of = vec![0; n];
     for (r, vs) in members {
+        for &v in &vs {
+            part_of[v] = out.len();
+        }
         let first_id = graph.vertices[r].id;
         let fixed_ids: Vec<u64> = vs
             .iter()
@@ -102,5 +133,9 @@ pub fn parts<G: LieGroup<N>, const N: usize>(graph: &PoseGraph<G, N>) -> (Vec<Pa
             anchor,
         });
     }
-    (out, fixed)
+    Parts {
+        parts: out,
+        fixed,
+        part_of,
+    }
 }

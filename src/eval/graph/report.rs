@@ -3,7 +3,7 @@
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::uncertain::Confidence;
 
-use super::{GraphEvaluation, GraphReading, Iteration, Optimizer, Part, Stop};
+use super::{GraphEvaluation, GraphReading, Iteration, Joint, Optimizer, Part, Stop};
 
 /// One optimised pose.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -42,6 +42,22 @@ pub struct LoopClosureRecord {
     pub relative_covariance: Option<Vec<Vec<f64>>>,
 }
 
+/// The joint marginal of two poses (`--joint a,b`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct JointRecord {
+    /// Vertex a.
+    pub a: u64,
+    /// Vertex b.
+    pub b: u64,
+    /// The 2N×2N covariance over [δ_a; δ_b] (right form, [ρ; θ] each), row by row: the blocks
+    /// Σ_aa, Σ_ab / Σ_ba, Σ_bb of H⁻¹ (`null`: a vertex nothing reaches, or no marginals).
+    pub covariance: Option<Vec<Vec<f64>>>,
+    /// X_a⁻¹ X_b at the optimised poses, as g2o writes a pose.
+    pub relative_pose: Vec<f64>,
+    /// Its right-form covariance to first order (`null` across unconnected parts).
+    pub relative_covariance: Option<Vec<Vec<f64>>>,
+}
+
 /// `report --json`'s `optimized` object.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct OptimizedReport {
@@ -70,6 +86,8 @@ pub struct OptimizedReport {
     pub poses: Vec<PoseRecord>,
     /// Every loop closure.
     pub loop_closures: Vec<LoopClosureRecord>,
+    /// The joint marginals asked for (`--joint a,b`), in order.
+    pub joints: Vec<JointRecord>,
     /// The confidence of `radius`.
     pub confidence: Confidence,
     /// χ² of each edge at the optimised poses, in file order.
@@ -105,6 +123,23 @@ pub struct Seconds {
 fn rows<const N: usize>(m: &TangentMatrix<N>) -> Vec<Vec<f64>> {
     (0..N)
         .map(|r| (0..N).map(|c| m[(r, c)]).collect())
+        .collect()
+}
+
+/// [[Σ_aa, Σ_ab], [Σ_abᵀ, Σ_bb]] row by row.
+fn joint_rows<const N: usize>(j: &Joint<N>) -> Vec<Vec<f64>> {
+    let [aa, ab, bb] = j;
+    (0..2 * N)
+        .map(|r| {
+            (0..2 * N)
+                .map(|c| match (r < N, c < N) {
+                    (true, true) => aa[(r, c)],
+                    (true, false) => ab[(r, c - N)],
+                    (false, true) => ab[(c, r - N)],
+                    (false, false) => bb[(r - N, c - N)],
+                })
+                .collect()
+        })
         .collect()
 }
 
@@ -166,6 +201,17 @@ impl<G: LieGroup<N>, const N: usize> GraphEvaluation<G, N> {
                     radius: self.radius,
                     outlier: l.mahalanobis > self.radius,
                     relative_covariance: l.relative_cov.as_ref().map(rows),
+                })
+                .collect(),
+            joints: self
+                .joints
+                .iter()
+                .map(|j| JointRecord {
+                    a: j.a,
+                    b: j.b,
+                    covariance: j.blocks.as_ref().map(joint_rows),
+                    relative_pose: g2o_values(&j.relative_pose),
+                    relative_covariance: j.relative_cov.as_ref().map(rows),
                 })
                 .collect(),
             confidence: self.confidence,

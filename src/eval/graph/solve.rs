@@ -10,7 +10,7 @@
 //! Each step solves (H + λ I) δ = −g with H = Σ Jᵀ Λ J, g = Σ Jᵀ Λ r.
 
 use crate::lie::{LieGroup, Tangent, TangentMatrix};
-use crate::plan::graph::{GraphEdge, PoseGraph};
+use crate::plan::graph::{GraphEdge, GraphReading, PoseGraph};
 
 use super::sparse::{BlockSystem, SparseError};
 use super::{Iteration, Optimizer, SolverSettings, Stop};
@@ -21,7 +21,7 @@ use super::{Iteration, Optimizer, SolverSettings, Stop};
 /// use posecov::eval::graph::edge_jacobians;
 /// use posecov::lie::{LieGroup, Se2};
 /// use posecov::plan::graph::GraphEdge;
-/// let e = GraphEdge { from: 0, to: 1, measurement: Se2::from_xy_theta(1.0, 0.0, 0.3), information: nalgebra::Matrix3::identity(), information_gtsam: nalgebra::Matrix3::identity(), line: 1 };
+/// let e = GraphEdge { from: 0, to: 1, measurement: Se2::from_xy_theta(1.0, 0.0, 0.3), information: nalgebra::Matrix3::identity(), line: 1 };
 /// let poses = [Se2::from_xy_theta(0.1, 0.2, 0.3), Se2::from_xy_theta(1.0, 0.5, 0.7)];
 /// let (ji, jj) = edge_jacobians(&e, &poses);
 /// // Moving both poses together (the same world-frame motion) leaves the residual unchanged:
@@ -47,14 +47,14 @@ pub(super) struct Problem<'a, G: LieGroup<N>, const N: usize> {
     /// Per vertex: its block among the unknowns (None: held fixed).
     pub block_of: Vec<Option<usize>>,
     pub system: BlockSystem<N>,
-    pub gtsam: bool,
+    pub reading: GraphReading,
 }
 
 impl<'a, G: LieGroup<N>, const N: usize> Problem<'a, G, N> {
     pub fn new(
         graph: &'a PoseGraph<G, N>,
         fixed: &[bool],
-        gtsam: bool,
+        reading: GraphReading,
     ) -> Result<Self, SparseError> {
         let mut block_of = Vec::with_capacity(graph.vertices.len());
         let mut blocks = 0;
@@ -73,7 +73,7 @@ impl<'a, G: LieGroup<N>, const N: usize> Problem<'a, G, N> {
             graph,
             system: BlockSystem::new(blocks, &pairs)?,
             block_of,
-            gtsam,
+            reading,
         })
     }
 
@@ -93,7 +93,7 @@ impl<'a, G: LieGroup<N>, const N: usize> Problem<'a, G, N> {
             }
             let r = e.residual(poses);
             let (ji, jj) = edge_jacobians(e, poses);
-            let lambda = e.information_in(self.gtsam);
+            let lambda = e.information_in(self.reading);
             let (li, lj) = (lambda * ji, lambda * jj);
             if let Some(bi) = bi {
                 self.system.add(bi, bi, &(ji.transpose() * li));
@@ -113,7 +113,7 @@ impl<'a, G: LieGroup<N>, const N: usize> Problem<'a, G, N> {
             };
             let r = p.residual(poses);
             let j = G::jr_inv(&r);
-            let lj = p.information_in(self.gtsam) * j;
+            let lj = p.information_in(self.reading) * j;
             self.system.add(b, b, &(j.transpose() * lj));
             add_g(b, &(lj.transpose() * r));
         }
@@ -133,7 +133,7 @@ impl<'a, G: LieGroup<N>, const N: usize> Problem<'a, G, N> {
     }
 
     pub fn chi2(&self, poses: &[G]) -> f64 {
-        self.graph.chi2(poses, self.gtsam)
+        self.graph.chi2(poses, self.reading)
     }
 }
 

@@ -74,9 +74,16 @@ pub fn upper_triangle_name(axes: &[&str], k: usize) -> String {
     format!("I[{k}]")
 }
 
-/// D = diag(1, 1, 1, 2, 2, 2) = J⁻¹ for J = ∂(t, q.xyz)/∂[ρ; θ] at 0 (see the module docs).
+/// D = diag(1, 1, 1, 2, 2, 2) = J⁻¹ for J = ∂(t, q.xyz)/∂[ρ; θ] at 0 (see the module docs;
+/// the one rule is [`half_angle_scale`](crate::plan::graph::half_angle_scale)).
 fn half_angle_scale() -> Matrix6<f64> {
-    Matrix6::from_diagonal(&nalgebra::Vector6::new(1.0, 1.0, 1.0, 2.0, 2.0, 2.0))
+    Matrix6::from_fn(|r, c| {
+        if r == c {
+            crate::plan::graph::half_angle_scale::<6>(r)
+        } else {
+            0.0
+        }
+    })
 }
 
 /// posecov's right-perturbation covariance Σ_ξ over [ρ; θ] of an `EDGE_SE3:QUAT` whose error
@@ -107,8 +114,8 @@ pub fn se3_cov_from_g2o_error_cov(cov_error: &Matrix6<f64>) -> Matrix6<f64> {
 /// assert_eq!(lambda[(3, 3)], 2.5e3); // σ_θ = 2 σ_q: a quarter of the information
 /// ```
 pub fn se3_information_from_g2o(information: &Matrix6<f64>) -> Matrix6<f64> {
-    let d_inv = Matrix6::from_diagonal(&nalgebra::Vector6::new(1.0, 1.0, 1.0, 0.5, 0.5, 0.5));
-    d_inv * information * d_inv
+    let d = half_angle_scale();
+    Matrix6::from_fn(|r, c| information[(r, c)] / (d[(r, r)] * d[(c, c)]))
 }
 
 /// The covariance GTSAM's `readG2o` gives an `EDGE_SE3:QUAT` of information `information`

@@ -10,13 +10,13 @@ use super::convention::{
 };
 use super::parse::{Dimension, Kind, Record, Records, information_axes};
 use super::problem::{Edge, Prior, chain_initial_guess, pose_graph};
-use super::{InputError, Locator, Residual, Summary};
+use super::{InputError, Locator, Summary};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
 use crate::plan::{
     AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, limits,
 };
-use crate::uncertain::{Confidence, Method, Side, UncertainPose};
+use crate::uncertain::{Method, Side, UncertainPose};
 
 /// Most loop closures evaluated and drawn with their uncertainty (evenly chosen); the rest
 /// are counted in the text panel.
@@ -163,8 +163,7 @@ fn build<G: GraphGroup<N>, const N: usize>(
                     line: r.line,
                     measurement: pose,
                     cov,
-                    information_g2o: G::information_from_g2o(&information),
-                    information_gtsam: information,
+                    information: G::information_from_g2o(&information),
                 });
             }
             Kind::Prior | Kind::Fix => {
@@ -173,8 +172,7 @@ fn build<G: GraphGroup<N>, const N: usize>(
                     vertex: r.ids[0],
                     line: r.line,
                     measurement: pose,
-                    information_g2o: G::information_from_g2o(&information),
-                    information_gtsam: information,
+                    information: G::information_from_g2o(&information),
                 });
             }
         }
@@ -308,39 +306,6 @@ fn evenly(n: usize, max: usize) -> Vec<usize> {
     (0..max).map(|k| k * (n - 1) / (max - 1).max(1)).collect()
 }
 
-/// Every loop closure's [`Residual`] at the file's estimates.
-fn residuals<G: LieGroup<N>, const N: usize>(
-    vertices: &BTreeMap<u64, (G, usize)>,
-    edges: &[Edge<G, N>],
-    loops: &[usize],
-) -> Vec<Residual> {
-    let radius_95 = Confidence::DEFAULT.radius(N);
-    loops
-        .iter()
-        .map(|&i| {
-            let e = &edges[i];
-            let (xi, xj) = (vertices[&e.from].0, vertices[&e.to].0);
-            let r = e
-                .measurement
-                .inverse()
-                .compose(&xi.inverse().compose(&xj))
-                .log();
-            // Σ is positive definite (the inverse of a positive-definite Ω, scaled).
-            let d2 = e
-                .cov
-                .cholesky()
-                .map_or(f64::INFINITY, |c| (r.transpose() * c.solve(&r))[(0, 0)]);
-            Residual {
-                from: e.from,
-                to: e.to,
-                line: e.line,
-                mahalanobis: d2.max(0.0).sqrt(),
-                radius_95,
-            }
-        })
-        .collect()
-}
-
 fn vertex_name(id: u64) -> String {
     format!("v{id}")
 }
@@ -441,13 +406,6 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         choices.axis_length =
             Some((0.3 * median).clamp(limits::MIN_AXIS_LENGTH, limits::MAX_AXIS_LENGTH));
     }
-    let mut residuals = residuals(vertices, edges, &loops);
-    let loop_closures_inconsistent = residuals
-        .iter()
-        .filter(|r| r.mahalanobis > r.radius_95)
-        .count();
-    residuals.sort_by(|a, b| b.mahalanobis.total_cmp(&a.mahalanobis));
-    residuals.truncate(10);
     let summary = Summary {
         vertices: vertices.len(),
         edges: edges.len(),
@@ -455,8 +413,6 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         loop_closures: loops.len(),
         loop_closures_drawn: drawn_loops.len(),
         vertices_drawn: drawn_ids.len(),
-        loop_closures_inconsistent,
-        worst_loop_closures: residuals,
     };
     let chain_end = first + chain.len() as u64;
     let about = About {
@@ -546,30 +502,6 @@ fn describe(
              drawn, not propagated).\n",
             chain_end.saturating_add(1)
         ));
-    }
-    if s.loop_closures > 0 {
-        d.push_str(&format!(
-            "\n**Loop closures against the estimates**: {} of {} put vertex j outside their own \
-             95 % region around X_i · Z (Mahalanobis distance d of X_j under the edge's Σ beyond \
-             √χ²₉₅ = {:.2}).",
-            s.loop_closures_inconsistent,
-            s.loop_closures,
-            s.worst_loop_closures
-                .first()
-                .map_or(f64::NAN, |r| r.radius_95)
-        ));
-        let worst: Vec<String> = s
-            .worst_loop_closures
-            .iter()
-            .take(5)
-            .map(|r| {
-                format!(
-                    "v{} → v{} (line {}): d = {:.3}",
-                    r.from, r.to, r.line, r.mahalanobis
-                )
-            })
-            .collect();
-        d.push_str(&format!(" Largest: {}.\n", worst.join("; ")));
     }
     if chained {
         d.push_str(

@@ -54,29 +54,9 @@ pub struct Summary {
     /// [`MAX_LOOP_CLOSURES`]).
     pub loop_closures_drawn: usize,
     /// Vertex estimates drawn as axes (at most 300, plus the drawn loop closures' ends).
+    /// Each loop closure's residual, before and after the optimisation, is evaluated at the
+    /// chosen confidence by [`crate::eval::graph`].
     pub vertices_drawn: usize,
-    /// Loop closures whose vertex estimates lie outside the edge's own 95 % region
-    /// ([`Residual::mahalanobis`] beyond [`Residual::radius_95`]).
-    pub loop_closures_inconsistent: usize,
-    /// The loop closures that disagree most with the vertex estimates (at most 10, worst first).
-    pub worst_loop_closures: Vec<Residual>,
-}
-
-/// How far a loop closure i → j is from the file's estimates: r = Log(Z⁻¹ · X_i⁻¹ · X_j)
-/// (the edge's error at the estimates, right form, [ρ; θ]) measured with the edge's Σ,
-/// d = √(rᵀ Σ⁻¹ r), beside the χ² radius that holds 95 % of the edge's Gaussian.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Residual {
-    /// Vertex i.
-    pub from: u64,
-    /// Vertex j.
-    pub to: u64,
-    /// The edge's line.
-    pub line: usize,
-    /// d = √(rᵀ Σ⁻¹ r).
-    pub mahalanobis: f64,
-    /// √χ²_n(0.95), n = 3 (SE(2)) or 6 (SE(3)).
-    pub radius_95: f64,
 }
 
 /// A read graph file: where its records are (to locate later errors) and what it holds.

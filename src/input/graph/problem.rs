@@ -15,9 +15,7 @@ pub(super) struct Edge<G: LieGroup<N>, const N: usize> {
     /// Right-perturbation covariance over [ρ; θ] in the frame of X_from · Z (g2o's reading).
     pub cov: TangentMatrix<N>,
     /// Λ over [ρ; θ], g2o's reading.
-    pub information_g2o: TangentMatrix<N>,
-    /// Λ over [ρ; θ], GTSAM's reading (the file's Ω as written).
-    pub information_gtsam: TangentMatrix<N>,
+    pub information: TangentMatrix<N>,
 }
 
 /// A checked prior.
@@ -26,8 +24,8 @@ pub(super) struct Prior<G: LieGroup<N>, const N: usize> {
     pub vertex: (u64, usize),
     pub line: usize,
     pub measurement: G,
-    pub information_g2o: TangentMatrix<N>,
-    pub information_gtsam: TangentMatrix<N>,
+    /// Λ over [ρ; θ], g2o's reading.
+    pub information: TangentMatrix<N>,
 }
 
 /// The initial guess of a file without vertex lines, as GTSAM's `load2D` builds it: the
@@ -98,8 +96,7 @@ pub(super) fn pose_graph<G: LieGroup<N>, const N: usize>(
                 from: index[&e.from],
                 to: index[&e.to],
                 measurement: e.measurement,
-                information: e.information_g2o,
-                information_gtsam: e.information_gtsam,
+                information: e.information,
                 line: e.line,
             })
             .collect(),
@@ -108,8 +105,7 @@ pub(super) fn pose_graph<G: LieGroup<N>, const N: usize>(
             .map(|p| GraphPrior {
                 vertex: index[&p.vertex.0],
                 measurement: p.measurement,
-                information: p.information_g2o,
-                information_gtsam: p.information_gtsam,
+                information: p.information,
                 line: p.line,
             })
             .collect(),

@@ -1,176 +1,46 @@
-//! A pose graph's optimisation in words: the findings (outliers, parts, duplicated edges, a
-//! solve that did not converge) and the text panel's paragraph.
+//! The "after" picture of a pose graph: the optimised trajectory and poses, every drawn
+//! pose's marginal ellipse at the confidence, a few marginal bananas, each loop closure with
+//! its residual, the relative uncertainty of the worst loop closures and of every `--joint`
+//! pair, and labels that do not collide.
 
-use std::fmt::Write;
-
-use super::shapes;
-use super::{Painter, v3};
-use crate::eval::Finding;
-use crate::eval::graph::{Anchor, GraphEvaluation, Optimizer, Part, Stop};
-use crate::lie::LieGroup;
+use super::super::shapes;
+use super::super::{Painter, v3};
+use crate::eval::graph::{GraphEvaluation, LoopClosure};
+use crate::lie::{LieGroup, TangentMatrix};
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, QuatXyzw, Timing,
     Triads, Vec3, WORLD,
 };
 use crate::uncertain::{Side, UncertainPose};
 
-/// The sentence of a graph finding (`None` for any other finding).
-pub(super) fn finding_text(f: &Finding) -> Option<String> {
-    Some(match f {
-        Finding::GraphNotConverged {
-            stop,
-            optimizer,
-            iterations,
-            chi2_before,
-            chi2_after,
-            log,
-        } => {
-            let mut s = format!(
-                "**The {} did not converge**: {} after {iterations} accepted steps; χ² {chi2_before:.6e} → {chi2_after:.6e}. The poses drawn and reported are the last estimate that lowered χ². Steps tried:",
-                optimizer_name(*optimizer),
-                stop_text(*stop)
-            );
-            for i in log {
-                let _ = write!(
-                    s,
-                    " #{} χ² {}{}{};",
-                    i.iteration,
-                    i.chi2
-                        .map_or("not finite (no step)".to_owned(), |c| format!("{c:.4e}")),
-                    i.lambda.map_or(String::new(), |l| format!(" λ {l:.0e}")),
-                    if i.accepted { "" } else { " (rejected)" }
-                );
-            }
-            s
-        }
-        Finding::LoopClosureOutlier {
-            from,
-            to,
-            line,
-            mahalanobis,
-            mahalanobis_before,
-            radius,
-            confidence,
-        } => format!(
-            "**Loop closure v{from} → v{to} (line {line}) is an outlier**: after the optimisation its residual is d = {mahalanobis:.2} (Mahalanobis, under the edge's own Σ), beyond the {:.0} % radius {radius:.2} (it was {mahalanobis_before:.2} at the file's estimates).",
-            100.0 * confidence.get()
-        ),
-        Finding::MoreLoopClosureOutliers {
-            more,
-            outliers,
-            loop_closures,
-        } => format!(
-            "… and {more} more outliers: {outliers} of {loop_closures} loop closures in all (`report --json` lists every loop closure)."
-        ),
-        Finding::GraphParts { parts } => {
-            let list: Vec<String> = parts.iter().map(part_text).collect();
-            format!(
-                "**The graph has {} unconnected parts**, each anchored on its own (marginals are relative to each part's anchor): {}.",
-                parts.len(),
-                list.join("; ")
-            )
-        }
-        Finding::DuplicateEdges { count, lines } => {
-            let list: Vec<String> = lines
-                .iter()
-                .map(|(line, first)| format!("line {line} repeats line {first}"))
-                .collect();
-            format!(
-                "{count} edge(s) join two vertices an earlier edge already joins; all are kept and counted in χ² ({}).",
-                list.join(", ")
-            )
-        }
-        Finding::GraphMarginalsFailed { reason } => {
-            format!("*No marginals: {reason}. The optimised poses stand.*")
-        }
-        _ => return None,
-    })
-}
-
-fn optimizer_name(o: Optimizer) -> &'static str {
-    match o {
-        Optimizer::LevenbergMarquardt => "Levenberg–Marquardt optimiser",
-        Optimizer::GaussNewton => "Gauss–Newton optimiser",
-    }
-}
-
-fn stop_text(stop: Stop) -> &'static str {
-    match stop {
-        Stop::Converged => "converged",
-        Stop::MaxIterations => "stopped at the iteration limit",
-        Stop::LambdaLimit => "λ reached its bound without lowering χ²",
-        Stop::Diverged => "a step raised χ² (diverging)",
-        Stop::Singular => "the normal equations were singular",
-        Stop::NotFinite => "χ² of the initial guess is not finite",
-        Stop::Interrupted => "interrupted",
-    }
-}
-
-fn part_text(p: &Part) -> String {
-    let anchor = match &p.anchor {
-        Anchor::Priors { count } => format!("{count} prior(s)"),
-        Anchor::Fixed { ids } => {
-            let ids: Vec<String> = ids.iter().map(|id| format!("v{id}")).collect();
-            format!("FIX {}", ids.join(" "))
-        }
-        Anchor::FirstVertex { id } => format!("v{id} held at its estimate"),
-        Anchor::Isolated { id } => {
-            return format!(
-                "v{id} alone (no edge or prior reaches it: kept as given, no marginal)"
-            );
-        }
-    };
-    format!("{} vertices from v{} ({anchor})", p.vertices, p.first_id)
-}
-
-/// The text panel's paragraph on the optimisation.
-pub(super) fn describe<G: LieGroup<N>, const N: usize>(g: &GraphEvaluation<G, N>) -> String {
-    let s = &g.solution;
-    let mut d = format!(
-        "\n\n**Optimised** ({}, {} accepted steps, {}): χ² = Σ rᵀ Λ r over edges and priors {:.6e} → **{:.6e}** ({} edges, {} unknowns).",
-        optimizer_name(s.optimizer),
-        s.iterations,
-        stop_text(s.stop),
-        s.chi2_before,
-        s.chi2_after,
-        g.edge_chi2.len(),
-        s.unknowns
-    );
-    let anchors: Vec<String> = s.parts.iter().map(part_text).collect();
-    let _ = write!(d, " Gauge: {}.", anchors.join("; "));
-    let outliers = g.outliers().len();
-    let _ = write!(
-        d,
-        " {} loop closures; {outliers} lie beyond the {:.0} % radius {:.2} of their own Σ after the optimisation.",
-        g.loop_closures.len(),
-        100.0 * g.confidence.get(),
-        g.radius
-    );
-    d
-}
-
 /// The subtree of the "after" picture, under [`WORLD`].
-pub(super) const AFTER: &str = "optimized";
+pub(in crate::draw) const AFTER: &str = "optimized";
 
 /// Most optimised poses drawn with their marginal ellipse (evenly chosen, plus the loop
 /// closures' ends).
-pub const MAX_DRAWN_MARGINALS: usize = 600;
-/// Most poses drawn with their marginal banana: the largest marginal, the last pose and the
-/// ends of the loop closures with the largest residuals.
-pub const MAX_BANANAS: usize = 6;
+const MAX_DRAWN_MARGINALS: usize = 600;
+/// Most poses drawn with their marginal banana: the largest marginal and the last pose.
+const MAX_BANANAS: usize = 2;
+/// Most loop closures drawn with their relative uncertainty (the worst ones), besides every
+/// `--joint` pair.
+const MAX_RELATIVE_LOOP_CLOSURES: usize = 2;
+/// Most `--joint` pairs drawn (all are in `report --json`).
+const MAX_DRAWN_JOINTS: usize = 12;
 /// Most labels in the after picture.
 const MAX_LABELS: usize = 24;
 /// Colour of the optimised poses and their marginals.
-pub const OPTIMIZED: Color = Color::rgb(0, 158, 115);
+const OPTIMIZED: Color = Color::rgb(0, 158, 115);
 /// Colour of loop closures beyond their radius.
-pub const OUTLIER: Color = Color::rgb(213, 94, 0);
+const OUTLIER: Color = Color::rgb(213, 94, 0);
+/// Colour of a relative pose's uncertainty (X_b as X_a sees it).
+const RELATIVE: Color = Color::rgb(204, 121, 167);
 
 /// The "after" picture at `world/optimized/…` (static): the optimised trajectory and poses,
 /// every drawn pose's marginal position ellipse at the confidence, the marginal bananas of a
 /// few poses, each loop closure as a line between its optimised ends (outliers in
 /// [`OUTLIER`]) with its residual as an arrow from the pose it predicts (X_i · Z) to X_j,
 /// and labels only where they do not collide.
-pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
+pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
 ) {
@@ -194,7 +64,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         .collect();
     let index_of: std::collections::HashMap<u64, usize> =
         g.ids.iter().enumerate().map(|(k, &id)| (id, k)).collect();
-    let mut worst: Vec<&crate::eval::graph::LoopClosure<N>> = g.loop_closures.iter().collect();
+    let mut worst: Vec<&LoopClosure<N>> = g.loop_closures.iter().collect();
     worst.sort_by(|a, b| b.mahalanobis.total_cmp(&a.mahalanobis));
     for l in worst.iter().take(MAX_DRAWN_MARGINALS / 4) {
         drawn.extend([index_of[&l.from], index_of[&l.to]]);
@@ -238,16 +108,11 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
             line_radius: radius * 0.5,
         }),
     );
-    // Bananas: the largest marginal, the last pose, the worst loop closures' ends.
+    // Bananas: the largest marginal and the last pose.
     let size = |k: usize| s.covariances[k].map_or(0.0, |c| c.trace());
     let largest = (0..n).max_by(|&a, &b| size(a).total_cmp(&size(b)));
     let mut banana_poses: Vec<usize> = largest.into_iter().chain([n.saturating_sub(1)]).collect();
-    for l in &worst {
-        banana_poses.push(index_of[&l.to]);
-    }
     banana_poses.dedup();
-    let mut seen = std::collections::BTreeSet::new();
-    banana_poses.retain(|k| seen.insert(*k));
     for &k in banana_poses.iter().take(MAX_BANANAS) {
         if let Some(pose) = uncertain(k) {
             p.region_banana(
@@ -261,7 +126,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     }
     // Loop closures: lines between the optimised ends; residual arrows X_i·Z → X_j.
     for (outliers, name, color) in [(false, "inliers", scene::LINK), (true, "outliers", OUTLIER)] {
-        let chosen: Vec<&crate::eval::graph::LoopClosure<N>> = g
+        let chosen: Vec<&LoopClosure<N>> = g
             .loop_closures
             .iter()
             .filter(|l| (l.mahalanobis > g.radius) == outliers)
@@ -269,7 +134,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         if chosen.is_empty() {
             continue;
         }
-        let ends = |l: &crate::eval::graph::LoopClosure<N>| (index_of[&l.from], index_of[&l.to]);
+        let ends = |l: &LoopClosure<N>| (index_of[&l.from], index_of[&l.to]);
         p.push(
             format!("{WORLD}/{AFTER}/loop_closures/{name}"),
             None,
@@ -307,8 +172,54 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
             }),
         );
     }
+    relative(p, g, &worst);
     labels(p, g, &worst, &banana_poses, true);
     labels(p, g, &worst, &banana_poses, false);
+}
+
+/// The relative uncertainty of the worst loop closures and of every `--joint` pair: X_b as
+/// X_a sees it, X_a · (X_a⁻¹ X_b) · Exp(ξ) with ξ ~ N(0, Σ_rel) from the joint marginal, a
+/// banana around X_b (`world/optimized/relative/v<a>_v<b>`). Where it is smaller than X_b's
+/// own marginal, the two poses are known better together than either alone.
+fn relative<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    g: &GraphEvaluation<G, N>,
+    worst: &[&LoopClosure<N>],
+) {
+    let index_of = |id: u64| g.ids.binary_search(&id).ok();
+    let closures = worst
+        .iter()
+        .take(MAX_RELATIVE_LOOP_CLOSURES)
+        .filter_map(|l| Some((l.from, l.to, l.relative_cov?)));
+    let joints = g
+        .joints
+        .iter()
+        .take(MAX_DRAWN_JOINTS)
+        .filter_map(|j| Some((j.a, j.b, j.relative_cov?)));
+    let mut drawn = std::collections::BTreeSet::new();
+    for (a, b, cov) in closures.chain(joints) {
+        let (Some(ia), Some(ib)) = (index_of(a), index_of(b)) else {
+            continue;
+        };
+        if !drawn.insert((a, b)) || !is_drawable(&cov) {
+            continue;
+        }
+        // X_a · (X_a⁻¹ X_b) = X_b: the relative pose placed where X_a puts it.
+        let (xa, xb) = (&g.solution.poses[ia], &g.solution.poses[ib]);
+        let at = xa.compose(&xa.inverse().compose(xb));
+        p.region_banana(
+            &format!("{WORLD}/{AFTER}/relative/v{a}_v{b}"),
+            Timing::Static,
+            &UncertainPose::new_unchecked(at, cov, Side::Right),
+            RELATIVE,
+            |x: &G| x.to_se3().translation().to_owned(),
+        );
+    }
+}
+
+/// A covariance with a banana to draw: finite and not all zero (two poses held fixed).
+fn is_drawable<const N: usize>(cov: &TangentMatrix<N>) -> bool {
+    cov.iter().all(|v| v.is_finite()) && cov.amax() > 0.0
 }
 
 /// Labels that do not collide: the first and last pose, the loop closures' ends (worst
@@ -318,7 +229,7 @@ pub(super) fn draw_optimized<G: LieGroup<N>, const N: usize>(
 fn labels<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
-    worst: &[&crate::eval::graph::LoopClosure<N>],
+    worst: &[&LoopClosure<N>],
     bananas: &[usize],
     after: bool,
 ) {
