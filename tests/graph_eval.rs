@@ -27,7 +27,7 @@ fn evaluated<G: LieGroup<N>, const N: usize>(
     graph: &PoseGraph<G, N>,
     settings: GraphSettings,
 ) -> GraphEvaluation<G, N> {
-    evaluate_graph(graph, &settings, None, &mut |_| {}).expect("solvable")
+    evaluate_graph(graph, &settings, None, &mut |_, _| {}).expect("solvable")
 }
 
 fn at(p: f64) -> GraphSettings {

@@ -534,7 +534,7 @@ fn duplicated_edges_are_kept_counted_and_noted() {
                 EDGE_SE2 0 1 1 0 0 100 0 0 100 0 100\nEDGE_SE2 1 2 1 0 0 100 0 0 100 0 100\n\
                 EDGE_SE2 0 2 2 0 0 100 0 0 100 0 100\nEDGE_SE2 0 2 2.5 0 0 100 0 0 100 0 100\n";
     let graph = se2_graph(text);
-    let g = evaluate_graph(&graph, &GraphSettings::default(), None, &mut |_| {}).unwrap();
+    let g = evaluate_graph(&graph, &GraphSettings::default(), None, &mut |_, _| {}).unwrap();
     assert_eq!(g.duplicates, vec![(7, 6)]);
     assert_eq!(g.loop_closures.len(), 2, "both copies are loop closures");
     assert_eq!(g.edge_chi2.len(), 4);

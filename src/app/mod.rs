@@ -262,7 +262,7 @@ pub fn pipeline(
     overrides: &Overrides,
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<(AnyEvaluation, Scene), AppError> {
-    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, cancel)?;
+    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, cancel, None)?;
     Ok((evaluation, scene))
 }
 
@@ -272,8 +272,10 @@ fn evaluate_and_draw(
     loaded: &Loaded,
     overrides: &Overrides,
     cancel: Option<Arc<AtomicBool>>,
+    progress: Option<crate::eval::graph::ProgressHook>,
 ) -> Result<(Settings, AnyEvaluation, Scene), AppError> {
-    let settings = resolve(&loaded.input, overrides, cancel)?;
+    let mut settings = resolve(&loaded.input, overrides, cancel)?;
+    settings.eval.graph_progress = progress;
     let evaluation = evaluate(loaded, &settings.eval)?;
     let scene = draw::scene(&evaluation, &settings.draw);
     scene.validate()?;

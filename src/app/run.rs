@@ -22,6 +22,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::bag::{self, LogRun};
 use super::{AppError, Loaded, Overrides, Settings, resolve_log};
 use crate::draw;
+use crate::eval::graph::{Iteration, ProgressHook, Stage};
 use crate::eval::{self, AnyEvaluation};
 use crate::input::{self, InputKind, Located};
 use crate::scene::Scene;
@@ -83,7 +84,19 @@ impl PlanRun {
         overrides: &Overrides,
         cancel: Option<Arc<AtomicBool>>,
     ) -> Result<Self, AppError> {
-        let (settings, evaluation, scene) = super::evaluate_and_draw(&loaded, overrides, cancel)?;
+        Self::from_loaded_with(loaded, overrides, cancel, None)
+    }
+
+    /// [`from_loaded`](Self::from_loaded), with a pose graph's solves reporting their steps to
+    /// `progress`.
+    pub fn from_loaded_with(
+        loaded: Loaded,
+        overrides: &Overrides,
+        cancel: Option<Arc<AtomicBool>>,
+        progress: Option<ProgressHook>,
+    ) -> Result<Self, AppError> {
+        let (settings, evaluation, scene) =
+            super::evaluate_and_draw(&loaded, overrides, cancel, progress)?;
         Ok(Self {
             loaded,
             settings,
@@ -145,8 +158,11 @@ impl Run {
         match opened {
             Opened::Plan(loaded) => {
                 let what = format!("evaluating {}", loaded.input.about.title);
-                with_spinner(&what, || PlanRun::from_loaded(*loaded, overrides, cancel))
-                    .map(|run| Run::Plan(Box::new(run)))
+                with_spinner(&what, |spinner| {
+                    let hook = graph_progress(spinner.clone(), what.clone());
+                    PlanRun::from_loaded_with(*loaded, overrides, cancel, Some(hook))
+                })
+                .map(|run| Run::Plan(Box::new(run)))
             }
             Opened::Log(located) => {
                 let settings = resolve_log(overrides)?;
@@ -188,8 +204,30 @@ impl Run {
     }
 }
 
-/// Runs `work`, showing a spinner on a terminal when it takes more than 0.3 s.
-fn with_spinner<T>(message: &str, work: impl FnOnce() -> T) -> T {
+/// A pose graph's progress on the spinner: the solve, its iteration, χ² and λ (Ctrl-C stops
+/// between iterations, keeping the last accepted estimate).
+fn graph_progress(spinner: ProgressBar, what: String) -> ProgressHook {
+    ProgressHook(Arc::new(move |stage: Stage, i: &Iteration| {
+        let solve = match stage {
+            Stage::Optimizing => "optimising".to_owned(),
+            Stage::Timeline { step, of } => {
+                format!("loop closures one by one, step {step} of {of}")
+            }
+        };
+        let lambda = i.lambda.map_or(String::new(), |l| format!(", λ {l:.0e}"));
+        let chi2 = i
+            .chi2
+            .map_or("not finite".to_owned(), |c| format!("{c:.6e}"));
+        spinner.set_message(format!(
+            "{what}: {solve}, iteration {}, χ² {chi2}{lambda} (Ctrl-C keeps the last estimate)",
+            i.iteration
+        ));
+    }))
+}
+
+/// Runs `work`, showing a spinner on a terminal when it takes more than 0.3 s; `work` may
+/// change its message.
+fn with_spinner<T>(message: &str, work: impl FnOnce(&ProgressBar) -> T) -> T {
     let spinner = ProgressBar::new_spinner().with_message(message.to_owned());
     spinner.set_style(
         ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
@@ -207,7 +245,7 @@ fn with_spinner<T>(message: &str, work: impl FnOnce() -> T) -> T {
                 std::thread::park_timeout(Duration::from_millis(80));
             }
         });
-        let result = work();
+        let result = work(&spinner);
         done.store(true, Ordering::Release);
         ticker.thread().unpark();
         result

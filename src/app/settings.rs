@@ -335,6 +335,7 @@ pub fn resolve(
                 confidence,
                 joints: overrides.joints.clone(),
             },
+            graph_progress: None,
         },
         draw: DrawSettings {
             about: input.about.clone(),

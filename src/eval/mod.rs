@@ -95,6 +95,8 @@ pub struct EvalSettings {
     pub cancel: Option<Arc<AtomicBool>>,
     /// How a plan's pose graph is optimised and its loop closures measured.
     pub graph: graph::GraphSettings,
+    /// Where a pose graph's solves report their steps (a progress bar), if anywhere.
+    pub graph_progress: Option<graph::ProgressHook>,
 }
 
 impl Default for EvalSettings {
@@ -109,6 +111,7 @@ impl Default for EvalSettings {
             unscented: Default::default(),
             cancel: None,
             graph: Default::default(),
+            graph_progress: None,
         }
     }
 }
@@ -378,9 +381,17 @@ fn run<G: EvalGroup<N>, const N: usize>(
         run_blocked(plan, settings, n, b)?
     };
     if let Some(g) = &plan.graph {
-        let evaluation =
-            graph::evaluate_graph(g, &settings.graph, settings.cancel.clone(), &mut |_| {})
-                .map_err(|e| EvalError::Graph(e.to_string()))?;
+        let evaluation = graph::evaluate_graph(
+            g,
+            &settings.graph,
+            settings.cancel.clone(),
+            &mut |stage, i| {
+                if let Some(hook) = &settings.graph_progress {
+                    (hook.0)(stage, i);
+                }
+            },
+        )
+        .map_err(|e| EvalError::Graph(e.to_string()))?;
         out.findings.extend(graph_findings(&evaluation));
         out.graph = Some(evaluation);
     }

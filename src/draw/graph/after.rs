@@ -5,7 +5,9 @@
 
 use super::super::shapes;
 use super::super::{Painter, v3};
-use crate::eval::graph::{GraphEvaluation, LoopClosure};
+use std::collections::BTreeSet;
+
+use crate::eval::graph::{ClosureStep, GraphEvaluation, LoopClosure};
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, QuatXyzw, Timing,
@@ -35,11 +37,15 @@ const OUTLIER: Color = Color::rgb(213, 94, 0);
 /// Colour of a relative pose's uncertainty (X_b as X_a sees it).
 const RELATIVE: Color = Color::rgb(204, 121, 167);
 
-/// The "after" picture at `world/optimized/…` (static): the optimised trajectory and poses,
-/// every drawn pose's marginal position ellipse at the confidence, the marginal bananas of a
-/// few poses, each loop closure as a line between its optimised ends (outliers in
-/// [`OUTLIER`]) with its residual as an arrow from the pose it predicts (X_i · Z) to X_j,
-/// and labels only where they do not collide.
+/// The "after" picture at `world/optimized/…`: the optimised trajectory and poses, every
+/// drawn pose's marginal position ellipse at the confidence, the marginal bananas of the
+/// largest marginal and the last pose, each loop closure as a line between its optimised ends
+/// (outliers in [`OUTLIER`]) with its residual as an arrow from the pose it predicts
+/// (X_i · Z) to X_j, relative uncertainties ([`relative`]) and labels only where they do not
+/// collide. With a loop-closure timeline, the trajectory, ellipses, poses and bananas follow
+/// it on the `step` timeline: the graph without loop closures from step 0 (while the chain's
+/// banana grows), then one step per value of k after the chain's last step, the loop
+/// closures added so far drawn thick; everything else is the final solution, static.
 pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
@@ -47,18 +53,9 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     let s = &g.solution;
     let position = |x: &G| x.to_se3().translation().to_owned();
     let radius = 0.003 * p.extent.max(0.25);
-    p.push(
-        format!("{WORLD}/{AFTER}/trajectory"),
-        None,
-        ItemKind::LineStrips(LineStrips {
-            strips: vec![s.poses.iter().map(|x| v3(&position(x))).collect()],
-            color: OPTIMIZED,
-            radius,
-        }),
-    );
-    // Which poses get an ellipse: evenly chosen, plus every loop closure's ends.
+    // Which poses get an ellipse: evenly chosen, plus the worst loop closures' ends.
     let n = s.poses.len();
-    let mut drawn: std::collections::BTreeSet<usize> = (0..MAX_DRAWN_MARGINALS.min(n))
+    let mut drawn: BTreeSet<usize> = (0..MAX_DRAWN_MARGINALS.min(n))
         .map(|k| k * (n.max(2) - 1) / (MAX_DRAWN_MARGINALS.min(n).max(2) - 1))
         .filter(|&k| k < n)
         .collect();
@@ -69,59 +66,25 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     for l in worst.iter().take(MAX_DRAWN_MARGINALS / 4) {
         drawn.extend([index_of[&l.from], index_of[&l.to]]);
     }
-    let d = G::KIND.position_dims().max(1);
-    let uncertain = |k: usize| {
-        s.covariances[k].map(|cov| UncertainPose::new_unchecked(s.poses[k], cov, Side::Right))
-    };
-    let shapes: Vec<_> = drawn
-        .iter()
-        .filter_map(|&k| {
-            let pose = uncertain(k)?;
-            let cov = pose.position_cov_in_world_3d()?;
-            Some(shapes::ellipsoid_of(
-                &position(&s.poses[k]),
-                &cov,
-                p.confidence().radius(d),
-            ))
-        })
-        .collect();
-    if !shapes.is_empty() {
-        p.push(
-            format!("{WORLD}/{AFTER}/marginals"),
-            None,
-            ItemKind::Ellipsoids(Ellipsoids {
-                shapes,
-                color: OPTIMIZED,
-                fill: FillMode::MajorWireframe,
-                line_radius: radius * 0.6,
-                label: None,
-            }),
-        );
-    }
-    p.push(
-        format!("{WORLD}/{AFTER}/poses"),
-        None,
-        ItemKind::Triads(Triads {
-            translations: drawn.iter().map(|&k| v3(&position(&s.poses[k]))).collect(),
-            rotations: drawn.iter().map(|&k| quat(&s.poses[k])).collect(),
-            axis_length: p.axis_length * 0.6,
-            line_radius: radius * 0.5,
-        }),
-    );
-    // Bananas: the largest marginal and the last pose.
+    // Bananas: the largest marginal and the last pose (of the final solution).
     let size = |k: usize| s.covariances[k].map_or(0.0, |c| c.trace());
     let largest = (0..n).max_by(|&a, &b| size(a).total_cmp(&size(b)));
     let mut banana_poses: Vec<usize> = largest.into_iter().chain([n.saturating_sub(1)]).collect();
     banana_poses.dedup();
-    for &k in banana_poses.iter().take(MAX_BANANAS) {
-        if let Some(pose) = uncertain(k) {
-            p.region_banana(
-                &format!("{WORLD}/{AFTER}/bananas/v{}", g.ids[k]),
-                Timing::Static,
-                &pose,
-                OPTIMIZED,
-                |x: &G| x.to_se3().translation().to_owned(),
-            );
+    banana_poses.truncate(MAX_BANANAS);
+    let look = Look {
+        radius,
+        drawn: &drawn,
+        bananas: &banana_poses,
+    };
+    if g.timeline.steps.is_empty() {
+        state(p, g, &s.poses, &s.covariances, None, &look);
+    } else {
+        let chain_end = p.scene.steps().last().copied().unwrap_or(0).max(0) as u64;
+        for (i, step) in g.timeline.steps.iter().enumerate() {
+            let at = if i == 0 { 0 } else { chain_end + i as u64 };
+            state(p, g, &step.poses, &step.covariances, Some(at), &look);
+            closed_so_far(p, g, step, at, radius);
         }
     }
     // Loop closures: lines between the optimised ends; residual arrows X_i·Z → X_j.
@@ -175,6 +138,117 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     relative(p, g, &worst);
     labels(p, g, &worst, &banana_poses, true);
     labels(p, g, &worst, &banana_poses, false);
+}
+
+/// What every state of the after picture draws the same way.
+struct Look<'a> {
+    radius: f64,
+    drawn: &'a BTreeSet<usize>,
+    bananas: &'a [usize],
+}
+
+/// One state of the optimised graph (the final one, static; or a timeline step): the
+/// trajectory, the drawn poses with their marginal ellipses, and the bananas.
+fn state<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    g: &GraphEvaluation<G, N>,
+    poses: &[G],
+    covariances: &[Option<TangentMatrix<N>>],
+    step: Option<u64>,
+    look: &Look,
+) {
+    let position = |x: &G| x.to_se3().translation().to_owned();
+    p.push(
+        format!("{WORLD}/{AFTER}/trajectory"),
+        step,
+        ItemKind::LineStrips(LineStrips {
+            strips: vec![poses.iter().map(|x| v3(&position(x))).collect()],
+            color: OPTIMIZED,
+            radius: look.radius,
+        }),
+    );
+    let d = G::KIND.position_dims().max(1);
+    let uncertain = |k: usize| {
+        covariances[k].map(|cov| UncertainPose::new_unchecked(poses[k], cov, Side::Right))
+    };
+    let shapes: Vec<_> = look
+        .drawn
+        .iter()
+        .filter_map(|&k| {
+            let cov = uncertain(k)?.position_cov_in_world_3d()?;
+            Some(shapes::ellipsoid_of(
+                &position(&poses[k]),
+                &cov,
+                p.confidence().radius(d),
+            ))
+        })
+        .collect();
+    if !shapes.is_empty() {
+        p.push(
+            format!("{WORLD}/{AFTER}/marginals"),
+            step,
+            ItemKind::Ellipsoids(Ellipsoids {
+                shapes,
+                color: OPTIMIZED,
+                fill: FillMode::MajorWireframe,
+                line_radius: look.radius * 0.6,
+                label: None,
+            }),
+        );
+    }
+    p.push(
+        format!("{WORLD}/{AFTER}/poses"),
+        step,
+        ItemKind::Triads(Triads {
+            translations: look
+                .drawn
+                .iter()
+                .map(|&k| v3(&position(&poses[k])))
+                .collect(),
+            rotations: look.drawn.iter().map(|&k| quat(&poses[k])).collect(),
+            axis_length: p.axis_length * 0.6,
+            line_radius: look.radius * 0.5,
+        }),
+    );
+    for &k in look.bananas {
+        if let Some(pose) = uncertain(k) {
+            p.region_banana(
+                &format!("{WORLD}/{AFTER}/bananas/v{}", g.ids[k]),
+                step.map_or(Timing::Static, |k| Timing::Step(k as i64)),
+                &pose,
+                OPTIMIZED,
+                |x: &G| x.to_se3().translation().to_owned(),
+            );
+        }
+    }
+}
+
+/// The loop closures in the graph at a timeline step, thick between the step's poses
+/// (`world/optimized/closed`; nothing at k = 0).
+fn closed_so_far<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    g: &GraphEvaluation<G, N>,
+    step: &ClosureStep<G, N>,
+    at: u64,
+    radius: f64,
+) {
+    let index_of = |id: u64| g.ids.binary_search(&id).ok();
+    let position = |k: usize| v3(&step.poses[k].to_se3().translation().to_owned());
+    let strips: Vec<Vec<Vec3>> = g.loop_closures[..step.closures.min(g.loop_closures.len())]
+        .iter()
+        .filter_map(|l| Some(vec![position(index_of(l.from)?), position(index_of(l.to)?)]))
+        .collect();
+    if !strips.is_empty() {
+        p.push(
+            format!("{WORLD}/{AFTER}/closed"),
+            Some(at),
+            ItemKind::LineStrips(LineStrips {
+                strips,
+                color: OPTIMIZED,
+                radius: radius * 1.5,
+            }),
+        );
+    }
 }
 
 /// The relative uncertainty of the worst loop closures and of every `--joint` pair: X_b as

@@ -5,7 +5,7 @@
 use std::fmt::Write;
 
 use crate::eval::Finding;
-use crate::eval::graph::{Anchor, GraphEvaluation, Optimizer, Part, Stop};
+use crate::eval::graph::{Anchor, GraphEvaluation, MAX_TIMELINE_POSES, Optimizer, Part, Stop};
 use crate::lie::LieGroup;
 
 mod after;
@@ -138,7 +138,34 @@ pub(super) fn describe<G: LieGroup<N>, const N: usize>(g: &GraphEvaluation<G, N>
     let _ = write!(d, " Gauge: {}.", anchors.join("; "));
     loop_closures(&mut d, g);
     joints(&mut d, g);
+    timeline(&mut d, g);
     d
+}
+
+/// How to scrub the loop-closure timeline, or why there is none.
+fn timeline<G: LieGroup<N>, const N: usize>(d: &mut String, g: &GraphEvaluation<G, N>) {
+    let t = &g.timeline;
+    if let Some(poses) = t.too_large {
+        let _ = write!(
+            d,
+            "\n\nNo loop-closure timeline: {poses} poses, more than the {MAX_TIMELINE_POSES} posecov re-solves closure by closure."
+        );
+        return;
+    }
+    if t.steps.len() < 2 {
+        return;
+    }
+    let ks: Vec<String> = t.steps.iter().map(|s| s.closures.to_string()).collect();
+    let chi2: Vec<String> = t.steps.iter().map(|s| format!("{:.3e}", s.chi2)).collect();
+    let _ = write!(
+        d,
+        "\n\n**Loop closures one by one**: scrub the `step` timeline. Up to the chain's last step the after view shows the graph without loop closures — dead reckoning, its marginals grow like the chain's banana; each later step adds the next loop closures in file order (k = {}), re-optimised, drawn thick, and the marginals shrink where they join. χ² at each step: {}.",
+        ks.join(", "),
+        chi2.join(", ")
+    );
+    if t.interrupted {
+        d.push_str(" *Interrupted: the steps so far.*");
+    }
 }
 
 /// Most loop closures named in the text panel's paragraph.

@@ -10,8 +10,8 @@ use crate::plan::graph::PoseGraph;
 use crate::uncertain::Confidence;
 
 use super::{
-    Anchor, GraphReading, Iteration, Joint, Optimizer, Solution, SolverSettings, SparseError, Stop,
-    relative_covariance,
+    Anchor, ClosureTimeline, GraphReading, Iteration, Joint, Optimizer, Solution, SolverSettings,
+    SparseError, Stage, Stop, relative_covariance,
 };
 
 /// The settings of a graph's evaluation (resolved by `app/`).
@@ -108,6 +108,8 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
     pub loop_closures: Vec<LoopClosure<N>>,
     /// The joint marginals asked for ([`GraphSettings::joints`]), in order.
     pub joints: Vec<JointMarginal<G, N>>,
+    /// The graph re-solved as its loop closures are added one by one.
+    pub timeline: ClosureTimeline<G, N>,
     /// The confidence the residuals are measured at.
     pub confidence: Confidence,
     /// √χ²_N(confidence): a residual beyond it is an outlier.
@@ -118,8 +120,9 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
     pub edge_chi2: Vec<f64>,
 }
 
-/// Optimises `graph`, measures its loop closures at `settings.confidence` and computes the
-/// joint marginals of `settings.joints`.
+/// Optimises `graph`, measures its loop closures at `settings.confidence`, computes the
+/// joint marginals of `settings.joints` and re-solves it loop closure by loop closure
+/// ([`ClosureTimeline`]); `progress` sees every step tried, and of which solve.
 ///
 /// ```
 /// use posecov::eval::graph::{GraphSettings, evaluate_graph};
@@ -130,20 +133,20 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
 ///             EDGE_SE2 0 2 2.1 0 0 100 0 0 100 0 400\n";
 /// let AnyPlan::Se2(plan) = read_text(text, "g.g2o").unwrap().1.plan else { unreachable!() };
 /// let settings = GraphSettings { joints: vec![(1, 2)], ..Default::default() };
-/// let g = evaluate_graph(plan.graph.as_ref().unwrap(), &settings, None, &mut |_| {}).unwrap();
+/// let g = evaluate_graph(plan.graph.as_ref().unwrap(), &settings, None, &mut |_, _| {}).unwrap();
 /// assert_eq!(g.loop_closures.len(), 1); // 0 → 2
 /// assert!(g.loop_closures[0].mahalanobis < g.loop_closures[0].mahalanobis_before);
 /// let joint = &g.joints[0];
 /// assert!(joint.relative_cov.unwrap()[(0, 0)] > 0.0);
 /// let wrong = GraphSettings { joints: vec![(1, 7)], ..Default::default() };
-/// let e = evaluate_graph(plan.graph.as_ref().unwrap(), &wrong, None, &mut |_| {}).unwrap_err();
+/// let e = evaluate_graph(plan.graph.as_ref().unwrap(), &wrong, None, &mut |_, _| {}).unwrap_err();
 /// assert_eq!(e.to_string(), "no vertex has id 7 (a joint marginal was asked for it)");
 /// ```
 pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
     graph: &PoseGraph<G, N>,
     settings: &GraphSettings,
     cancel: Option<Arc<AtomicBool>>,
-    progress: &mut dyn FnMut(&Iteration),
+    progress: &mut dyn FnMut(Stage, &Iteration),
 ) -> Result<GraphEvaluation<G, N>, GraphError> {
     let index = |id: u64| {
         graph
@@ -163,7 +166,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         cancel,
         ..SolverSettings::default()
     };
-    let solution = super::optimize(graph, &solver, progress)?;
+    let solution = super::optimize(graph, &solver, &mut |i| progress(Stage::Optimizing, i))?;
     let isolated = |v: usize| {
         matches!(
             solution.parts[solution.part_of[v]].anchor,
@@ -223,6 +226,19 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
             }),
         });
     }
+    let loop_edges: Vec<usize> = loop_closures
+        .iter()
+        .map(|l: &LoopClosure<N>| l.edge)
+        .collect();
+    let timeline = if solution.stop == Stop::Interrupted {
+        ClosureTimeline {
+            steps: Vec::new(),
+            too_large: None,
+            interrupted: true,
+        }
+    } else {
+        super::timeline::closure_timeline(graph, &loop_edges, &solution, &solver, progress)?
+    };
     let edge_chi2 = graph
         .edges
         .iter()
@@ -237,6 +253,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         solution,
         loop_closures,
         joints,
+        timeline,
         confidence: settings.confidence,
         radius: settings.confidence.radius(N),
         duplicates,

@@ -60,6 +60,7 @@ mod parts;
 mod report;
 mod solve;
 pub mod sparse;
+mod timeline;
 
 pub use crate::plan::graph::GraphReading;
 pub use evaluate::{
@@ -68,9 +69,13 @@ pub use evaluate::{
 pub use parts::{Anchor, Part, Parts, parts};
 pub use report::{
     JointRecord, LoopClosureRecord, OptimizedReport, PoseRecord, Seconds, StopCriteria,
+    TimelineRecord,
 };
 pub use solve::edge_jacobians;
 pub use sparse::{MAX_FACTOR_NONZEROS, SparseError};
+pub use timeline::{
+    ClosureStep, ClosureTimeline, MAX_TIMELINE_POSES, MAX_TIMELINE_STEPS, closure_counts,
+};
 
 /// Gauss–Newton or Levenberg–Marquardt.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
@@ -136,6 +141,34 @@ impl Optimizer {
             Optimizer::LevenbergMarquardt => "lm",
             Optimizer::GaussNewton => "gn",
         }
+    }
+}
+
+/// Which solve a step belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// The graph with every edge.
+    Optimizing,
+    /// Step `step` (1-based) of `of` of the loop-closure timeline ([`ClosureTimeline`]).
+    Timeline {
+        /// This step.
+        step: usize,
+        /// Steps to solve.
+        of: usize,
+    },
+}
+
+/// Where a long solve reports each step it tries: the front end shows it (a progress bar);
+/// the evaluation only calls it.
+#[derive(Clone)]
+pub struct ProgressHook(pub Arc<ProgressFn>);
+
+/// What a [`ProgressHook`] calls: the solve and the step it tried.
+pub type ProgressFn = dyn Fn(Stage, &Iteration) + Send + Sync;
+
+impl std::fmt::Debug for ProgressHook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ProgressHook")
     }
 }
 

@@ -58,6 +58,17 @@ pub struct JointRecord {
     pub relative_covariance: Option<Vec<Vec<f64>>>,
 }
 
+/// One step of the loop-closure timeline.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct TimelineRecord {
+    /// k: loop closures in the graph (the first k in file order).
+    pub closures: usize,
+    /// χ² at the step's optimum.
+    pub chi2: f64,
+    /// Why its optimiser stopped.
+    pub stop: Stop,
+}
+
 /// `report --json`'s `optimized` object.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct OptimizedReport {
@@ -88,6 +99,9 @@ pub struct OptimizedReport {
     pub loop_closures: Vec<LoopClosureRecord>,
     /// The joint marginals asked for (`--joint a,b`), in order.
     pub joints: Vec<JointRecord>,
+    /// The graph re-solved as its loop closures are added one by one (empty without loop
+    /// closures, or beyond the timeline's size).
+    pub timeline: Vec<TimelineRecord>,
     /// The confidence of `radius`.
     pub confidence: Confidence,
     /// χ² of each edge at the optimised poses, in file order.
@@ -212,6 +226,16 @@ impl<G: LieGroup<N>, const N: usize> GraphEvaluation<G, N> {
                     covariance: j.blocks.as_ref().map(joint_rows),
                     relative_pose: g2o_values(&j.relative_pose),
                     relative_covariance: j.relative_cov.as_ref().map(rows),
+                })
+                .collect(),
+            timeline: self
+                .timeline
+                .steps
+                .iter()
+                .map(|t| TimelineRecord {
+                    closures: t.closures,
+                    chi2: t.chi2,
+                    stop: t.stop,
                 })
                 .collect(),
             confidence: self.confidence,

@@ -1,0 +1,141 @@
+//! What the loop closures did, one at a time: the graph re-solved with its odometry (every
+//! edge that is not a loop closure) and its priors, plus the first k loop closures in file
+//! order, for k = 0 … L. Step 0 is dead reckoning — the marginals grow from the anchor along
+//! the chain — and each later step shows the marginals shrinking where the new closures join.
+//! Each step is warm-started from the one before; the last is the full solution, not solved
+//! again.
+//!
+//! Bounded: at most [`MAX_TIMELINE_STEPS`] values of k after 0 (evenly spaced, always L), and
+//! only for graphs of at most [`MAX_TIMELINE_POSES`] poses (re-solving a larger graph two
+//! dozen times is minutes, not seconds); a larger graph gets no timeline and says so.
+
+use crate::lie::{LieGroup, TangentMatrix};
+use crate::plan::graph::PoseGraph;
+
+use super::{Iteration, Solution, SolverSettings, SparseError, Stage, Stop, optimize};
+
+/// Most poses a graph may have to be re-solved loop closure by loop closure.
+pub const MAX_TIMELINE_POSES: usize = 10_000;
+
+/// Most steps after step 0 (the values of k are evenly spaced when there are more loop
+/// closures).
+pub const MAX_TIMELINE_STEPS: usize = 24;
+
+/// The graph with its first `closures` loop closures, optimised.
+#[derive(Debug, Clone)]
+pub struct ClosureStep<G, const N: usize> {
+    /// k: the loop closures in the graph (the first k in file order).
+    pub closures: usize,
+    /// The optimised poses, one per vertex.
+    pub poses: Vec<G>,
+    /// Each vertex's marginal (right form, [ρ; θ]; None as in [`Solution::covariances`]).
+    pub covariances: Vec<Option<TangentMatrix<N>>>,
+    /// χ² at this step's optimum, over its own edges and priors.
+    pub chi2: f64,
+    /// Why its optimiser stopped.
+    pub stop: Stop,
+}
+
+/// The steps, or why there are none.
+#[derive(Debug, Clone)]
+pub struct ClosureTimeline<G, const N: usize> {
+    /// k = 0, then up to [`MAX_TIMELINE_STEPS`] values up to L (empty: see the other fields).
+    pub steps: Vec<ClosureStep<G, N>>,
+    /// The graph has more poses than [`MAX_TIMELINE_POSES`]: how many.
+    pub too_large: Option<usize>,
+    /// The re-solves were interrupted (Ctrl-C): the steps so far are kept.
+    pub interrupted: bool,
+}
+
+/// The values of k: 0, then every k up to `loops`, or [`MAX_TIMELINE_STEPS`] of them evenly
+/// spaced (always ending at `loops`).
+///
+/// ```
+/// use posecov::eval::graph::closure_counts;
+/// assert_eq!(closure_counts(3), vec![0, 1, 2, 3]);
+/// let many = closure_counts(1000);
+/// assert_eq!((many.len(), many[0], many[many.len() - 1]), (25, 0, 1000));
+/// assert!(closure_counts(0).is_empty());
+/// ```
+pub fn closure_counts(loops: usize) -> Vec<usize> {
+    if loops == 0 {
+        return Vec::new();
+    }
+    let steps = loops.min(MAX_TIMELINE_STEPS);
+    let mut out: Vec<usize> = (0..=steps).map(|i| (i * loops).div_ceil(steps)).collect();
+    out.dedup();
+    out
+}
+
+/// The timeline of `graph`, whose loop closures are the edges `loop_edges` (in file order),
+/// with `full` its solution with every edge (see the [module docs](self)).
+pub(super) fn closure_timeline<G: LieGroup<N>, const N: usize>(
+    graph: &PoseGraph<G, N>,
+    loop_edges: &[usize],
+    full: &Solution<G, N>,
+    settings: &SolverSettings,
+    progress: &mut dyn FnMut(Stage, &Iteration),
+) -> Result<ClosureTimeline<G, N>, SparseError> {
+    let mut timeline = ClosureTimeline {
+        steps: Vec::new(),
+        too_large: None,
+        interrupted: false,
+    };
+    if graph.vertices.len() > MAX_TIMELINE_POSES {
+        timeline.too_large = Some(graph.vertices.len());
+        return Ok(timeline);
+    }
+    let mut rank = vec![None; graph.edges.len()];
+    for (r, &e) in loop_edges.iter().enumerate() {
+        rank[e] = Some(r);
+    }
+    let solver = SolverSettings {
+        pairs: Vec::new(),
+        ..settings.clone()
+    };
+    let mut start = graph.estimates();
+    let counts = closure_counts(loop_edges.len());
+    let of = counts.len().saturating_sub(1);
+    for (step, k) in counts.into_iter().enumerate() {
+        if k == loop_edges.len() {
+            timeline.steps.push(ClosureStep {
+                closures: k,
+                poses: full.poses.clone(),
+                covariances: full.covariances.clone(),
+                chi2: full.chi2_after,
+                stop: full.stop,
+            });
+            break;
+        }
+        let mut sub = PoseGraph {
+            vertices: graph.vertices.clone(),
+            edges: graph
+                .edges
+                .iter()
+                .zip(&rank)
+                .filter(|(_, r)| r.is_none_or(|r| r < k))
+                .map(|(e, _)| e.clone())
+                .collect(),
+            priors: graph.priors.clone(),
+            fixed: graph.fixed.clone(),
+        };
+        for (v, x) in sub.vertices.iter_mut().zip(&start) {
+            v.estimate = *x;
+        }
+        let stage = Stage::Timeline { step: step + 1, of };
+        let s = optimize(&sub, &solver, &mut |i| progress(stage, i))?;
+        if s.stop == Stop::Interrupted {
+            timeline.interrupted = true;
+            break;
+        }
+        start.clone_from(&s.poses);
+        timeline.steps.push(ClosureStep {
+            closures: k,
+            poses: s.poses,
+            covariances: s.covariances,
+            chi2: s.chi2_after,
+            stop: s.stop,
+        });
+    }
+    Ok(timeline)
+}
