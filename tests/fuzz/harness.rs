@@ -339,11 +339,17 @@ pub fn env_u64(k: &str) -> Option<u64> {
         .and_then(|v| v.replace('_', "").parse().ok())
 }
 
-/// Where failing inputs go: `POSECOV_FUZZ_OUT`, default `<crate>/target`.
+/// Where failing inputs and the input being run go: `POSECOV_FUZZ_OUT`, default `fuzz/` in
+/// Cargo's scratch directory for tests (`<target dir>/tmp/fuzz`, wherever `CARGO_TARGET_DIR`
+/// puts the target dir; never inside the clone). Created when missing.
 pub fn target_dir() -> PathBuf {
-    std::env::var_os("POSECOV_FUZZ_OUT")
+    let dir = std::env::var_os("POSECOV_FUZZ_OUT")
         .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"))
+        .unwrap_or_else(|| Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz"));
+    if let Err(e) = std::fs::create_dir_all(&dir) {
+        panic!("cannot create the fuzz output directory {}: {e}", dir.display());
+    }
+    dir
 }
 
 /// What a campaign found.
@@ -367,8 +373,9 @@ impl Summary {
 
 /// Runs cases `cases` of `family` from `seed`. Each failing input (deduplicated by class and
 /// normalised first line, across runs too) is written to
-/// `target/fuzz-failures/<family>-<class>-s<seed>-c<case>.<ext>` with a `.txt` beside it; the
-/// input being run is in `target/fuzz-current-<family>.<ext>` (if the process dies).
+/// `<out>/fuzz-failures/<family>-<class>-s<seed>-c<case>.<ext>` with a `.txt` beside it; the
+/// input being run is in `<out>/fuzz-current-<family>.<ext>` (if the process dies), `<out>` being
+/// [`target_dir`].
 pub fn campaign(family: &dyn Family, seed: u64, cases: std::ops::Range<u64>) -> Summary {
     let _guard = RUN_LOCK.lock().unwrap_or_else(|e| e.into_inner());
     install_panic_hook();
@@ -376,7 +383,7 @@ pub fn campaign(family: &dyn Family, seed: u64, cases: std::ops::Range<u64>) -> 
     let (name, ext) = (family.name(), family.extension());
     let dir = target_dir();
     let failures = dir.join("fuzz-failures");
-    std::fs::create_dir_all(&failures).expect("create target/fuzz-failures");
+    std::fs::create_dir_all(&failures).expect("create <out>/fuzz-failures");
     let current = dir.join(format!("fuzz-current-{name}.{ext}"));
     let mut s = Summary {
         family: name,

@@ -42,9 +42,11 @@
 //!   families `POSECOV_FUZZ_FAMILIES` (comma-separated; default all), starting at case
 //!   `POSECOV_FUZZ_START`. It prints one summary line per family (counts per outcome, time).
 //! - Failing inputs are written, one per distinct failure, to
-//!   `target/fuzz-failures/<family>-<class>-s<seed>-c<case>.<ext>` with a `.txt` saying what
+//!   `<out>/fuzz-failures/<family>-<class>-s<seed>-c<case>.<ext>` with a `.txt` saying what
 //!   happened and which mutations made it; the input being run is in
-//!   `target/fuzz-current-<family>.<ext>` (if the process dies).
+//!   `<out>/fuzz-current-<family>.<ext>` (if the process dies). `<out>` is `POSECOV_FUZZ_OUT`,
+//!   default `<target dir>/tmp/fuzz` (Cargo's scratch directory for tests, outside the clone
+//!   when `CARGO_TARGET_DIR` is, as in CI).
 //! - One scenario file: `POSECOV_FUZZ_FILE=x.toml cargo test --test fuzz scenario_file --
 //!   --ignored --nocapture` (with `POSECOV_FUZZ_REDUCE=1`, a line-reduced input per failure).
 
