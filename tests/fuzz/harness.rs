@@ -347,7 +347,10 @@ pub fn target_dir() -> PathBuf {
         .map(PathBuf::from)
         .unwrap_or_else(|| Path::new(env!("CARGO_TARGET_TMPDIR")).join("fuzz"));
     if let Err(e) = std::fs::create_dir_all(&dir) {
-        panic!("cannot create the fuzz output directory {}: {e}", dir.display());
+        panic!(
+            "cannot create the fuzz output directory {}: {e}",
+            dir.display()
+        );
     }
     dir
 }
