@@ -8,14 +8,9 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 venv="${POSECOV_GTSAM_VENV:-${XDG_CACHE_HOME:-$HOME/.cache}/posecov/gtsam-venv}"
 
-if [ ! -x "$venv/bin/python" ]; then
-    mkdir -p "$(dirname "$venv")"
-    python3 -m venv "$venv"
-    "$venv/bin/python" -m pip install --quiet --upgrade pip
-fi
-if ! "$venv/bin/python" -c 'import gtsam, numpy' 2>/dev/null; then
-    "$venv/bin/python" -m pip install --quiet gtsam numpy
-fi
+# shellcheck source=benches/venv.sh
+source "$here/venv.sh"
+bench_venv "$venv" "gtsam, numpy" gtsam numpy
 for file in "$@"; do
     env OMP_NUM_THREADS=1 "$venv/bin/python" "$here/gtsam_graphs.py" "$file"
 done

@@ -7,14 +7,9 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 venv="${POSECOV_BENCH_VENV:-${XDG_CACHE_HOME:-$HOME/.cache}/posecov/bench-venv}"
 
-if [ ! -x "$venv/bin/python" ]; then
-    mkdir -p "$(dirname "$venv")"
-    python3 -m venv "$venv"
-    "$venv/bin/python" -m pip install --quiet --upgrade pip
-fi
-if ! "$venv/bin/python" -c 'import numpy, scipy' 2>/dev/null; then
-    "$venv/bin/python" -m pip install --quiet numpy scipy
-fi
+# shellcheck source=benches/venv.sh
+source "$here/venv.sh"
+bench_venv "$venv" "numpy, scipy" numpy scipy
 
 # Some machines pin OpenBLAS to an old kernel through these variables; they slow a current
 # NumPy. Unset them for this benchmark only (3x3 matrices barely touch BLAS either way).

@@ -15,14 +15,9 @@ bag="$root/tests/data/robot_localization/test2.bag"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
-if [ ! -x "$venv/bin/python" ]; then
-    mkdir -p "$(dirname "$venv")"
-    python3 -m venv "$venv"
-    "$venv/bin/python" -m pip install --quiet --upgrade pip
-fi
-if ! "$venv/bin/python" -c 'import rosbags' 2>/dev/null; then
-    "$venv/bin/python" -m pip install --quiet 'rosbags==0.11.9'
-fi
+# shellcheck source=benches/venv.sh
+source "$here/venv.sh"
+bench_venv "$venv" "rosbags" 'rosbags==0.11.9'
 
 bags=()
 for c in none lz4 bz2; do

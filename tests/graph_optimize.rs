@@ -18,7 +18,9 @@ use rand::{Rng, SeedableRng};
 
 #[path = "common/graph.rs"]
 mod graph_common;
-use graph_common::{block, dense_information, pose2_slam_example, se2_graph, se3_graph};
+use graph_common::{
+    block, dense_information, manhattan_walk, pose2_slam_example, se2_graph, se3_graph,
+};
 
 const POSE2: &str = include_str!("data/gtsam/pose2example.txt");
 const POSE3: &str = include_str!("data/gtsam/pose3example.txt");
@@ -253,69 +255,6 @@ fn unconnected_parts_are_each_anchored_and_an_isolated_vertex_is_kept() {
     assert!((s.poses[2].theta() - 0.1).abs() < 1e-9);
     let cov = s.covariances[2].unwrap();
     assert!((cov[(2, 2)] - 0.01).abs() < 1e-12);
-}
-
-/// A seeded Manhattan-world walk with loop closures, started from a badly rotated guess.
-fn manhattan_walk(poses: usize, seed: u64) -> PoseGraph<Se2, 3> {
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let mut truth = vec![Se2::identity()];
-    for _ in 1..poses {
-        let turn = [
-            0.0,
-            0.0,
-            0.0,
-            std::f64::consts::FRAC_PI_2,
-            -std::f64::consts::FRAC_PI_2,
-        ][rng.random_range(0..5)];
-        let last = *truth.last().unwrap();
-        truth.push(last.compose(&Se2::from_xy_theta(1.0, 0.0, turn)));
-    }
-    let sigma = [0.05, 0.05, 0.02];
-    let info = SMatrix::<f64, 3, 3>::from_diagonal(&SVector::<f64, 3>::from_fn(|k, _| {
-        1.0 / (sigma[k] * sigma[k])
-    }));
-    let noisy = |rng: &mut rand_chacha::ChaCha8Rng, z: Se2| {
-        let n = SVector::<f64, 3>::from_fn(|k, _| {
-            sigma[k] * rand_distr::Distribution::<f64>::sample(&rand_distr::StandardNormal, rng)
-        });
-        z.rplus(&n)
-    };
-    let mut graph = PoseGraph::<Se2, 3>::default();
-    let mut guess = Se2::identity();
-    for k in 0..poses {
-        if k > 0 {
-            let z = noisy(&mut rng, truth[k - 1].between(&truth[k]));
-            graph.edges.push(GraphEdge {
-                from: k - 1,
-                to: k,
-                measurement: z,
-                information: info,
-                line: 0,
-            });
-            guess = guess.compose(&z);
-        }
-        graph.vertices.push(GraphVertex {
-            id: k as u64,
-            estimate: guess,
-            line: 0,
-        });
-    }
-    for j in 0..poses {
-        for i in 0..j.saturating_sub(5) {
-            let d = truth[i].between(&truth[j]);
-            if d.translation().norm() < 1.1 && rng.random_bool(0.5) {
-                let z = noisy(&mut rng, d);
-                graph.edges.push(GraphEdge {
-                    from: i,
-                    to: j,
-                    measurement: z,
-                    information: info,
-                    line: 0,
-                });
-            }
-        }
-    }
-    graph
 }
 
 #[test]

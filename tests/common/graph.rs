@@ -2,12 +2,15 @@
 //! (tiny graphs only: the code under test never forms them).
 #![allow(dead_code)]
 
-use nalgebra::{DMatrix, SMatrix};
+use std::f64::consts::FRAC_PI_2;
+
+use nalgebra::{DMatrix, SMatrix, SVector};
 use posecov::eval::graph::edge_jacobians;
 use posecov::input::graph::read_text;
 use posecov::lie::{LieGroup, Se2, Se3};
 use posecov::plan::AnyPlan;
-use posecov::plan::graph::PoseGraph;
+use posecov::plan::graph::{GraphEdge, GraphVertex, PoseGraph};
+use rand::{Rng, SeedableRng};
 
 /// The SE(2) pose graph of g2o text.
 pub fn se2_graph(text: &str) -> PoseGraph<Se2, 3> {
@@ -75,4 +78,96 @@ pub fn dense_information<G: LieGroup<N>, const N: usize>(
 /// Block (a, b) of a dense matrix over N-blocks.
 pub fn block<const N: usize>(m: &DMatrix<f64>, a: usize, b: usize) -> SMatrix<f64, N, N> {
     SMatrix::<f64, N, N>::from_fn(|p, q| m[(a * N + p, b * N + q)])
+}
+
+/// A seeded Manhattan-world walk in the plane with loop closures: unit steps, a quarter turn
+/// left or right 2 times in 5, noisy odometry (σ = 0.05, 0.05, 0.02) chained into the
+/// initial guess, and a loop closure (same noise) with probability ½ between poses at most
+/// 1.1 apart and more than 5 steps apart.
+pub fn manhattan_walk(poses: usize, seed: u64) -> PoseGraph<Se2, 3> {
+    let turns = [0.0, 0.0, 0.0, FRAC_PI_2, -FRAC_PI_2];
+    let steps = turns.map(|turn| Se2::from_xy_theta(1.0, 0.0, turn));
+    walk(poses, seed, &steps, [0.05, 0.05, 0.02], |d| {
+        d.translation().norm()
+    })
+}
+
+/// The same walk in space: unit steps, a quarter turn about z (left, right) 4 times in 9 and
+/// about y (up, down) 2 times in 9, σ = 0.05 (translation) and 0.02 (rotation).
+pub fn manhattan_walk_3d(poses: usize, seed: u64) -> PoseGraph<Se3, 6> {
+    let turns = [
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, FRAC_PI_2],
+        [0.0, 0.0, -FRAC_PI_2],
+        [0.0, 0.0, FRAC_PI_2],
+        [0.0, 0.0, -FRAC_PI_2],
+        [0.0, FRAC_PI_2, 0.0],
+        [0.0, -FRAC_PI_2, 0.0],
+    ];
+    let steps = turns.map(|rpy| Se3::from_xyz_rpy([1.0, 0.0, 0.0], rpy));
+    let sigma = [0.05, 0.05, 0.05, 0.02, 0.02, 0.02];
+    walk(poses, seed, &steps, sigma, |d| d.translation().norm())
+}
+
+fn walk<G: LieGroup<N>, const N: usize>(
+    poses: usize,
+    seed: u64,
+    steps: &[G],
+    sigma: [f64; N],
+    distance: impl Fn(&G) -> f64,
+) -> PoseGraph<G, N> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut truth = vec![G::identity()];
+    for _ in 1..poses {
+        let step = steps[rng.random_range(0..steps.len())];
+        let last = *truth.last().unwrap();
+        truth.push(last.compose(&step));
+    }
+    let info = SMatrix::<f64, N, N>::from_diagonal(&SVector::<f64, N>::from_fn(|k, _| {
+        1.0 / (sigma[k] * sigma[k])
+    }));
+    let noisy = |rng: &mut rand_chacha::ChaCha8Rng, z: G| {
+        let n = SVector::<f64, N>::from_fn(|k, _| {
+            sigma[k] * rand_distr::Distribution::<f64>::sample(&rand_distr::StandardNormal, rng)
+        });
+        z.rplus(&n)
+    };
+    let mut graph = PoseGraph::<G, N>::default();
+    let mut guess = G::identity();
+    for k in 0..poses {
+        if k > 0 {
+            let z = noisy(&mut rng, truth[k - 1].between(&truth[k]));
+            graph.edges.push(GraphEdge {
+                from: k - 1,
+                to: k,
+                measurement: z,
+                information: info,
+                line: 0,
+            });
+            guess = guess.compose(&z);
+        }
+        graph.vertices.push(GraphVertex {
+            id: k as u64,
+            estimate: guess,
+            line: 0,
+        });
+    }
+    for j in 0..poses {
+        for i in 0..j.saturating_sub(5) {
+            let d = truth[i].between(&truth[j]);
+            if distance(&d) < 1.1 && rng.random_bool(0.5) {
+                let z = noisy(&mut rng, d);
+                graph.edges.push(GraphEdge {
+                    from: i,
+                    to: j,
+                    measurement: z,
+                    information: info,
+                    line: 0,
+                });
+            }
+        }
+    }
+    graph
 }

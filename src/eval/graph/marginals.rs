@@ -1,22 +1,33 @@
 //! Marginal covariances by selected inversion of the sparse factor: the entries of
 //! Σ = H⁻¹ on the pattern of the Cholesky factor L, and nothing else (Takahashi, Fagan &
-//! Chen 1973; Erisman & Tinney 1975; g2o's `MarginalCovarianceCholesky` does the same).
+//! Chen 1973; Erisman & Tinney 1975; g2o's `MarginalCovarianceCholesky` does the same one
+//! entry at a time), here one supernode at a time on dense blocks (as in Amestoy et al.,
+//! "On computing inverse entries of a sparse matrix in an out-of-core environment", SIAM J.
+//! Sci. Comput. 2012, and Lin et al.'s SelInv, ACM TOMS 2011).
 //!
 //! With H = L Lᵀ (in the factor's permuted order), Lᵀ Σ = L⁻¹ is upper triangular with
-//! diagonal 1/L_jj, which gives, from the last column to the first,
+//! diagonal block L_ss⁻¹. Take a supernode s (columns S, the rows R below them) and
+//! L̂ = L_RS L_SS⁻¹. Block row S of Lᵀ Σ = L⁻¹ gives, from the last supernode to the first,
 //!
-//! - Σ_ij = −(1/L_jj) Σ_{k > j, k ∈ struct(j)} L_kj Σ_ki  for i > j in struct(j),
-//! - Σ_jj = (1/L_jj) (1/L_jj − Σ_{k > j} L_kj Σ_kj),
+//! - Σ_RS = −Σ_RR L̂,
+//! - Σ_SS = L_SS⁻ᵀ L_SS⁻¹ − L̂ᵀ Σ_RS.
 //!
-//! where struct(j) is the pattern of L's column j. Every Σ_ki needed lies in the pattern of
-//! L (struct(j) is a clique of the filled graph), so Σ is computed exactly on that pattern,
-//! which holds every pose's diagonal block and the block of every edge's two poses. The
-//! cost is of the order of the factorisation's. Any other pair of poses is answered by two
-//! block solves with the factor ([`joint_by_solves`]).
+//! R is a clique of the filled graph, so every entry of Σ_RR lies in the pattern of L in
+//! later supernodes: Σ is computed exactly on that pattern, which holds every pose's
+//! diagonal block and the block of every edge's two poses. Each step is a gather of Σ_RR
+//! (|R|² entries, all in L's pattern), a triangular solve and two dense products (faer's
+//! kernels): the cost is of the order of the factorisation's, and the memory is Σ in L's
+//! layout plus one |R| × |R| block (≤ 2 nnz(L)), never a dense n×n. Any other pair of poses is
+//! answered by two block solves with the factor ([`joint_by_solves`]).
 
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{Accum, MatMut, MatRef, Par};
 use nalgebra::SMatrix;
 
-use super::sparse::{BlockSystem, Factor};
+use super::sparse::{BlockSystem, Factor, Supernode};
 
 /// Σ = H⁻¹ on the pattern of L (same storage layout as L).
 pub struct SelectedInverse<'a> {
@@ -29,39 +40,110 @@ pub struct SelectedInverse<'a> {
 pub fn selected_inverse<const N: usize>(system: &BlockSystem<N>) -> Option<SelectedInverse<'_>> {
     let factor = system.factor();
     let mut sigma = vec![0.0; factor.len()];
-    let mut rows = Vec::new();
-    let mut sums = Vec::new();
-    let mut offsets = Vec::new();
-    for j in (0..factor.n).rev() {
-        let diagonal_at = factor.column(j, &mut rows);
-        let d = factor.value(diagonal_at);
-        sums.clear();
-        sums.resize(rows.len(), 0.0);
-        let l = |k: usize| factor.value(diagonal_at + 1 + k);
-        for a in 0..rows.len() {
-            let i = rows[a];
-            // Σ_ii, then Σ_ik for the later rows k of column j (in column i at row k).
-            let ii = factor.offset(i, i)?;
-            sums[a] += l(a) * sigma[ii];
-            offsets.clear();
-            for &k in &rows[a + 1..] {
-                offsets.push(factor.offset(k, i)?);
-            }
-            for (b, &at) in (a + 1..rows.len()).zip(&offsets) {
-                let s = sigma[at];
-                sums[a] += l(b) * s;
-                sums[b] += l(a) * s;
-            }
-        }
-        let mut dot = 0.0;
-        for (a, s) in sums.iter().enumerate() {
-            let sigma_ij = -s / d;
-            sigma[diagonal_at + 1 + a] = sigma_ij;
-            dot += l(a) * sigma_ij;
-        }
-        sigma[diagonal_at] = (1.0 / d - dot) / d;
+    let mut sigma_rr = Vec::new();
+    let mut l_hat = Vec::new();
+    let mut l_ss_inverse = Vec::new();
+    for s in (0..factor.supernodes()).rev() {
+        let Supernode {
+            columns,
+            pattern,
+            at,
+        } = factor.supernode(s);
+        let (w, r) = (columns.len(), pattern.len());
+        let rows = w + r;
+        gather(&factor, &sigma, pattern, &mut sigma_rr)?;
+        let sigma_rr = MatRef::from_column_major_slice(&sigma_rr, r, r);
+        let l = MatRef::from_column_major_slice(&factor.values()[at..at + rows * w], rows, w);
+        let (l_ss, l_rs) = l.split_at_row(w);
+        // L̂ = L_RS L_SS⁻¹, i.e. L_SSᵀ L̂ᵀ = L_RSᵀ.
+        l_hat.clear();
+        l_hat.resize(r * w, 0.0);
+        let mut l_hat_mut = MatMut::from_column_major_slice_mut(&mut l_hat, r, w);
+        l_hat_mut.copy_from(l_rs);
+        solve_upper_triangular_in_place(l_ss.transpose(), l_hat_mut.transpose_mut(), Par::Seq);
+        let l_hat = MatRef::from_column_major_slice(&l_hat, r, w);
+        // L_SS⁻¹ (lower triangular, w × w).
+        l_ss_inverse.clear();
+        l_ss_inverse.resize(w * w, 0.0);
+        (0..w).for_each(|k| l_ss_inverse[k * w + k] = 1.0);
+        let inverse = MatMut::from_column_major_slice_mut(&mut l_ss_inverse, w, w);
+        solve_lower_triangular_in_place(l_ss, inverse, Par::Seq);
+        let inverse = MatRef::from_column_major_slice(&l_ss_inverse, w, w);
+        let out = MatMut::from_column_major_slice_mut(&mut sigma[at..at + rows * w], rows, w);
+        let (mut sigma_ss, mut sigma_rs) = out.split_at_row_mut(w);
+        matmul(
+            sigma_rs.as_mut(),
+            Accum::Replace,
+            sigma_rr,
+            l_hat,
+            -1.0,
+            Par::Seq,
+        );
+        matmul(
+            sigma_ss.as_mut(),
+            Accum::Replace,
+            inverse.transpose(),
+            inverse,
+            1.0,
+            Par::Seq,
+        );
+        matmul(
+            sigma_ss.as_mut(),
+            Accum::Add,
+            l_hat.transpose(),
+            sigma_rs.as_ref(),
+            -1.0,
+            Par::Seq,
+        );
     }
     Some(SelectedInverse { factor, sigma })
+}
+
+/// Σ_RR as a dense |R| × |R| column-major matrix, from the entries of Σ already computed
+/// (rows R all lie after the supernode being inverted). The rows of R that fall in one later
+/// supernode t are found in t's row list by one merge, and serve every column of R in t.
+/// `None` if an entry is outside L's pattern.
+fn gather(factor: &Factor<'_>, sigma: &[f64], rows: &[usize], out: &mut Vec<f64>) -> Option<()> {
+    let r = rows.len();
+    out.clear();
+    out.resize(r * r, 0.0);
+    let mut positions = Vec::with_capacity(r);
+    let mut b = 0;
+    while b < r {
+        let Supernode {
+            columns,
+            pattern,
+            at,
+        } = factor.supernode(factor.supernode_of(rows[b]));
+        let leading = columns.len() + pattern.len();
+        // Position of each row R[a], a ≥ b, in t's row list (its columns, then its pattern).
+        positions.clear();
+        let mut k = 0;
+        for &row in &rows[b..] {
+            if row < columns.end {
+                positions.push(row - columns.start);
+            } else {
+                while k < pattern.len() && pattern[k] < row {
+                    k += 1;
+                }
+                if pattern.get(k) != Some(&row) {
+                    return None;
+                }
+                positions.push(columns.len() + k);
+            }
+        }
+        let group_end = b + rows[b..].partition_point(|&row| row < columns.end);
+        for c in b..group_end {
+            let column = at + (rows[c] - columns.start) * leading;
+            for a in c..r {
+                let v = sigma[column + positions[a - b]];
+                out[a + c * r] = v;
+                out[c + a * r] = v;
+            }
+        }
+        b = group_end;
+    }
+    Some(())
 }
 
 impl SelectedInverse<'_> {

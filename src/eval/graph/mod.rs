@@ -19,7 +19,7 @@
 //! - **Linear algebra.** (H + λ I) δ = −g with faer's supernodal sparse Cholesky, the pose
 //!   blocks ordered by approximate minimum degree; no dense n×n matrix anywhere.
 //! - **Marginals.** From the *undamped* H at the final estimate, by selected inversion of its
-//!   factor ([`marginals`]): Σ_k is the N×N block of H⁻¹, the covariance of δ_k in
+//!   factor, supernode by supernode ([`marginals`]): Σ_k is the N×N block of H⁻¹, the covariance of δ_k in
 //!   X_k = X̂_k · Exp(δ_k): posecov's right form over [ρ; θ]. GTSAM's `Marginals` gives the
 //!   same for `Pose2` (tangent (x, y, θ), right); for `Pose3` its tangent is [ω; v], so its
 //!   matrix is P Σ Pᵀ with P the one rotation-first permutation

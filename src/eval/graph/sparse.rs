@@ -297,8 +297,8 @@ fn block_ordering<const N: usize>(
     Ok((scalar_fwd, scalar_inv))
 }
 
-/// Read access to a supernodal factor L, column by column in the permuted order: column j
-/// holds rows j .. end of its supernode, then the supernode's pattern (all ascending).
+/// Read access to a supernodal factor L in the permuted order, supernode by supernode: the
+/// columns of a supernode share one row pattern below them and are stored as one dense block.
 pub struct Factor<'a> {
     /// Unknowns.
     pub n: usize,
@@ -326,44 +326,57 @@ impl Factor<'_> {
         self.values.is_empty()
     }
 
-    fn supernode(&self, j: usize) -> (usize, usize, &[usize], usize) {
-        let s = self.supernode_of[j];
-        let (start, end) = (self.begin[s], self.end[s]);
-        let pattern = &self.row_idx[self.row_idx_ptr[s]..self.row_idx_ptr[s + 1]];
-        let rows = (end - start) + pattern.len();
-        (
-            start,
-            end,
-            pattern,
-            self.val_ptr[s] + (j - start) * rows + (j - start),
-        )
+    /// Supernodes of L: runs of consecutive columns that share one row pattern below them.
+    pub fn supernodes(&self) -> usize {
+        self.begin.len()
     }
 
-    /// Column j: (the offset of L[j, j] in the value storage, the rows below the diagonal in
-    /// ascending order). Entry k of the list is at offset + 1 + k.
-    pub fn column(&self, j: usize, rows: &mut Vec<usize>) -> usize {
-        let (_, end, pattern, offset) = self.supernode(j);
-        rows.clear();
-        rows.extend(j + 1..end);
-        rows.extend_from_slice(pattern);
-        offset
+    /// The supernode that holds column j.
+    pub fn supernode_of(&self, j: usize) -> usize {
+        self.supernode_of[j]
+    }
+
+    /// Supernode s: its columns, the rows below them and where its values are. L's entries of
+    /// these columns are one dense column-major matrix of `columns.len() + pattern.len()` rows
+    /// (first the columns' own rows, lower triangle used, then `pattern`).
+    pub fn supernode(&self, s: usize) -> Supernode<'_> {
+        Supernode {
+            columns: self.begin[s]..self.end[s],
+            pattern: &self.row_idx[self.row_idx_ptr[s]..self.row_idx_ptr[s + 1]],
+            at: self.val_ptr[s],
+        }
     }
 
     /// The value-storage offset of entry (i, j), i ≥ j, if it is in L's pattern.
     pub fn offset(&self, i: usize, j: usize) -> Option<usize> {
-        let (_, end, pattern, offset) = self.supernode(j);
-        if i < end {
-            Some(offset + (i - j))
+        let Supernode {
+            columns,
+            pattern,
+            at,
+        } = self.supernode(self.supernode_of[j]);
+        let column = at + (j - columns.start) * (columns.len() + pattern.len());
+        if i < columns.end {
+            (i >= j).then(|| column + (i - columns.start))
         } else {
             pattern
                 .binary_search(&i)
                 .ok()
-                .map(|k| offset + (end - j) + k)
+                .map(|k| column + columns.len() + k)
         }
     }
 
-    /// L's value at a storage offset.
-    pub fn value(&self, offset: usize) -> f64 {
-        self.values[offset]
+    /// L's values (the layout of [`supernode`](Self::supernode)).
+    pub fn values(&self) -> &[f64] {
+        self.values
     }
+}
+
+/// One supernode of a [`Factor`] (see [`Factor::supernode`]).
+pub struct Supernode<'a> {
+    /// Its columns (consecutive, in the factor's order).
+    pub columns: std::ops::Range<usize>,
+    /// The rows below its columns, ascending.
+    pub pattern: &'a [usize],
+    /// Offset of its dense block in the value storage.
+    pub at: usize,
 }
