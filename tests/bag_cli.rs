@@ -146,6 +146,12 @@ fn save_writes_a_recording_and_every_thins_it() {
         .filter(|c| c.entity_path().to_string().ends_with("/TimeAxis"))
         .count();
     assert_eq!(ranges, 3, "σ of position, σ of rotation, trace");
+    // And each plot's value axis is fitted to the data (a flat σ is not lost in ±1).
+    let values = rrd::store_chunks(&bytes, rerun::StoreKind::Blueprint)
+        .iter()
+        .filter(|c| c.entity_path().to_string().ends_with("/ScalarAxis"))
+        .count();
+    assert_eq!(values, 3);
     std::fs::remove_dir_all(&dir).ok();
 }
 

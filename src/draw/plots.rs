@@ -309,6 +309,7 @@ pub(super) fn plots<G: LieGroup<N>, const N: usize>(
             id,
             title: k.title.to_owned(),
             unit: k.unit.to_owned(),
+            range: None,
         })
         .collect();
     (plots, series)

@@ -18,7 +18,7 @@ use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::input::{CameraChoice, Layout};
 use crate::scene::WORLD;
-use crate::scene::{Camera, ItemKind, Scene, Vec3, View3d, grid_columns, rotate};
+use crate::scene::{Camera, ItemKind, Scene, SceneItem, Vec3, View3d, grid_columns, rotate};
 use crate::uncertain::Method;
 
 /// Rerun's default vertical field of view of a 3-D view (55°).
@@ -130,7 +130,7 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
     let rows = views.len().div_ceil(columns);
     let aspect = ASPECT * rows as f64 / columns as f64;
     for view in &mut views {
-        view.camera = camera(&points_of(scene, view), plan, aspect);
+        view.camera = camera(&points_of(scene, view, |_| true), plan, aspect);
     }
     views
 }
@@ -153,7 +153,7 @@ pub(super) fn before_after(scene: &Scene, plan: &ViewInputs, after: &str) -> Vec
     ];
     let aspect = ASPECT / 2.0;
     for view in &mut views {
-        view.camera = camera(&points_of(scene, view), plan, aspect);
+        view.camera = camera(&points_of(scene, view, |_| true), plan, aspect);
     }
     views
 }
@@ -213,10 +213,19 @@ fn per_method(plan: &ViewInputs) -> Vec<View3d> {
         .collect()
 }
 
-/// Every point a view draws: positions, vertices, ellipsoid and axis extremes.
-fn points_of(scene: &Scene, view: &View3d) -> Vec<Vector3<f64>> {
+/// Every point a view draws (of the items `keep` accepts): positions, vertices, ellipsoid and
+/// axis extremes.
+pub(super) fn points_of(
+    scene: &Scene,
+    view: &View3d,
+    keep: impl Fn(&SceneItem) -> bool,
+) -> Vec<Vector3<f64>> {
     let mut out: Vec<Vec3> = Vec::new();
-    for item in scene.items.iter().filter(|i| view.shows(&i.path)) {
+    for item in scene
+        .items
+        .iter()
+        .filter(|i| view.shows(&i.path) && keep(i))
+    {
         match &item.kind {
             ItemKind::Frame(f) => {
                 out.push(f.translation);

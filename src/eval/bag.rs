@@ -108,6 +108,9 @@ pub struct PoseEvaluation {
     pub state: PoseState,
     /// RViz's numbers (`None` when the covariance is not finite).
     pub rviz: Option<RvizNumbers>,
+    /// σ = √Σᵢᵢ per ROS axis (x, y, z in the parent's axes, m; roll, pitch, yaw, rad) where
+    /// the axis is estimated: finite, neither a placeholder (≥ 1e6) nor zero.
+    pub sigma: [Option<f64>; 6],
 }
 
 /// One axis's σ over a topic: first, last, smallest and largest over every message where the
@@ -177,6 +180,8 @@ pub fn sigma_summary(
 pub struct TopicEvaluation {
     /// Topic name.
     pub name: String,
+    /// The frame its poses are in (`header.frame_id` of its first message; may be empty).
+    pub frame_id: String,
     /// Drawn as SE(2) in the x–y plane.
     pub planar: bool,
     /// Degrees of freedom of the position region (2 planar, 3 otherwise).
@@ -266,17 +271,23 @@ fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) ->
                     },
                 },
             };
+            let sigma = std::array::from_fn(|i| {
+                let v = m.covariance[i * 7];
+                (v.is_finite() && v >= 0.0 && !d.unestimated[i]).then(|| v.sqrt())
+            });
             PoseEvaluation {
                 index: d.index,
                 stamp_ns: m.stamp_ns,
                 mean,
                 state,
                 rviz,
+                sigma,
             }
         })
         .collect();
     TopicEvaluation {
         name: topic.name.clone(),
+        frame_id: topic.frame_id.clone(),
         planar: topic.planar,
         position_dof: if topic.planar { 2 } else { 3 },
         pose_dof: if topic.planar { 3 } else { 6 },

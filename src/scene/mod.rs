@@ -318,13 +318,17 @@ pub struct Plot {
     pub title: String,
     /// The unit of the values, e.g. "m²".
     pub unit: String,
+    /// The value axis's range `[low, high]` in `unit`, fitted to the data by the drawing stage
+    /// (a constant σ is then a flat line at its level, not lost in the viewer's ±1 default);
+    /// `None`: the viewer's own fit.
+    pub range: Option<[f64; 2]>,
 }
 
 impl Plot {
     /// The title with its unit, as a view shows it: "trace of rotation covariance (rad²)".
     ///
     /// ```
-    /// let p = posecov::scene::Plot { id: "t".into(), title: "trace".into(), unit: "m²".into() };
+    /// let p = posecov::scene::Plot { id: "t".into(), title: "trace".into(), unit: "m²".into(), range: None };
     /// assert_eq!(p.label(), "trace (m²)");
     /// ```
     pub fn label(&self) -> String {
@@ -403,6 +407,10 @@ pub struct Scene {
     pub legend: Vec<LegendEntry>,
     /// The probability inside every drawn region, if the scene draws regions.
     pub confidence: Option<crate::uncertain::Confidence>,
+    /// Layout: the plots in a row under the 3-D views and the text panel the whole right
+    /// column (robot logs, whose health findings need the height); else the plots stand under
+    /// the text panel on the right.
+    pub plots_below: bool,
 }
 
 impl Scene {
@@ -424,6 +432,7 @@ impl Scene {
             views: Vec::new(),
             legend: Vec::new(),
             confidence: None,
+            plots_below: false,
         }
     }
 

@@ -366,7 +366,7 @@ impl Scene {
     /// Checks that the scene can be drawn: every number finite (also as `f32`), quaternions
     /// of unit norm, sizes non-negative and radii positive, parallel arrays of equal length,
     /// triangle indices in range, entity paths well formed, 3-D items under [`WORLD`], series
-    /// under [`PLOTS`], views' subtrees under [`WORLD`] and their cameras usable, and nothing placed under a [`Frame`]'s entity (its transform would
+    /// under [`PLOTS`] and their plots' ranges finite, views' subtrees under [`WORLD`] and their cameras usable, and nothing placed under a [`Frame`]'s entity (its transform would
     /// move it).
     ///
     /// ```
@@ -382,6 +382,11 @@ impl Scene {
     pub fn validate(&self) -> Result<(), SceneError> {
         self.items.iter().try_for_each(check_item)?;
         self.series.iter().try_for_each(check_series)?;
+        for plot in &self.plots {
+            for (i, v) in plot.range.iter().flatten().enumerate() {
+                finite(&format!("{PLOTS}/{}", plot.id), "range", i, *v)?;
+            }
+        }
         self.views.iter().try_for_each(super::View3d::check)?;
         // Each item's ancestors looked up among the frames: linear in items × depth.
         let frames: std::collections::HashSet<&str> = self

@@ -24,10 +24,10 @@ use rr::blueprint::components::{
     ContainerKind, Eye3DKind, IncludedContent, PanelState, PlayState, QueryExpression,
     RootContainer, RowShare, TimelineName, ViewClass,
 };
-use rr::components::{Name, Position3D, Vector3D, Visible};
+use rr::components::{Name, Position3D, Range1D, Vector3D, Visible};
 use rr::external::re_log_types::BlueprintActivationCommand;
 use rr::external::re_sdk_types::blueprint::archetypes::{
-    ContainerBlueprint, EntityBehavior, EyeControls3D, PanelBlueprint, TimeAxis,
+    ContainerBlueprint, EntityBehavior, EyeControls3D, PanelBlueprint, ScalarAxis, TimeAxis,
     TimePanelBlueprint, ViewBlueprint, ViewContents, ViewportBlueprint,
 };
 use rr::external::re_sdk_types::blueprint::components::{ColumnShare, GridColumns, TimeRange};
@@ -41,8 +41,9 @@ use crate::scene::{self, Camera, Scene, View3d};
 /// Sends the layout of `scene` through `rec` and makes it the active and default blueprint:
 /// the 3-D views on the left (two thirds; several views in a grid, each with its camera and
 /// its hidden entities), on the right the description above one time-series view per
-/// [`Plot`](crate::scene::Plot) (its title and unit as the view's name). Panels collapsed; the
-/// time panel shows the `step` timeline following the latest data, so a recording opens on its
+/// [`Plot`](crate::scene::Plot) (its title and unit as the view's name, its value range when
+/// the scene fits one); with [`Scene::plots_below`], the plots in a row under the views and
+/// the description the whole right column (two fifths). Panels collapsed; the time panel shows the `step` timeline following the latest data, so a recording opens on its
 /// last step.
 ///
 /// # Errors
@@ -95,14 +96,14 @@ fn layout_messages(
             grid
         }
     };
-    let mut right = vec![log_view(
+    let description = log_view(
         &bp,
         &mut ids,
         "TextDocument",
         "Description",
         scene::DESCRIPTION,
-    )?];
-    let mut shares = vec![3.0];
+    )?;
+    let mut plots = Vec::new();
     for plot in &scene.plots {
         let origin = format!("{}/{}", scene::PLOTS, plot.id);
         let view = log_view(&bp, &mut ids, "TimeSeries", &plot.label(), &origin)?;
@@ -112,18 +113,50 @@ fn layout_messages(
                 &TimeAxis::new().with_view_range(range),
             )?;
         }
-        right.push(view);
-        shares.push(2.0);
+        if let Some([low, high]) = plot.range {
+            bp.log(
+                format!("{view}/ScalarAxis"),
+                &ScalarAxis::new().with_range(Range1D::new(low, high)),
+            )?;
+        }
+        plots.push(view);
     }
-    let right = log_container(&bp, &mut ids, ContainerKind::Vertical, &right, &shares)?;
-    let root = ids.next();
-    log_container_at(
-        &bp,
-        &root,
-        ContainerKind::Horizontal,
-        &[left, right],
-        &[2.0, 1.0],
-    )?;
+    // Ids in creation order; the root is created after its children.
+    let root = if scene.plots_below && !plots.is_empty() {
+        // The views above a row of plots on the left, the text panel the whole right column.
+        let row = log_container(&bp, &mut ids, ContainerKind::Horizontal, &plots, &[])?;
+        let left = log_container(
+            &bp,
+            &mut ids,
+            ContainerKind::Vertical,
+            &[left, row],
+            &[3.0, 2.0],
+        )?;
+        let root = ids.next();
+        log_container_at(
+            &bp,
+            &root,
+            ContainerKind::Horizontal,
+            &[left, description],
+            &[3.0, 2.0],
+        )?;
+        root
+    } else {
+        let shares: Vec<f32> = std::iter::once(3.0)
+            .chain(plots.iter().map(|_| 2.0))
+            .collect();
+        let right: Vec<String> = std::iter::once(description).chain(plots).collect();
+        let right = log_container(&bp, &mut ids, ContainerKind::Vertical, &right, &shares)?;
+        let root = ids.next();
+        log_container_at(
+            &bp,
+            &root,
+            ContainerKind::Horizontal,
+            &[left, right],
+            &[2.0, 1.0],
+        )?;
+        root
+    };
     bp.log(
         "viewport",
         &ViewportBlueprint::new()

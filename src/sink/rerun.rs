@@ -45,7 +45,8 @@ pub fn log_scene(rec: &rr::RecordingStream, scene: &Scene) -> Result<(), SinkErr
 
 /// Logs `scene` to `rec`: validates it first (so NaN never reaches the viewer), then the
 /// world's view coordinates (right-handed, z up) and the description (static), every static
-/// item, then the items of each step in ascending order, then the plot series. `cancel` is
+/// item, then the items of each step in ascending order, then the plot series (on a stamp
+/// timeline, a robot log's, the series come before the items). `cancel` is
 /// checked before every item: when it is raised, logging stops at a step boundary-or-item and
 /// the outcome says where (what was logged stays a consistent prefix).
 ///
@@ -83,11 +84,21 @@ pub fn log_scene_cancellable(
             scene.description_markdown.as_str(),
         )],
     )?;
+    // A robot log's plots (on the stamp timeline) are small and what a reader looks at
+    // first: they go before its items, so a viewer still loading the recording shows them.
+    let series_first = scene.timeline != scene::Timeline::Step;
+    if series_first {
+        for series in &scene.series {
+            log_series(rec, series, scene.timeline)?;
+        }
+    }
     if let cancelled @ LogOutcome::Cancelled { .. } = log_items(rec, scene, cancel)? {
         return Ok(cancelled);
     }
-    for series in &scene.series {
-        log_series(rec, series, scene.timeline)?;
+    if !series_first {
+        for series in &scene.series {
+            log_series(rec, series, scene.timeline)?;
+        }
     }
     Ok(LogOutcome::Complete)
 }

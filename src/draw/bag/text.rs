@@ -146,6 +146,28 @@ pub fn description(
         plan.messages_total,
         plan.topics.len()
     );
+    let mut frames: Vec<&str> = e.topics.iter().map(|t| t.frame_id.as_str()).collect();
+    frames.sort_unstable();
+    frames.dedup();
+    if frames.len() > 1 {
+        let names: Vec<String> = frames
+            .iter()
+            .map(|f| {
+                if f.is_empty() {
+                    "(none)".to_owned()
+                } else {
+                    format!("`{f}`")
+                }
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "\n**{} frames** ({}): one whole-log view each — topics in different frames are \
+             never overlaid as if they were one (no `/tf` transform is applied).",
+            frames.len(),
+            names.join(", ")
+        );
+    }
     if plan.cancelled {
         let _ = writeln!(
             s,
@@ -174,12 +196,15 @@ pub fn description(
     }
     let _ = writeln!(
         s,
-        "\n---\n\n**The two pictures**\n\n\
+        "\n---\n\n**The views**: the whole log per frame; beside it, per topic, the message at \
+         the time cursor at the robot's scale (at the origin, the parent frame's axes; its σ on \
+         the pose; the camera fits the last message). Plots: σ in mm and degrees (or m, mrad) \
+         where that reads best, ranges from 0.\n\n**The two pictures**\n\n\
          - **RViz's picture** (magenta, `rviz/`): the ellipsoid of the covariance's position \
          block read in the parent frame's axes, and orientation discs at the axis tips \
          (tan of the angular spread, bounded at 89°) — a yaw fan when RViz takes the pose as \
          2-D (Σzz, Σroll, Σpitch ≤ 0; a 1e6 placeholder makes it draw a 3-D shape kilometres \
-         tall, clipped here at half the scene's size).\n\
+         tall: drawn here clipped at 3 × the estimated axes, and labelled).\n\
          - **What the numbers mean** (`meaning/`): ROS's covariance, read {}, converted to \
          posecov's body-frame right form, X = μ · Exp(ε); its Exp-mapped banana, Cartesian \
          ellipsoid and a seeded sample cloud (3-D: sampled axis tips).\n\
