@@ -13,11 +13,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
 use clap::{Args, Parser, Subcommand};
-use posecov::app::commands;
 use posecov::app::live::{self, LiveOptions};
 use posecov::app::sinks::{EXIT_INTERRUPTED, ServeOptions, ViewOptions};
 use posecov::app::view::view;
 use posecov::app::{AppError, EXIT_CANNOT, EXIT_CODES_HELP, Overrides};
+use posecov::app::{commands, many};
 use posecov::eval::graph::{GraphReading, Optimizer};
 use posecov::interop::RosReading;
 use posecov::sink::Sink;
@@ -45,20 +45,30 @@ struct Cli {
 enum Command {
     /// List the bundled scenarios with one-line descriptions.
     List,
-    /// Evaluate a scenario and print every mean, covariance, method and error.
+    /// Evaluate a scenario and print every mean, covariance, method and error. Several inputs
+    /// (or a directory: every .bag and .mcap in it) run in parallel; with --json each prints
+    /// one compact JSON object per line (JSON Lines) as it finishes.
+    #[command(after_help = EXIT_CODES_HELP)]
     Report {
         #[command(flatten)]
         scenario: ScenarioArgs,
+        /// Further inputs, or directories of logs.
+        #[arg(value_name = "MORE")]
+        more: Vec<String>,
         /// Print JSON (for scripts and tests).
         #[arg(long)]
         json: bool,
     },
     /// Validate a scenario or graph without drawing it; for a robot log, fail (exit 1) on a
-    /// covariance defect, printing the first of each topic on stderr.
+    /// covariance defect, printing the first of each topic on stderr. Several inputs (or a
+    /// directory of logs) run in parallel: one line each, the worst exit code.
     #[command(after_help = EXIT_CODES_HELP)]
     Check {
         #[command(flatten)]
         scenario: ScenarioArgs,
+        /// Further inputs, or directories of logs.
+        #[arg(value_name = "MORE")]
+        more: Vec<String>,
         /// Accept this defect class on purpose (repeatable): non_finite, asymmetric, not_psd,
         /// undecodable, bad_orientation, unknown_marker, all_zero, placeholder_used_axis,
         /// constant, frozen_stamp.
@@ -324,6 +334,13 @@ impl ScenarioArgs {
         self.scenario.as_deref().unwrap_or_default()
     }
 
+    /// Every input of a command that takes several: the first, then `more`.
+    fn inputs(&self, more: &[String]) -> Vec<String> {
+        std::iter::once(self.scenario().to_owned())
+            .chain(more.iter().cloned())
+            .collect()
+    }
+
     fn overrides(&self) -> Overrides {
         Overrides {
             topics: self.topics.clone(),
@@ -455,8 +472,28 @@ fn try_main() -> anyhow::Result<ExitCode> {
     });
     match cli.command {
         Some(Command::List) => emit(&commands::list()?),
-        Some(Command::Report { scenario, json }) => {
-            match commands::report(scenario.scenario(), &scenario.overrides(), json) {
+        Some(Command::Report {
+            scenario,
+            more,
+            json,
+        }) => {
+            let inputs = match many::expand(&scenario.inputs(&more)) {
+                Ok(inputs) => inputs,
+                Err(err) => {
+                    if json {
+                        write_out(&format!("{}\n", err.to_json()))?;
+                    }
+                    return Err(err.into());
+                }
+            };
+            if inputs.several {
+                let overrides = scenario.overrides();
+                let code = many::report(&inputs.names, &overrides, json, &mut |text| {
+                    write_out(text).unwrap_or(false)
+                });
+                return Ok(ExitCode::from(code));
+            }
+            match commands::report(&inputs.names[0], &scenario.overrides(), json) {
                 Ok(text) => emit(&text),
                 Err(err) => {
                     // Scripts reading `--json` get the error as JSON too; people get stderr.
@@ -467,9 +504,21 @@ fn try_main() -> anyhow::Result<ExitCode> {
                 }
             }
         }
-        Some(Command::Check { scenario, allow }) => {
+        Some(Command::Check {
+            scenario,
+            more,
+            allow,
+        }) => {
             let allow = commands::allowed(&allow)?;
-            let checked = commands::check(scenario.scenario(), &scenario.overrides(), &allow)?;
+            let inputs = many::expand(&scenario.inputs(&more))?;
+            if inputs.several {
+                let overrides = scenario.overrides();
+                let code = many::check(&inputs.names, &overrides, &allow, &mut |line| {
+                    write_out(line).unwrap_or(false)
+                });
+                return Ok(ExitCode::from(code));
+            }
+            let checked = commands::check(&inputs.names[0], &scenario.overrides(), &allow)?;
             for defect in &checked.defects {
                 eprintln!("{defect}");
             }

@@ -50,7 +50,18 @@ pub fn run(
     settings: &LogSettings,
     cancel: Option<&AtomicBool>,
 ) -> Result<LogRun, AppError> {
-    let plan = read(located, &settings.read, cancel)?;
+    run_with(located, settings, cancel, true)
+}
+
+/// [`run`]; `bar`: show the reading's progress bar (hidden when many logs run at once under
+/// one bar, [`super::many`]).
+pub(super) fn run_with(
+    located: &Located,
+    settings: &LogSettings,
+    cancel: Option<&AtomicBool>,
+    bar: bool,
+) -> Result<LogRun, AppError> {
+    let plan = read(located, &settings.read, cancel, bar)?;
     let evaluation = evaluate_bag(&plan, &settings.eval);
     let file = located.origin();
     let title = match &located.place {
@@ -115,9 +126,15 @@ fn read(
     located: &Located,
     options: &BagOptions,
     cancel: Option<&AtomicBool>,
+    shown: bool,
 ) -> Result<LogSummary, AppError> {
     let file = located.origin();
-    let bar = ProgressBar::new(0).with_message(format!("reading {file}"));
+    let bar = if shown {
+        ProgressBar::new(0)
+    } else {
+        ProgressBar::hidden()
+    }
+    .with_message(format!("reading {file}"));
     bar.set_style(
         ProgressStyle::with_template("{msg} {wide_bar} {percent} % ({elapsed}, eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),

@@ -48,6 +48,17 @@ pub fn list() -> Result<String, AppError> {
     Ok(out)
 }
 
+/// How `report` prints one input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReportStyle {
+    /// Words for people.
+    Text,
+    /// One JSON object, indented.
+    Json,
+    /// One JSON object on one line (a line of JSON Lines, for several inputs).
+    JsonLine,
+}
+
 /// `posecov report`: every mean, covariance, method, error and finding, as JSON or text.
 ///
 /// ```
@@ -57,24 +68,45 @@ pub fn list() -> Result<String, AppError> {
 /// assert_eq!(json["meta"]["samples"], 50);
 /// ```
 pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<String, AppError> {
+    let style = if json {
+        ReportStyle::Json
+    } else {
+        ReportStyle::Text
+    };
+    report_as(scenario, overrides, style, true)
+}
+
+/// [`report`] in a [`ReportStyle`]; `bar`: a log's reading shows its progress bar.
+pub(super) fn report_as(
+    scenario: &str,
+    overrides: &Overrides,
+    style: ReportStyle,
+    bar: bool,
+) -> Result<String, AppError> {
+    let printed = |value: serde_json::Value| match style {
+        ReportStyle::JsonLine => value.to_string() + "\n",
+        _ => serde_json::to_string_pretty(&value).unwrap_or_default() + "\n",
+    };
     let loaded = match open(scenario)? {
         Opened::Plan(loaded) => *loaded,
         Opened::Log(located) => {
-            let run = bag::run(&located, &resolve_log(overrides)?, None)?;
-            return Ok(if json {
-                serde_json::to_string_pretty(&bag::report_json(scenario, &run)).unwrap_or_default()
-                    + "\n"
-            } else {
-                bag::report_text(scenario, &run)
+            let run = bag::run_with(&located, &resolve_log(overrides)?, None, bar)?;
+            return Ok(match style {
+                ReportStyle::Text => bag::report_text(scenario, &run),
+                _ => printed(bag::report_json(scenario, &run)),
             });
         }
     };
     let settings = resolve(&loaded.input, overrides, None)?;
     let evaluation = evaluate(&loaded, &settings.eval)?;
     let confidence = settings.draw.confidence;
-    if json {
-        let value = report_json(scenario, &loaded, &evaluation, confidence);
-        return Ok(serde_json::to_string_pretty(&value).unwrap_or_default() + "\n");
+    if style != ReportStyle::Text {
+        return Ok(printed(report_json(
+            scenario,
+            &loaded,
+            &evaluation,
+            confidence,
+        )));
     }
     let ran = evaluation.ran_with();
     let (seed, samples) = (ran.seed, ran.samples);
@@ -171,10 +203,20 @@ pub fn allowed(names: &[String]) -> Result<Vec<Issue>, AppError> {
 /// assert_eq!(log.exit_code(), 1);
 /// ```
 pub fn check(scenario: &str, overrides: &Overrides, allow: &[Issue]) -> Result<Checked, AppError> {
+    check_as(scenario, overrides, allow, true)
+}
+
+/// [`check`]; `bar`: a log's reading shows its progress bar.
+pub(super) fn check_as(
+    scenario: &str,
+    overrides: &Overrides,
+    allow: &[Issue],
+    bar: bool,
+) -> Result<Checked, AppError> {
     let loaded = match open(scenario)? {
         Opened::Plan(loaded) => *loaded,
         Opened::Log(located) => {
-            let run = bag::run(&located, &resolve_log(overrides)?, None)?;
+            let run = bag::run_with(&located, &resolve_log(overrides)?, None, bar)?;
             return Ok(bag::check(&run, scenario, allow));
         }
     };

@@ -27,6 +27,7 @@ pub mod commands;
 #[cfg(feature = "viewer")]
 pub mod figure;
 pub mod live;
+pub mod many;
 pub mod run;
 #[cfg(feature = "viewer")]
 pub mod session;
@@ -60,7 +61,8 @@ Exit codes (every command; `check` differs where shown):
        every command: a scenario or graph error located at file:line:column
   2    cannot process: unreadable file, unknown format, no pose-with-covariance topic,
        a damaged log, a usage error
-  130  interrupted (Ctrl-C)";
+  130  interrupted (Ctrl-C)
+Several inputs (`report`, `check`): the worst code of any input.";
 
 /// Why a command could not run. Each names where the problem is in the user's words: the
 /// file, line, column and key, or the command-line flag.
