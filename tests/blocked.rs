@@ -247,13 +247,19 @@ fn blocked_compounding_and_diff_drive_match_single_block() {
                 );
             }
         }
+        // The means and their batch-means standard errors (the same batches in both runs).
         let means = |e: &AnyEvaluation| -> Vec<[f64; 2]> {
             e.findings()
                 .iter()
                 .filter_map(|f| match f {
-                    Finding::DiffDriveMeans { cartesian_mean, .. } => Some(*cartesian_mean),
+                    Finding::DiffDriveMeans {
+                        cartesian_mean,
+                        cartesian_mean_stderr,
+                        ..
+                    } => Some([*cartesian_mean, cartesian_mean_stderr.expect("stderr")]),
                     _ => None,
                 })
+                .flatten()
                 .collect()
         };
         let (ma, mb) = (means(&single), means(&blocked));

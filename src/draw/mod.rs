@@ -28,6 +28,7 @@
 //! ```
 
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 
 use nalgebra::Vector3;
 
@@ -53,6 +54,7 @@ mod plots;
 mod shapes;
 mod text;
 mod views;
+mod words;
 
 /// At most this many Monte Carlo particles get a small axis triad.
 const TRIAD_SUBSAMPLE: usize = 60;
@@ -207,6 +209,64 @@ impl<'a> Shown<'a> {
     }
 }
 
+impl Shown<'_> {
+    /// The pose through which a result `a_from_c` that is relative to a frame `a` other than
+    /// the root is drawn: the single, drawn pose `root_from_a` (`world_from_b` for
+    /// `b_from_world`). `None` when the file chose for the result, or there is no such pose.
+    fn through<'e, G: LieGroup<N>, const N: usize>(
+        &self,
+        e: &'e Evaluation<G, N>,
+        node: &Node<G, N>,
+    ) -> Option<&'e Node<G, N>> {
+        if self.choices.shown.contains_key(&node.name)
+            || node.role != Role::Output
+            || node.step.is_some()
+            || self.rotation_only
+        {
+            return None;
+        }
+        let (root, parent) = (self.root?, parent_frame(&node.name)?);
+        let via = format!("{root}_from_{parent}");
+        e.nodes
+            .iter()
+            .rev()
+            .find(|n| n.name == via && n.step.is_none() && self.node(n))
+    }
+}
+
+/// A result `a_from_c` relative to a frame `a` that is not the root, drawn where it puts `c`
+/// seen from `a`'s mean: moved by the mean of `via` = `root_from_a`, μ_via · X, a known change
+/// of frame of the picture ([`change_frame_left`](crate::propagate::first_order::change_frame_left):
+/// a right-form Σ is unchanged, so the spread drawn is the result's own), and said so in the
+/// legend and the text panel.
+fn draw_through<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    node: &Node<G, N>,
+    via: &Node<G, N>,
+    settings: &DrawSettings,
+) {
+    use crate::propagate::first_order::change_frame_left;
+    let by = via.nominal;
+    let mut moved = node.clone();
+    moved.nominal = by.compose(&node.nominal);
+    for estimate in &mut moved.estimates {
+        estimate.result.pose = change_frame_left(&by, &estimate.result.pose).pose;
+    }
+    moved.particles = node
+        .particles
+        .as_ref()
+        .map(|x| std::sync::Arc::new(x.iter().map(|g| by.compose(g)).collect()));
+    draw_node(p, &moved, settings);
+    let (name, from) = (&node.name, &via.name);
+    let child = node.name.split_once("_from_").map_or("", |(_, c)| c);
+    p.scene
+        .add_legend(legend::axes(&format!("{name}, drawn from {from}'s mean")));
+    let _ = write!(
+        p.scene.description_markdown,
+        "**`{name}`** is relative to its own frame, so it is drawn where it puts `{child}` seen from          `{from}`'s mean: μ_{from} · {name}, a known change of frame of the picture (its right-form Σ          is unchanged: the spread drawn is `{name}`'s own).\n\n"
+    );
+}
+
 /// The parent frame of a name `a_from_b` (`a`), if it follows that convention.
 fn parent_frame(name: &str) -> Option<&str> {
     name.split_once("_from_").map(|(parent, _)| parent)
@@ -238,8 +298,12 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
             .unwrap_or(0);
         p.layout = views::default_layout(G::KIND.is_rotation_only(), names.len(), most_methods);
     }
-    for node in e.nodes.iter().filter(|n| shown.node(n)) {
-        draw_node(&mut p, node, settings);
+    for node in &e.nodes {
+        if shown.node(node) {
+            draw_node(&mut p, node, settings);
+        } else if let Some(via) = shown.through(e, node) {
+            draw_through(&mut p, node, via, settings);
+        }
     }
     if choices.trajectories {
         let radius = 0.004 * p.extent.max(0.25);

@@ -2,6 +2,7 @@
 //! orientation spray) on one side, and its Monte Carlo particles.
 
 use super::*;
+use crate::uncertain::Region;
 
 /// Colour of the Monte Carlo heading arrows of planar poses (light red).
 const HEADING_COLOR: Color = Color::rgb(255, 120, 120);
@@ -49,7 +50,7 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
             && !rotation_only
         {
             let who = e.result.method.label().to_owned();
-            cartesian_legend(p, who, e.result.method);
+            cartesian_legend(p, who, e.result.method, "");
             p.region_ellipsoid(
                 &format!("{WORLD}/{}/{}", node.name, e.result.method.slug()),
                 timing,
@@ -67,11 +68,11 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
         .iter()
         .find(|e| Some(e.result.method) == primary)
         .map(|e| e.result.pose.side());
-    // The Cartesian ellipses drawn for this pose: (method, who, centre, covariance).
-    let mut cartesian: Vec<(Method, String, Vec3, nalgebra::Matrix3<f64>)> = Vec::new();
-    for estimate in &node.estimates {
-        let pose = side.map_or(estimate.result.pose, |s| estimate.result.pose.to_side(s));
-        let method = estimate.result.method;
+    // The Cartesian ellipses drawn for this pose.
+    let mut cartesian: Vec<Drawn> = Vec::new();
+    for evaluated in &node.estimates {
+        let pose = side.map_or(evaluated.result.pose, |s| evaluated.result.pose.to_side(s));
+        let method = evaluated.result.method;
         if method == Method::MonteCarlo && node.particles.is_some() {
             continue; // the cloud itself shows Monte Carlo
         }
@@ -102,10 +103,11 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
         // vector-space baseline's (a Gaussian in (x, y, θ) is exactly that ellipse).
         let who = legend::who(estimate, method.label());
         if !rotation_only && ellipsoids && (is_primary || method == Method::VectorSpace) {
-            cartesian_legend(p, who.clone(), method);
+            let ellipse_held = held(node, evaluated, &[Region::Cartesian, Region::VectorSpace]);
+            cartesian_legend(p, who.clone(), method, &ellipse_held);
             if let Some(cov) = pose.position_cov_in_world_3d() {
                 let centre = v3(pose.mean().to_se3().translation());
-                cartesian.push((method, who.clone(), centre, cov));
+                cartesian.push((method, who.clone(), centre, cov, ellipse_held));
             }
             p.region_ellipsoid(&base, timing, &pose, color);
         }
@@ -114,7 +116,10 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
             let point_of = |x: &G| *x.to_se3().translation();
             if is_primary || p.layout == Layout::PerMethod {
                 p.legend(
-                    format!("{who}: Exp-mapped {region} region"),
+                    format!(
+                        "{who}: Exp-mapped {region} region{}",
+                        held(node, evaluated, &[Region::Tangent])
+                    ),
                     color,
                     Swatch::Region,
                 );
@@ -156,19 +161,19 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
     }
 }
 
+/// A Cartesian ellipse drawn for a pose: (method, who, centre, covariance, the share of
+/// samples its legend entry states).
+type Drawn = (Method, String, Vec3, nalgebra::Matrix3<f64>, String);
+
 /// Says when the vector-space ellipse and another method's Cartesian ellipse of one pose are
 /// the same (same centre and matrix to 1e-9 relative): one hides the other exactly, and a
-/// reader would conclude the hidden one is missing. Once per pose name, in the legend and the
-/// text panel.
-fn coinciding(
-    p: &mut Painter,
-    pose: &str,
-    drawn: &[(Method, String, Vec3, nalgebra::Matrix3<f64>)],
-) {
-    let Some((_, _, c0, m0)) = drawn.iter().find(|d| d.0 == Method::VectorSpace) else {
+/// reader would conclude the hidden one is missing. Once per pose name, in the text panel, and
+/// in the legend in place of the hidden ellipse's own entry (one entry per line drawn).
+fn coinciding(p: &mut Painter, pose: &str, drawn: &[Drawn]) {
+    let Some((_, _, c0, m0, _)) = drawn.iter().find(|d| d.0 == Method::VectorSpace) else {
         return;
     };
-    for (method, who, c, m) in drawn.iter().filter(|d| d.0 != Method::VectorSpace) {
+    for (method, who, c, m, held) in drawn.iter().filter(|d| d.0 != Method::VectorSpace) {
         let scale = m0.amax().max(f64::MIN_POSITIVE);
         let same_matrix = (m - m0).amax() <= 1e-9 * scale;
         let same_centre = (0..3).all(|k| (c[k] - c0[k]).abs() <= 1e-9 * (1.0 + c0[k].abs()));
@@ -176,13 +181,20 @@ fn coinciding(
             continue;
         }
         let region = p.confidence().to_string();
-        p.legend(
-            format!(
-                "{who}: Cartesian {region} ellipse = the vector-space one here (same matrix; drawn under it)"
-            ),
-            method.color(),
-            Swatch::Dashed,
+        let own = format!("{}{held}", cartesian_label(p, who, *method));
+        let label = format!(
+            "{who}: Cartesian {region} ellipse = the vector-space one here (same matrix; drawn under it){held}"
         );
+        let color = method.color().with_alpha(255);
+        match p
+            .scene
+            .legend
+            .iter_mut()
+            .find(|e| e.label == own && e.color == color)
+        {
+            Some(entry) => entry.label = label,
+            None => p.legend(label, method.color(), Swatch::Dashed),
+        }
         let sentence = format!(
             "**{pose}:** the vector-space ellipse ({}) coincides with the {who} Cartesian one ({}) here: same matrix, so only one line shows.\n\n",
             Method::VectorSpace.color_name(),
@@ -195,15 +207,46 @@ fn coinciding(
 }
 
 /// The legend entry of a method's Cartesian position ellipse (the vector-space baseline's is
-/// its whole Gaussian in (x, y[, z])).
-fn cartesian_legend(p: &mut Painter, who: String, method: Method) {
+/// its whole Gaussian in (x, y[, z])), with the share of samples it holds (`held`).
+fn cartesian_legend(p: &mut Painter, who: String, method: Method, held: &str) {
+    let label = cartesian_label(p, &who, method);
+    p.legend(format!("{label}{held}"), method.color(), Swatch::Dashed);
+}
+
+/// The words of a method's Cartesian ellipse in the legend.
+fn cartesian_label(p: &Painter, who: &str, method: Method) -> String {
     let region = p.confidence().to_string();
-    let label = if method == Method::VectorSpace {
+    if method == Method::VectorSpace {
         format!("{who}: {region} ellipse")
     } else {
         format!("{who}: Cartesian {region} ellipse (first-order position)")
+    }
+}
+
+/// The share of the Monte Carlo samples an output's region holds, for its legend entry
+/// (", holds 70.1 % of map_from_camera's samples"; [`crate::eval::consistency`]): only for
+/// single results, whose entries name one pose's numbers.
+fn held<G: LieGroup<N>, const N: usize>(
+    node: &Node<G, N>,
+    estimate: &crate::eval::Estimate<G, N>,
+    regions: &[Region],
+) -> String {
+    if node.role != Role::Output || node.step.is_some() {
+        return String::new();
+    }
+    let Some(c) = estimate.consistency.as_ref() else {
+        return String::new();
     };
-    p.legend(label, method.color(), Swatch::Dashed);
+    regions
+        .iter()
+        .find_map(|r| c.region(*r))
+        .map_or(String::new(), |c| {
+            format!(
+                "; holds {:.1} % of {}'s samples",
+                100.0 * c.inside,
+                node.name
+            )
+        })
 }
 
 pub(super) fn draw_particles<G: LieGroup<N>, const N: usize>(

@@ -63,7 +63,10 @@ impl Painter {
                 (0.12 * extent).clamp(0.05, 2.0)
             });
         Painter {
-            scene: Scene::new(settings.about.title.clone(), description),
+            scene: Scene::new(
+                super::words::fill(&settings.about.title, e, settings.confidence),
+                description,
+            ),
             confidence: settings.confidence,
             kind: G::KIND,
             axis_length,

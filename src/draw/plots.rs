@@ -132,7 +132,7 @@ fn trace_lines<G: LieGroup<N>, const N: usize>(
 /// Σ_ρxρx in the left (world) form per method and step: the along-track variance that
 /// second-order compounding misses (Barfoot & Furgale 2014, Fig. 2). Monte Carlo is the
 /// uncentred E[ξξᵀ] about the propagated mean, as in their experiments.
-pub(super) fn along_track_lines<G: LieGroup<N>, const N: usize>(
+fn along_track_lines<G: LieGroup<N>, const N: usize>(
     e: &Evaluation<G, N>,
     name: &str,
 ) -> Vec<Line> {
@@ -150,6 +150,39 @@ pub(super) fn along_track_lines<G: LieGroup<N>, const N: usize>(
             .filter(|a| a.step == step)
             .map(|a| (a.method, a.variance_m2));
         add(&mut lines, ALONG_TRACK, step as i64, at_step);
+    }
+    // Monte Carlo's last value with its standard error in its legend entry, and its value ± 2
+    // standard errors (batch means) as a band: how far its line is to be trusted.
+    if let Some(last) = values
+        .iter()
+        .rfind(|a| a.method == Method::MonteCarlo && a.stderr_m2.is_some())
+        && let Some(line) = lines
+            .iter_mut()
+            .find(|l| l.kind == ALONG_TRACK && l.method == Some(Method::MonteCarlo))
+    {
+        line.label = format!(
+            "Monte Carlo (step {}: {} m²)",
+            last.step,
+            super::words::plus_minus(last.variance_m2, last.stderr_m2, 4)
+        );
+    }
+    let band = |sign: f64| -> Vec<(i64, f64)> {
+        values
+            .iter()
+            .filter_map(|a| Some((a.step as i64, a.variance_m2 + sign * 2.0 * a.stderr_m2?)))
+            .collect()
+    };
+    for (sign, label) in [(-1.0, "low"), (1.0, "high")] {
+        let points = band(sign);
+        if !points.is_empty() {
+            lines.push(Line {
+                kind: ALONG_TRACK,
+                method: None,
+                label: format!("Monte Carlo ± 2 standard errors, {label}"),
+                reference: true,
+                points,
+            });
+        }
     }
     lines
 }

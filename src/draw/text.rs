@@ -4,11 +4,9 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use super::DrawSettings;
-use super::plots::along_track_lines;
+use super::{DrawSettings, words};
 use crate::eval::{Consistency, Evaluation, FailureReason, Finding, Node, Role};
 use crate::lie::{GroupKind, LieGroup};
-use crate::plan::OpKind;
 use crate::uncertain::{Coverage, Method, Region};
 
 /// The Markdown of the text panel.
@@ -17,11 +15,12 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
     settings: &DrawSettings,
 ) -> String {
     let about = &settings.about;
-    let mut s = format!("# {}\n\n", about.title);
+    let fill = |text: &str| words::fill(text, e, settings.confidence);
+    let mut s = format!("# {}\n\n", fill(&about.title));
     if !about.source.is_empty() {
         let _ = writeln!(s, "*Source: {}*\n", about.source);
     }
-    let _ = writeln!(s, "{}", about.description.trim());
+    let _ = writeln!(s, "{}", fill(about.description.trim()));
     if let Some(g) = &e.graph {
         s.push_str(&super::graph::describe(g));
     }
@@ -61,41 +60,61 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
         );
     }
     errors_table(&mut s, e);
-    for name in compounds(e) {
-        let lines = along_track_lines(e, name);
-        let last = e
-            .nodes
-            .iter()
-            .rev()
-            .find(|n| n.name == name)
-            .and_then(|n| n.step);
-        if let (Some(step), false) = (last, lines.is_empty()) {
-            let summary: Vec<String> = lines
-                .iter()
-                .filter_map(|l| l.points.last().map(|(_, v)| format!("{} {v:.4}", l.label)))
-                .collect();
-            let _ = writeln!(
-                s,
-                "Along-track variance Σ_ρxρx (world frame, left form) at step {step}: {}.\n",
-                summary.join(", ")
-            );
-        }
-    }
+    along_track(&mut s, e);
     for finding in &e.findings {
         let _ = writeln!(s, "{}\n", finding_text(finding));
     }
     s
 }
 
-/// The outputs of compounding propagations.
-fn compounds<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>) -> Vec<&str> {
-    let mut names: Vec<&str> = Vec::new();
-    for n in e.nodes.iter().filter(|n| n.op == Some(OpKind::Compound)) {
-        if !names.contains(&n.name.as_str()) {
-            names.push(&n.name);
+/// Per compounding, every method's along-track variance at its last step; Monte Carlo's with
+/// its standard error by batch means ([`crate::eval::batch_means`]).
+fn along_track<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G, N>) {
+    let values = e.along_track();
+    let mut outputs: Vec<&str> = Vec::new();
+    for a in &values {
+        if !outputs.contains(&a.output.as_str()) {
+            outputs.push(&a.output);
         }
     }
-    names
+    for output in outputs {
+        let Some(step) = values
+            .iter()
+            .filter(|a| a.output == output)
+            .map(|a| a.step)
+            .max()
+        else {
+            continue;
+        };
+        let at_last: Vec<_> = values
+            .iter()
+            .filter(|a| a.output == output && a.step == step)
+            .collect();
+        let summary: Vec<String> = at_last
+            .iter()
+            .map(|a| {
+                format!(
+                    "{} {}",
+                    a.method.label(),
+                    words::plus_minus(a.variance_m2, a.stderr_m2, 4)
+                )
+            })
+            .collect();
+        let _ = write!(
+            s,
+            "Along-track variance Σ_ρxρx of `{output}` (world frame, left form, m²) at step {step}: {}",
+            summary.join(", ")
+        );
+        if at_last.iter().any(|a| a.stderr_m2.is_some()) {
+            let _ = write!(
+                s,
+                " (Monte Carlo ± its standard error by batch means over {} batches of the {} samples)",
+                crate::eval::batch_means::BATCHES,
+                e.samples
+            );
+        }
+        s.push_str(".\n\n");
+    }
 }
 
 /// Each final node's methods: their error against Monte Carlo and how many Monte Carlo
@@ -251,15 +270,26 @@ fn finding_text(f: &Finding) -> String {
             nominal_end,
             lie_mean,
             cartesian_mean,
-        } => format!(
-            "`{output}` (D = {diffusion}): nominal end ({:.3}, {:.3}); **Lie mean** of the samples ({:.3}, {:.3}); **Cartesian mean** of their positions ({:.3}, {:.3}) — it retreats inside the banana.",
-            nominal_end[0],
-            nominal_end[1],
-            lie_mean[0],
-            lie_mean[1],
-            cartesian_mean[0],
-            cartesian_mean[1]
-        ),
+            cartesian_mean_stderr,
+        } => {
+            let coordinate = |k: usize| {
+                words::plus_minus(cartesian_mean[k], cartesian_mean_stderr.map(|s| s[k]), 3)
+            };
+            format!(
+                "`{output}` (D = {diffusion}): nominal end ({:.3}, {:.3}); **Lie mean** of the samples ({:.3}, {:.3}); **Cartesian mean** of their positions ({}, {}{}) — it retreats inside the banana.",
+                nominal_end[0],
+                nominal_end[1],
+                lie_mean[0],
+                lie_mean[1],
+                coordinate(0),
+                coordinate(1),
+                if cartesian_mean_stderr.is_some() {
+                    "; ± its standard error by batch means"
+                } else {
+                    ""
+                }
+            )
+        }
         Finding::EulerDrift {
             output: _,
             steps,

@@ -7,22 +7,24 @@
 use crate::uncertain::Confidence;
 use nalgebra::{Matrix3, Vector3};
 
+use super::batch_means::BatchSums;
 use super::consistency::ConsistencySums;
+use super::engine::position_sum;
 use super::groups::EvalGroup;
 use super::model::{Estimate, Evaluation, McSummary, Node};
-use crate::lie::{LieGroup, TangentMatrix};
+use crate::lie::LieGroup;
 use crate::sample::{LieMeanAccumulator, MeanError, tangent_moments};
 use crate::uncertain::{Method, Side};
 
 /// One node's running sums.
 struct NodeSums<G: LieGroup<N>, const N: usize> {
     mean: LieMeanAccumulator<G, N>,
-    count: usize,
-    /// Σ Log_left(X nominal⁻¹) Log_left(…)ᵀ, where asked for.
-    left_outer: Option<TangentMatrix<N>>,
+    /// Σ Log_left(X nominal⁻¹) Log_left(…)ᵀ per batch ([`batch_means`](super::batch_means)),
+    /// where asked for.
+    left_outer: Option<BatchSums<N, N>>,
     /// Positions are summed relative to `shift` (block 0's mean) to avoid cancellation.
     shift: Vector3<f64>,
-    position_sum: Option<Vector3<f64>>,
+    position_sum: Option<BatchSums<3, 1>>,
     /// Coverage counts of the node's analytic estimates (Monte Carlo's own Gaussian is
     /// known only after every block, so it is not counted in a blocked run).
     consistency: Option<ConsistencySums<G, N>>,
@@ -74,9 +76,9 @@ pub(super) struct BlockedStats<G: LieGroup<N>, const N: usize> {
 }
 
 impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
-    /// Starts from block 0's evaluation: its Monte Carlo means start each iteration and
-    /// shift each sum.
-    pub(super) fn start(first: &Evaluation<G, N>) -> Self {
+    /// Starts from block 0's evaluation of a sample of `total`: its Monte Carlo means start
+    /// each iteration and shift each sum.
+    pub(super) fn start(first: &Evaluation<G, N>, total: usize) -> Self {
         let nodes = first
             .nodes
             .iter()
@@ -84,10 +86,9 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
                 let mc = node.monte_carlo.as_ref()?;
                 Some(NodeSums {
                     mean: LieMeanAccumulator::new(mc.stats.mean, Side::Right),
-                    count: 0,
-                    left_outer: mc.uncentred_left.map(|_| TangentMatrix::<N>::zeros()),
+                    left_outer: mc.uncentred_left.map(|_| BatchSums::new(total)),
                     shift: mc.position_mean.unwrap_or_else(Vector3::zeros),
-                    position_sum: mc.position_mean.map(|_| Vector3::zeros()),
+                    position_sum: mc.position_mean.map(|_| BatchSums::new(total)),
                     consistency: None,
                 })
             })
@@ -110,12 +111,14 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
         self.nodes.iter().flatten().any(|n| n.mean.is_iterating())
     }
 
-    /// Adds one block's particles of node `index` (`first_pass`: also the one-pass sums).
+    /// Adds one block's particles of node `index`, the samples `offset ..` of the whole
+    /// sample (`first_pass`: also the one-pass sums).
     pub(super) fn add_node(
         &mut self,
         index: usize,
         node: &Node<G, N>,
         particles: &[G],
+        offset: usize,
         first_pass: bool,
     ) {
         let Some(Some(sums)) = self.nodes.get_mut(index) else {
@@ -123,15 +126,17 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
         };
         sums.mean.add(particles, None);
         if first_pass {
-            sums.count += particles.len();
             if let Some(outer) = sums.left_outer.as_mut() {
-                *outer += tangent_moments(particles, None, &node.nominal, Side::Left).1;
+                outer.add(offset, particles.len(), |r| {
+                    tangent_moments(&particles[r], None, &node.nominal, Side::Left).1
+                });
             }
             if let Some(sum) = sums.position_sum.as_mut() {
-                *sum += particles
-                    .iter()
-                    .map(|g| g.to_se3().translation() - sums.shift)
-                    .sum::<Vector3<f64>>();
+                let shift = sums.shift;
+                sum.add(offset, particles.len(), |r| {
+                    let n = r.len() as f64;
+                    position_sum(&particles[r]) - shift * n
+                });
             }
         }
     }
@@ -189,11 +194,14 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
     /// Node `index`'s statistics over every block (`None` where it has no particles).
     pub(super) fn node(&self, index: usize) -> Option<Result<McSummary<G, N>, MeanError<G>>> {
         let sums = self.nodes.get(index)?.as_ref()?;
-        let n = sums.count as f64;
+        let left = sums.left_outer.as_ref().map(BatchSums::mean_and_stderr);
+        let position = sums.position_sum.as_ref().map(BatchSums::mean_and_stderr);
         Some(sums.mean.statistics().map(|stats| McSummary {
             stats,
-            uncentred_left: sums.left_outer.map(|o| o / n),
-            position_mean: sums.position_sum.map(|s| sums.shift + s / n),
+            uncentred_left: left.map(|(mean, _)| mean),
+            uncentred_left_stderr: left.and_then(|(_, se)| se),
+            position_mean: position.map(|(mean, _)| sums.shift + mean),
+            position_mean_stderr: position.and_then(|(_, se)| se),
         }))
     }
 

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::batch_means::BatchSums;
 use super::blocked::{BlockedStats, VectorSums};
 use super::consistency::ConsistencySums;
 use super::groups::EvalGroup;
@@ -17,7 +18,7 @@ use crate::lie::LieGroup;
 use crate::plan::{OpKind, Operand, Plan, PoseValue, limits};
 use crate::propagate::sigma_point::JointInputs;
 use crate::propagate::{Propagated, relative_frobenius_error};
-use crate::sample::{CHUNK_SIZE, MeanError, Sampler, sample_statistics, uncentred_covariance};
+use crate::sample::{CHUNK_SIZE, MeanError, Sampler, sample_statistics, tangent_moments};
 use crate::uncertain::{Method, Side, UncertainPose};
 
 /// An operand's Gaussian (its primary estimate) and its particles.
@@ -469,24 +470,35 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
     ) -> Option<Result<McSummary<G, N>, MeanError<G>>> {
         match &mut self.stats {
             StatsMode::Own => Some(sample_statistics(particles, Side::Right).map(|stats| {
+                let (uncentred_left, uncentred_left_stderr) = if extras.uncentred_left {
+                    let mut sums = BatchSums::new(particles.len());
+                    sums.add(0, particles.len(), |r| {
+                        tangent_moments(&particles[r], None, &node.nominal, Side::Left).1
+                    });
+                    let (mean, stderr) = sums.mean_and_stderr();
+                    (Some(mean), stderr)
+                } else {
+                    (None, None)
+                };
+                let (position_mean, position_mean_stderr) = if extras.position_mean {
+                    let mut sums = BatchSums::new(particles.len());
+                    sums.add(0, particles.len(), |r| position_sum(&particles[r]));
+                    let (mean, stderr) = sums.mean_and_stderr();
+                    (Some(mean), stderr)
+                } else {
+                    (None, None)
+                };
                 McSummary {
                     stats,
-                    uncentred_left: extras
-                        .uncentred_left
-                        .then(|| uncentred_covariance(particles, &node.nominal, Side::Left).ok())
-                        .flatten(),
-                    position_mean: extras.position_mean.then(|| {
-                        particles
-                            .iter()
-                            .map(|g| *g.to_se3().translation())
-                            .sum::<Vector3<f64>>()
-                            / particles.len() as f64
-                    }),
+                    uncentred_left,
+                    uncentred_left_stderr,
+                    position_mean,
+                    position_mean_stderr,
                 }
             })),
             StatsMode::Skip => None,
             StatsMode::Collect(stats, first_pass) => {
-                stats.add_node(index, node, particles, *first_pass);
+                stats.add_node(index, node, particles, self.block.start, *first_pass);
                 None
             }
             StatsMode::Blocked(stats) => stats.node(index),
@@ -547,6 +559,11 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
         });
         Ok(())
     }
+}
+
+/// The sum of the samples' positions (x, y, z; z = 0 in the plane).
+pub(super) fn position_sum<G: LieGroup<N>, const N: usize>(particles: &[G]) -> Vector3<f64> {
+    particles.iter().map(|g| *g.to_se3().translation()).sum()
 }
 
 /// Whether a result's mean and covariance are finite and within the magnitudes that can be

@@ -63,6 +63,10 @@ pub enum Finding {
         lie_mean: [f64; 2],
         /// Cartesian mean of the samples' positions (x, y).
         cartesian_mean: [f64; 2],
+        /// Its standard error by batch means (x, y; [`batch_means`](super::batch_means));
+        /// absent with fewer than two samples per batch.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        cartesian_mean_stderr: Option<[f64; 2]>,
     },
     /// Euler integration's drift off SO(3) against the exponential map's.
     EulerDrift {

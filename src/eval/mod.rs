@@ -37,6 +37,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 pub mod bag;
+pub mod batch_means;
 mod blocked;
 pub mod consistency;
 mod engine;
@@ -507,7 +508,7 @@ fn run_blocked<G: EvalGroup<N>, const N: usize>(
 ) -> Result<Evaluation<G, N>, EvalError> {
     let blocks: Vec<Range<usize>> = (0..n).step_by(b).map(|s| s..(s + b).min(n)).collect();
     let first = Engine::<G, N>::run(plan, settings, 0..b, StatsMode::Own)?;
-    let mut stats = BlockedStats::start(&first);
+    let mut stats = BlockedStats::start(&first, n);
     drop(first);
     let mut passes = 0;
     while stats.iterating() {

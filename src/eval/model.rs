@@ -47,8 +47,13 @@ pub struct McSummary<G: LieGroup<N>, const N: usize> {
     /// E\[ξξᵀ\] about the nominal pose, left (world) side, uncentred — Barfoot & Furgale's
     /// Monte Carlo covariance (2014, §IV), where the operation asks for it.
     pub uncentred_left: Option<TangentMatrix<N>>,
+    /// The standard error of each entry of `uncentred_left`, by batch means
+    /// ([`batch_means`](super::batch_means); `None` with fewer than two samples per batch).
+    pub uncentred_left_stderr: Option<TangentMatrix<N>>,
     /// The Cartesian mean of the samples' positions, where the operation asks for it.
     pub position_mean: Option<Vector3<f64>>,
+    /// The standard error of each coordinate of `position_mean`, by batch means.
+    pub position_mean_stderr: Option<Vector3<f64>>,
 }
 
 /// The Monte Carlo statistics of one node as plain data, for `report --json` (keys stable).
@@ -73,9 +78,16 @@ pub struct MonteCarloRecord {
     /// The same about the nominal pose on the right (body) side, ξ = Log(μ̄⁻¹ X) = Ad_μ̄⁻¹ ξ_left,
     /// hence Ad_μ̄⁻¹ E\[ξξᵀ\]_left Ad_μ̄⁻¹ᵀ; `null` with the left one.
     pub uncentred_about_nominal_right: Option<Vec<Vec<f64>>>,
+    /// The Monte Carlo standard error of each entry of `uncentred_about_nominal_left`, by batch
+    /// means over 20 consecutive batches of the sample; `null` where that is `null` or a batch
+    /// has fewer than two samples.
+    pub uncentred_about_nominal_left_stderr: Option<Vec<Vec<f64>>>,
     /// The Cartesian mean of the samples' positions (x, y, z), which a curved cloud pulls
     /// inside its banana; `null` where the operation does not compute it.
     pub cartesian_mean: Option<[f64; 3]>,
+    /// The Monte Carlo standard error of each coordinate of `cartesian_mean`, by batch means;
+    /// `null` where that is `null` or a batch has fewer than two samples.
+    pub cartesian_mean_stderr: Option<[f64; 3]>,
 }
 
 /// A named pose at one step, with every method's estimate.
@@ -176,6 +188,10 @@ pub struct AlongTrack {
     pub method: Method,
     /// Σ_ρxρx, left (world) form (m²).
     pub variance_m2: f64,
+    /// Its Monte Carlo standard error by batch means (m²; Monte Carlo only, where a batch
+    /// has two samples or more).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stderr_m2: Option<f64>,
 }
 
 /// How far a 3×3 matrix is from a rotation: max |RᵀR − I| over the entries.
@@ -241,19 +257,21 @@ impl<G: LieGroup<N>, const N: usize> Evaluation<G, N> {
                     .estimates
                     .iter()
                     .filter(|e| e.result.method != Method::MonteCarlo)
-                    .map(|e| (e.result.method, e.result.pose.cov_left()[(0, 0)]));
-                let monte_carlo = n
-                    .monte_carlo
-                    .as_ref()
-                    .and_then(|mc| mc.uncentred_left)
-                    .map(|c| (Method::MonteCarlo, c[(0, 0)]));
+                    .map(|e| (e.result.method, e.result.pose.cov_left()[(0, 0)], None));
+                let monte_carlo = n.monte_carlo.as_ref().and_then(|mc| {
+                    mc.uncentred_left.map(|c| {
+                        let stderr = mc.uncentred_left_stderr.map(|s| s[(0, 0)]);
+                        (Method::MonteCarlo, c[(0, 0)], stderr)
+                    })
+                });
                 analytic
                     .chain(monte_carlo)
-                    .map(move |(method, variance_m2)| AlongTrack {
+                    .map(move |(method, variance_m2, stderr_m2)| AlongTrack {
                         output: n.name.clone(),
                         step,
                         method,
                         variance_m2,
+                        stderr_m2,
                     })
             })
             .collect()
@@ -326,7 +344,11 @@ where
                     uncentred_about_nominal_right: mc
                         .uncentred_left
                         .map(|c| (to_right * c * to_right.transpose()).to_rows()),
+                    uncentred_about_nominal_left_stderr: mc
+                        .uncentred_left_stderr
+                        .map(|c| c.to_rows()),
                     cartesian_mean: mc.position_mean.map(|p| [p.x, p.y, p.z]),
+                    cartesian_mean_stderr: mc.position_mean_stderr.map(|p| [p.x, p.y, p.z]),
                 })
             })
             .collect()

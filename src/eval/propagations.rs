@@ -298,6 +298,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                 nominal_end: [nominal.translation().x, nominal.translation().y],
                 lie_mean: [lie.translation().x, lie.translation().y],
                 cartesian_mean: [cartesian.x, cartesian.y],
+                cartesian_mean_stderr: mc.position_mean_stderr.map(|s| [s.x, s.y]),
             });
         }
         self.nominal_path(outcome.nominal_path.iter().map(moved).collect());

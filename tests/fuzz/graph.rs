@@ -191,6 +191,9 @@ fn judge(text: &str, run: Run<Result<Output, String>>, limits: &Limits) -> Vec<F
                 "uncentred_about_nominal_left",
                 "uncentred_about_nominal_right",
                 "cartesian_mean",
+                // Batch means need two samples per batch (and the value they belong to).
+                "uncentred_about_nominal_left_stderr",
+                "cartesian_mean_stderr",
                 // The consistency of an estimate whose Σ is singular has no ANEES.
                 "anees",
                 "anees_dof",
