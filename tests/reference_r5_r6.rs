@@ -155,9 +155,11 @@ fn r5_se2_embedding_matches_se3_and_monte_carlo() {
         .as_ref()
         .and_then(|mc| mc.uncentred_left)
         .expect("the engine's uncentred left covariance of a compound");
-    assert_eq!(
-        mc_cov,
-        &uncentred_covariance(particles(last), &last.nominal, Side::Left).unwrap()
+    // (Summed batch by batch for its standard error: equal up to the order of the sums.)
+    let direct = uncentred_covariance(particles(last), &last.nominal, Side::Left).unwrap();
+    assert!(
+        (mc_cov - direct).amax() <= 1e-12 * direct.amax(),
+        "{mc_cov} vs {direct}"
     );
     println!(
         "R5 SE(2) MC: ρxρx {:.6}, ρyρy {:.4}, ρyθ {:.4}, θθ {:.5}",

@@ -122,7 +122,10 @@ fn crowded_scenes_get_one_view_per_pose_or_per_method() {
             "first order",
             "second order",
             "fourth order",
-            "sigma points"
+            "sigma points",
+            // The inversion, b_from_world (drawn from world_from_b's mean): exact, the inverse
+            // of μ·Exp(ε) is Exp(−ε)·μ⁻¹.
+            "exact"
         ]
     );
     // Each method's view shows its own banana surface and the Monte Carlo cloud, no other method.
@@ -134,9 +137,16 @@ fn crowded_scenes_get_one_view_per_pose_or_per_method() {
             .map(|i| i.path.as_str())
             .collect();
         let slug = view.name.replace(' ', "_");
-        assert!(paths.contains(&format!("world/world_from_b/{slug}/banana").as_str()));
-        assert!(paths.contains(&"world/world_from_b/monte_carlo/cloud"));
+        // The composition's methods, or the inversion's (exact).
+        let pose = if slug == "exact" {
+            "b_from_world"
+        } else {
+            "world_from_b"
+        };
+        assert!(paths.contains(&format!("world/{pose}/{slug}/banana").as_str()));
+        assert!(paths.contains(&format!("world/{pose}/monte_carlo/cloud").as_str()));
         for other in [
+            "exact",
             "first_order",
             "second_order",
             "fourth_order",
