@@ -27,14 +27,21 @@ fn evaluated<G: LieGroup<N>, const N: usize>(
     graph: &PoseGraph<G, N>,
     settings: GraphSettings,
 ) -> GraphEvaluation<G, N> {
-    evaluate_graph(graph, &settings, None, &mut |_, _| {}).expect("solvable")
+    let confidence = Confidence::DEFAULT;
+    evaluate_graph(graph, &settings, confidence, None, &mut |_, _| {}).expect("solvable")
 }
 
-fn at(p: f64) -> GraphSettings {
-    GraphSettings {
-        confidence: Confidence::new(p).expect("a probability"),
-        ..GraphSettings::default()
-    }
+/// The graph evaluated at confidence `p`.
+fn at<G: LieGroup<N>, const N: usize>(graph: &PoseGraph<G, N>, p: f64) -> GraphEvaluation<G, N> {
+    let confidence = Confidence::new(p).expect("a probability");
+    evaluate_graph(
+        graph,
+        &GraphSettings::default(),
+        confidence,
+        None,
+        &mut |_, _| {},
+    )
+    .expect("solvable")
 }
 
 #[test]
@@ -44,7 +51,7 @@ fn loop_closure_residuals_are_measured_at_the_chosen_confidence() {
                 EDGE_SE2 0 1 1 0 0 100 0 0 100 0 100\nEDGE_SE2 1 2 1 0.1 0 100 0 0 100 0 100\n\
                 EDGE_SE2 0 2 2 0 0 1 0 0 100 0 1\n";
     let graph = se2_graph(text);
-    let g = evaluated(&graph, at(0.95));
+    let g = at(&graph, 0.95);
     assert_eq!(g.loop_closures.len(), 1);
     let l = &g.loop_closures[0];
     assert_eq!((l.from, l.to, l.line), (0, 2, 6));
@@ -56,14 +63,14 @@ fn loop_closure_residuals_are_measured_at_the_chosen_confidence() {
     );
     assert!((g.radius - 2.795_483).abs() < 1e-6, "{}", g.radius);
     // At 10 % the radius is √χ²₃(0.1) = 0.7644: the same residual lies beyond it.
-    let g10 = evaluated(&graph, at(0.1));
+    let g10 = at(&graph, 0.1);
     assert!((g10.radius - 0.764_443).abs() < 1e-5, "{}", g10.radius);
     assert!(g10.loop_closures[0].mahalanobis_before > g10.radius);
 
     // GTSAM's pose3example: edge 3 → 0 (line 11) puts v0 about 1 m from v3, the estimates are
     // 2.24 m apart: hundreds of σ. Edge 1 → 4 agrees.
     let graph = se3_graph(POSE3);
-    let g = evaluated(&graph, at(0.95));
+    let g = at(&graph, 0.95);
     let mut worst: Vec<_> = g.loop_closures.iter().collect();
     worst.sort_by(|a, b| b.mahalanobis_before.total_cmp(&a.mahalanobis_before));
     assert_eq!((worst[0].from, worst[0].to, worst[0].line), (3, 0, 11));

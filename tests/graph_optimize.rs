@@ -19,7 +19,8 @@ use rand::{Rng, SeedableRng};
 #[path = "common/graph.rs"]
 mod graph_common;
 use graph_common::{
-    block, dense_information, manhattan_walk, pose2_slam_example, se2_graph, se3_graph,
+    block, dense_information, evaluate_default, manhattan_walk, pose2_slam_example, se2_graph,
+    se3_graph,
 };
 
 const POSE2: &str = include_str!("data/gtsam/pose2example.txt");
@@ -468,12 +469,11 @@ fn a_file_without_vertices_is_chained_from_its_edges_odometry_first() {
 
 #[test]
 fn duplicated_edges_are_kept_counted_and_noted() {
-    use posecov::eval::graph::{GraphSettings, evaluate_graph};
     let text = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0 0\n\
                 EDGE_SE2 0 1 1 0 0 100 0 0 100 0 100\nEDGE_SE2 1 2 1 0 0 100 0 0 100 0 100\n\
                 EDGE_SE2 0 2 2 0 0 100 0 0 100 0 100\nEDGE_SE2 0 2 2.5 0 0 100 0 0 100 0 100\n";
     let graph = se2_graph(text);
-    let g = evaluate_graph(&graph, &GraphSettings::default(), None, &mut |_, _| {}).unwrap();
+    let g = evaluate_default(&graph);
     assert_eq!(g.duplicates, vec![(7, 6)]);
     assert_eq!(g.loop_closures.len(), 2, "both copies are loop closures");
     assert_eq!(g.edge_chi2.len(), 4);

@@ -5,23 +5,20 @@
 //! gets no timeline and says so.
 
 use posecov::app::{Loaded, Overrides, pipeline};
-use posecov::eval::graph::{
-    GraphSettings, MAX_TIMELINE_POSES, SolverSettings, evaluate_graph, optimize,
-};
+use posecov::eval::graph::{MAX_TIMELINE_POSES, SolverSettings, optimize};
 use posecov::input::open;
 use posecov::scene::Timing;
 
 #[path = "common/graph.rs"]
 mod graph_common;
-use graph_common::se2_graph;
+use graph_common::{evaluate_default, se2_graph};
 
 const POSE2: &str = include_str!("data/gtsam/pose2example.txt");
 
 #[test]
 fn each_step_adds_loop_closures_and_no_marginal_grows() {
     let graph = se2_graph(POSE2);
-    let g =
-        evaluate_graph(&graph, &GraphSettings::default(), None, &mut |_, _| {}).expect("solved");
+    let g = evaluate_default(&graph);
     let t = &g.timeline;
     let ks: Vec<usize> = t.steps.iter().map(|s| s.closures).collect();
     assert_eq!(ks, vec![0, 1, 2], "pose2example has 2 loop closures");
@@ -132,8 +129,7 @@ fn a_graph_beyond_the_limit_gets_no_timeline_and_says_so() {
     }
     text += "EDGE_SE2 0 20 20 0 0 100 0 0 100 0 100\n";
     let graph = se2_graph(&text);
-    let g =
-        evaluate_graph(&graph, &GraphSettings::default(), None, &mut |_, _| {}).expect("solved");
+    let g = evaluate_default(&graph);
     assert!(g.timeline.steps.is_empty());
     assert_eq!(g.timeline.too_large, Some(n));
 }

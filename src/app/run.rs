@@ -205,12 +205,24 @@ impl Run {
 }
 
 /// A pose graph's progress on the spinner: the solve, its iteration, χ² and λ (Ctrl-C stops
-/// between iterations, keeping the last accepted estimate).
+/// between iterations, keeping the last accepted estimate). The optimisation's iterations
+/// are not known in advance (a spinner); the loop-closure timeline's steps are, so it turns
+/// into a bar of its steps.
 fn graph_progress(spinner: ProgressBar, what: String) -> ProgressHook {
     ProgressHook(Arc::new(move |stage: Stage, i: &Iteration| {
         let solve = match stage {
             Stage::Optimizing => "optimising".to_owned(),
             Stage::Timeline { step, of } => {
+                if spinner.length() != Some(of as u64) {
+                    spinner.set_style(
+                        ProgressStyle::with_template(
+                            "{spinner} {msg} [{bar:24}] {pos}/{len} steps done ({elapsed})",
+                        )
+                        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+                    );
+                    spinner.set_length(of as u64);
+                }
+                spinner.set_position(step.saturating_sub(1) as u64);
                 format!("loop closures one by one, step {step} of {of}")
             }
         };

@@ -332,7 +332,6 @@ pub fn resolve(
             graph: GraphSettings {
                 optimizer: overrides.optimizer.unwrap_or_default(),
                 reading: overrides.graph_reading.unwrap_or_default(),
-                confidence,
                 joints: overrides.joints.clone(),
             },
             graph_progress: None,

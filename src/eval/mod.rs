@@ -87,7 +87,8 @@ pub struct EvalSettings {
     /// Which steps of long propagations keep numbers and particles.
     pub steps: StepPolicy,
     /// The probability p of the regions whose coverage is measured against Monte Carlo
-    /// ([`consistency`]), 0 < p < 1 (default [`Confidence::DEFAULT`]).
+    /// ([`consistency`]) and of the region a pose graph's loop-closure residuals are measured
+    /// against, 0 < p < 1 (default [`Confidence::DEFAULT`]).
     pub confidence: Confidence,
     /// Sigma-point parameters α, β, κ (default 1, 2, 0).
     pub unscented: crate::propagate::sigma_point::Unscented,
@@ -385,6 +386,7 @@ fn run<G: EvalGroup<N>, const N: usize>(
         let evaluation = graph::evaluate_graph(
             g,
             &settings.graph,
+            settings.confidence,
             settings.cancel.clone(),
             &mut |stage, i| {
                 if let Some(hook) = &settings.graph_progress {

@@ -5,11 +5,12 @@
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::{DMatrix, SMatrix, SVector};
-use posecov::eval::graph::edge_jacobians;
+use posecov::eval::graph::{GraphEvaluation, GraphSettings, edge_jacobians, evaluate_graph};
 use posecov::input::graph::read_text;
 use posecov::lie::{LieGroup, Se2, Se3};
 use posecov::plan::AnyPlan;
 use posecov::plan::graph::{GraphEdge, GraphVertex, PoseGraph};
+use posecov::uncertain::Confidence;
 use rand::{Rng, SeedableRng};
 
 /// The SE(2) pose graph of g2o text.
@@ -41,6 +42,14 @@ pub fn se3_graph(text: &str) -> PoseGraph<Se3, 6> {
         AnyPlan::Se3(p) => p.graph.expect("a graph"),
         _ => panic!("spatial"),
     }
+}
+
+/// The graph evaluated with the default settings at the default confidence.
+pub fn evaluate_default<G: LieGroup<N>, const N: usize>(
+    graph: &PoseGraph<G, N>,
+) -> GraphEvaluation<G, N> {
+    let settings = GraphSettings::default();
+    evaluate_graph(graph, &settings, Confidence::DEFAULT, None, &mut |_, _| {}).expect("solvable")
 }
 
 /// H at `poses` as a dense matrix over the unknown vertices (tests only: tiny graphs).

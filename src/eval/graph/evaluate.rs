@@ -15,27 +15,14 @@ use super::{
 };
 
 /// The settings of a graph's evaluation (resolved by `app/`).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct GraphSettings {
     /// Gauss–Newton or Levenberg–Marquardt.
     pub optimizer: Optimizer,
     /// g2o's or GTSAM's reading of the information matrices.
     pub reading: GraphReading,
-    /// Probability inside the region a loop closure's residual is measured against.
-    pub confidence: Confidence,
     /// Pairs of vertex ids (a, b) whose joint marginal is wanted (`--joint a,b`).
     pub joints: Vec<(u64, u64)>,
-}
-
-impl Default for GraphSettings {
-    fn default() -> Self {
-        Self {
-            optimizer: Optimizer::default(),
-            reading: GraphReading::default(),
-            confidence: Confidence::DEFAULT,
-            joints: Vec::new(),
-        }
-    }
 }
 
 /// Why a graph could not be evaluated.
@@ -120,7 +107,8 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
     pub edge_chi2: Vec<f64>,
 }
 
-/// Optimises `graph`, measures its loop closures at `settings.confidence`, computes the
+/// Optimises `graph`, measures its loop closures at `confidence` (the evaluation's one
+/// `EvalSettings::confidence`), computes the
 /// joint marginals of `settings.joints` and re-solves it loop closure by loop closure
 /// ([`ClosureTimeline`]); `progress` sees every step tried, and of which solve.
 ///
@@ -128,23 +116,25 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
 /// use posecov::eval::graph::{GraphSettings, evaluate_graph};
 /// use posecov::input::graph::read_text;
 /// use posecov::plan::AnyPlan;
+/// use posecov::uncertain::Confidence;
 /// let text = "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0 0\n\
 ///             EDGE_SE2 0 1 1 0 0 100 0 0 100 0 400\nEDGE_SE2 1 2 1 0 0 100 0 0 100 0 400\n\
 ///             EDGE_SE2 0 2 2.1 0 0 100 0 0 100 0 400\n";
 /// let AnyPlan::Se2(plan) = read_text(text, "g.g2o").unwrap().1.plan else { unreachable!() };
 /// let settings = GraphSettings { joints: vec![(1, 2)], ..Default::default() };
-/// let g = evaluate_graph(plan.graph.as_ref().unwrap(), &settings, None, &mut |_, _| {}).unwrap();
+/// let g = evaluate_graph(plan.graph.as_ref().unwrap(), &settings, Confidence::DEFAULT, None, &mut |_, _| {}).unwrap();
 /// assert_eq!(g.loop_closures.len(), 1); // 0 → 2
 /// assert!(g.loop_closures[0].mahalanobis < g.loop_closures[0].mahalanobis_before);
 /// let joint = &g.joints[0];
 /// assert!(joint.relative_cov.unwrap()[(0, 0)] > 0.0);
 /// let wrong = GraphSettings { joints: vec![(1, 7)], ..Default::default() };
-/// let e = evaluate_graph(plan.graph.as_ref().unwrap(), &wrong, None, &mut |_, _| {}).unwrap_err();
+/// let e = evaluate_graph(plan.graph.as_ref().unwrap(), &wrong, Confidence::DEFAULT, None, &mut |_, _| {}).unwrap_err();
 /// assert_eq!(e.to_string(), "no vertex has id 7 (a joint marginal was asked for it)");
 /// ```
 pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
     graph: &PoseGraph<G, N>,
     settings: &GraphSettings,
+    confidence: Confidence,
     cancel: Option<Arc<AtomicBool>>,
     progress: &mut dyn FnMut(Stage, &Iteration),
 ) -> Result<GraphEvaluation<G, N>, GraphError> {
@@ -254,8 +244,8 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         loop_closures,
         joints,
         timeline,
-        confidence: settings.confidence,
-        radius: settings.confidence.radius(N),
+        confidence,
+        radius: confidence.radius(N),
         duplicates,
         edge_chi2,
     })
