@@ -371,6 +371,12 @@ fn damaged_mcap_is_an_error_not_a_panic() {
         std::fs::write(&path, &bytes[..cut]).unwrap();
         let e = read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None).unwrap_err();
         assert!(e.to_string().contains(&format!("cut{cut}.mcap")), "{e}");
+        // Cut inside a record: said in plain words, not as a length limit.
+        let e = e.to_string();
+        assert!(
+            e.contains("ended in the middle of a record") || e.contains("the file is cut short"),
+            "{e}"
+        );
     }
     let mut flipped = bytes.clone();
     for i in (40..flipped.len()).step_by(13) {

@@ -52,7 +52,8 @@ pub(super) fn read(
     let mut done = 0u64;
     let mut last_report = 0u64;
     while let Some(event) = reader.next_event() {
-        let event = event.map_err(|e| fail(format!("at byte {done}: {e}")))?;
+        let event =
+            event.map_err(|e| fail(format!("at byte {done}: {}", reader_error(&e, total))))?;
         match event {
             LinearReadEvent::ReadRequest(need) => {
                 let buf = reader.insert(need.min(READ_PIECE));
@@ -86,6 +87,18 @@ pub(super) fn read(
     }
     progress(total, total);
     Ok(())
+}
+
+/// The linear reader's error in the user's words: a record longer than the whole file means
+/// the file was cut short (a copy that did not finish) or damaged.
+fn reader_error(e: &mcap::McapError, total: u64) -> String {
+    match e {
+        mcap::McapError::RecordTooLarge { opcode, len } if *len > total => format!(
+            "a record (opcode 0x{opcode:02x}) claims {len} bytes, more than the whole file \
+             ({total} bytes): the file is cut short (a copy that did not finish?) or damaged"
+        ),
+        other => other.to_string(),
+    }
 }
 
 /// Whether to read on (the collector may ask to stop: Ctrl-C).
