@@ -182,6 +182,18 @@ struct ScenarioArgs {
     /// in the parent frame's axes, as tf2 moves them) or `body` (the rotation error local).
     #[arg(long = "ros-reading", value_name = "tf2|body")]
     ros_reading: Option<RosReading>,
+    /// Robot logs: the ground truth to take each estimate's NEES against — a topic of the log
+    /// (PoseStamped, PoseWithCovarianceStamped, Odometry, TransformStamped), `tf:CHILD` (the
+    /// child frame's transforms in /tf, parent = the estimate's frame_id) or a TUM trajectory
+    /// file. A bare value is a topic of the log, else a file; `topic:NAME` / `file:PATH` say
+    /// which.
+    #[arg(long, value_name = "TOPIC|tf:CHILD|FILE")]
+    reference: Option<String>,
+    /// Robot logs with --reference: align the reference to the estimate first — `none`
+    /// (default), `first` (the first poses coincide) or `se3` (Umeyama/Horn fit of the
+    /// positions, no scale).
+    #[arg(long, value_name = "none|first|se3")]
+    align: Option<posecov::eval::nees::Align>,
 }
 
 /// How to evaluate: values that override the file's.
@@ -242,6 +254,8 @@ impl EvalArgs {
             topics: Vec::new(),
             every: None,
             ros_reading: None,
+            reference: None,
+            align: None,
             steps: None,
             graph_reading: self.graph_reading.as_deref().map(|r| match r {
                 "gtsam" => GraphReading::Gtsam,
@@ -346,6 +360,8 @@ impl ScenarioArgs {
             topics: self.topics.clone(),
             every: self.every,
             ros_reading: self.ros_reading,
+            reference: self.reference.clone(),
+            align: self.align,
             ..self.settings.overrides()
         }
     }

@@ -256,6 +256,7 @@ fn topics_types_and_skips() {
         &BagOptions {
             topics: vec!["/bare".into()],
             every: None,
+            ..Default::default()
         },
     );
     assert_eq!(only.topics.len(), 1);

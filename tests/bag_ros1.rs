@@ -57,6 +57,7 @@ fn topic_selection_and_every() {
     let only = BagOptions {
         topics: vec!["/jackal_velocity_controller/odom".into()],
         every: Some(100),
+        ..Default::default()
     };
     let plan = read_bag(TEST2.as_ref(), &only, &mut |_, _| {}, None).unwrap();
     assert_eq!(plan.topics[0].drawn.len(), 31); // messages 0, 100, …, 3000
@@ -64,6 +65,7 @@ fn topic_selection_and_every() {
     let wrong = BagOptions {
         topics: vec!["/imu/data".into()],
         every: None,
+        ..Default::default()
     };
     let e = read_bag(TEST2.as_ref(), &wrong, &mut |_, _| {}, None)
         .unwrap_err()
@@ -77,6 +79,7 @@ fn topic_selection_and_every() {
     let missing = BagOptions {
         topics: vec!["/odom".into()],
         every: None,
+        ..Default::default()
     };
     let e = read_bag(TEST2.as_ref(), &missing, &mut |_, _| {}, None)
         .unwrap_err()

@@ -11,6 +11,8 @@
 //! crate: it would add about 20 crates and ~100 000 lines to the test build for the dozen
 //! keywords used here.)
 
+mod common;
+
 use posecov::app::{Overrides, commands::report};
 use serde_json::Value;
 
@@ -208,6 +210,26 @@ fn every_bundled_example_validates_against_the_schema_and_every_key_is_documente
         formats.iter().map(String::as_str).collect::<Vec<_>>(),
         every
     );
+}
+
+#[test]
+fn a_log_report_with_a_reference_validates_and_documents_its_consistency_keys() {
+    let schema: Value = serde_json::from_str(SCHEMA).unwrap();
+    let dir = std::env::temp_dir().join(format!("posecov-schema-nees-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log = dir.join("nees.mcap");
+    std::fs::write(&log, common::logs::nees_log(3)).unwrap();
+    let overrides = Overrides {
+        reference: Some("tf:base_link".into()),
+        align: Some(posecov::eval::nees::Align::Se3),
+        ..Default::default()
+    };
+    let text = report(log.to_str().unwrap(), &overrides, true).unwrap();
+    let value: Value = serde_json::from_str(&text).unwrap();
+    let found = dedup(problems(&schema, &value, "nees"));
+    assert!(found.is_empty(), "{found:#?}");
+    assert!(value["topics"][0]["consistency"]["anees"].is_number());
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

@@ -12,6 +12,8 @@
 
 use std::sync::atomic::AtomicBool;
 
+mod nees;
+
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::AppError;
@@ -21,8 +23,9 @@ use crate::draw::bag::{
     BagDrawSettings, bag_scene, description, issue_sentence, issue_word, topic_entity,
 };
 use crate::eval::bag::{BagEvaluation, evaluate_bag};
-use crate::input::bag::{BagOptions, bundled, read_located};
+use crate::input::bag::{BagOptions, bundled, read_located_observed};
 use crate::input::{About, InputError, Located, Place};
+use crate::plan::bag::LogObserver;
 use crate::plan::bag::{Class, Issue, LogSummary};
 use crate::scene::{Scene, SceneError, Timing};
 
@@ -61,9 +64,25 @@ pub(super) fn run_with(
     cancel: Option<&AtomicBool>,
     bar: bool,
 ) -> Result<LogRun, AppError> {
-    let plan = read(located, &settings.read, cancel, bar)?;
-    let evaluation = evaluate_bag(&plan, &settings.eval);
     let file = located.origin();
+    let mut reference = match &settings.reference {
+        Some(r) => Some(nees::prepare(
+            r,
+            settings.eval.reading,
+            settings.read.every,
+        )?),
+        None => None,
+    };
+    let mut options = settings.read.clone();
+    options.reference = reference.as_ref().and_then(|r| r.in_log.clone());
+    let observer = reference
+        .as_mut()
+        .map(|r| &mut r.observer as &mut dyn LogObserver);
+    let plan = read(located, &options, cancel, bar, observer)?;
+    let mut evaluation = evaluate_bag(&plan, &settings.eval);
+    if let Some(reference) = reference {
+        evaluation = evaluation.with_consistency(nees::finish(reference, &plan, &file)?);
+    }
     let title = match &located.place {
         Place::Bundled(e) => bundled::find(e.name).map_or(e.name, |l| l.title).to_owned(),
         Place::File(_) => file.clone(),
@@ -127,6 +146,7 @@ fn read(
     options: &BagOptions,
     cancel: Option<&AtomicBool>,
     shown: bool,
+    observer: Option<&mut dyn LogObserver>,
 ) -> Result<LogSummary, AppError> {
     let file = located.origin();
     let bar = if shown {
@@ -139,7 +159,7 @@ fn read(
         ProgressStyle::with_template("{msg} {wide_bar} {percent} % ({elapsed}, eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let plan = read_located(
+    let plan = read_located_observed(
         located,
         options,
         &mut |done, total| {
@@ -147,6 +167,7 @@ fn read(
             bar.set_position(done);
         },
         cancel,
+        observer,
     );
     bar.finish_and_clear();
     let plan = plan?;
@@ -283,6 +304,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 },
                 "ros_reading": run.evaluation.reading,
                 "ros_readings_apart": e.reading_difference,
+                "consistency": e.consistency.as_ref().map(nees::consistency_json),
             })
         })
         .collect();

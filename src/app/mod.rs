@@ -38,8 +38,8 @@ pub mod sinks;
 pub mod view;
 
 pub use settings::{
-    AppliesTo, DEFAULT_SAMPLES, Given, LogSettings, MAX_CLOUD_SAMPLES, Overrides, Settings,
-    SettingsError, resolve, resolve_log,
+    AppliesTo, DEFAULT_SAMPLES, Given, LogSettings, MAX_CLOUD_SAMPLES, Overrides, ReferenceArg,
+    ReferenceSettings, Settings, SettingsError, resolve, resolve_log,
 };
 
 /// Exit code: success; notes (and, except for `check`, defects) in a log are not failures.

@@ -8,6 +8,7 @@ use crate::draw::DrawSettings;
 use crate::eval::EvalSettings;
 use crate::eval::bag::{BagEvalSettings, DEFAULT_CLOUD_SAMPLES};
 use crate::eval::graph::{GraphReading, GraphSettings, Optimizer};
+use crate::eval::nees::Align;
 use crate::input::bag::BagOptions;
 use crate::input::{Input, InputKind};
 use crate::interop::RosReading;
@@ -36,6 +37,11 @@ pub struct Overrides {
     /// `--ros-reading` (robot logs only): how a PoseWithCovariance's 6×6 is read
     /// ([`RosReading`], CONVENTIONS §6); `None`: tf2's.
     pub ros_reading: Option<RosReading>,
+    /// `--reference` (robot logs only): the ground truth to take NEES against, as given
+    /// ([`ReferenceArg::parse`]).
+    pub reference: Option<String>,
+    /// `--align` (robot logs with `--reference`): how the reference is aligned first.
+    pub align: Option<Align>,
     /// Which steps of long propagations are kept (no flag: live mode's quick preview thins
     /// them); `None`: [`StepPolicy::default`].
     pub steps: Option<StepPolicy>,
@@ -160,8 +166,20 @@ pub enum SettingsError {
 /// table every input's flags are checked against.
 fn kind_flags(
     overrides: &Overrides,
-) -> [(&'static str, AppliesTo, &'static str, Option<String>); 7] {
+) -> [(&'static str, AppliesTo, &'static str, Option<String>); 9] {
     [
+        (
+            "--reference",
+            AppliesTo::Logs,
+            "it is the ground truth a log's estimates are compared with (NEES); a scenario's uncertainty is checked against its own Monte Carlo",
+            overrides.reference.clone(),
+        ),
+        (
+            "--align",
+            AppliesTo::Logs,
+            "it aligns a log's --reference to its estimates",
+            overrides.align.map(|a| a.name().to_owned()),
+        ),
         (
             "--topic",
             AppliesTo::Logs,
@@ -345,9 +363,74 @@ pub fn resolve(
     })
 }
 
+/// `--reference VALUE` as given: `topic:NAME`, `file:PATH`, `tf:CHILD`, or a bare value that
+/// is a topic of the log or else an existing file (decided once the log is read; both or
+/// neither is refused).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ReferenceArg {
+    /// `topic:NAME`.
+    Topic(String),
+    /// `file:PATH`: a TUM trajectory.
+    File(String),
+    /// `tf:CHILD`: the child frame's transforms in `/tf`.
+    Tf(String),
+    /// A bare value.
+    Either(String),
+}
+
+impl ReferenceArg {
+    /// Reads the flag's value by its prefix.
+    ///
+    /// ```
+    /// use posecov::app::ReferenceArg;
+    /// assert_eq!(ReferenceArg::parse("tf:base_link").unwrap(), ReferenceArg::Tf("base_link".into()));
+    /// assert_eq!(ReferenceArg::parse("/ground_truth").unwrap(), ReferenceArg::Either("/ground_truth".into()));
+    /// assert!(ReferenceArg::parse("topic:").is_err());
+    /// ```
+    pub fn parse(value: &str) -> Result<Self, SettingsError> {
+        let named = |rest: &str, what: &str, make: fn(String) -> ReferenceArg| {
+            if rest.is_empty() {
+                Err(SettingsError::OutOfRange {
+                    flag: "--reference",
+                    value: value.to_owned(),
+                    expected: format!("name {what} after the prefix"),
+                })
+            } else {
+                Ok(make(rest.to_owned()))
+            }
+        };
+        if let Some(rest) = value.strip_prefix("topic:") {
+            named(rest, "a topic of the log", ReferenceArg::Topic)
+        } else if let Some(rest) = value.strip_prefix("file:") {
+            named(rest, "a TUM trajectory file", ReferenceArg::File)
+        } else if let Some(rest) = value.strip_prefix("tf:") {
+            named(rest, "a child frame in /tf", ReferenceArg::Tf)
+        } else if value.is_empty() {
+            named(
+                value,
+                "a topic, `tf:CHILD` or a TUM file",
+                ReferenceArg::Either,
+            )
+        } else {
+            Ok(ReferenceArg::Either(value.to_owned()))
+        }
+    }
+}
+
+/// A log's reference and alignment, resolved from the flags.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReferenceSettings {
+    /// Where the truth comes from.
+    pub arg: ReferenceArg,
+    /// The alignment (none by default).
+    pub align: Align,
+}
+
 /// Everything reading, evaluating and drawing a robot log needs, resolved.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LogSettings {
+    /// `--reference` and `--align`: NEES against a ground truth, if asked for.
+    pub reference: Option<ReferenceSettings>,
     /// For [`crate::input::bag::read_located`]: topics and thinning.
     pub read: BagOptions,
     /// For [`crate::eval::bag::evaluate_bag`]: seed and cloud samples.
@@ -375,10 +458,28 @@ pub fn resolve_log(overrides: &Overrides) -> Result<LogSettings, SettingsError> 
             expected: format!("1 ..= {MAX_CLOUD_SAMPLES} samples per drawn message of a robot log"),
         });
     }
+    let reference = match &overrides.reference {
+        Some(value) => Some(ReferenceSettings {
+            arg: ReferenceArg::parse(value)?,
+            align: overrides.align.unwrap_or_default(),
+        }),
+        None => {
+            if let Some(align) = overrides.align {
+                return Err(SettingsError::OutOfRange {
+                    flag: "--align",
+                    value: align.name().to_owned(),
+                    expected: "it aligns a --reference, and none is given".to_owned(),
+                });
+            }
+            None
+        }
+    };
     Ok(LogSettings {
+        reference,
         read: BagOptions {
             topics: overrides.topics.clone(),
             every: overrides.every,
+            reference: None,
         },
         eval: BagEvalSettings {
             seed: overrides.seed.unwrap_or(0),

@@ -12,7 +12,8 @@
 //!   `invalid` and clears the rest (`bag/message.rs`);
 //! - `robot/…`: the same message at the origin, at the robot's scale, with its σ (`bag/robot.rs`);
 //! - plots over the stamp: σx σy σz, σroll σpitch σyaw and the position trace, in units and
-//!   ranges fitted to the data (`bag/plots.rs`).
+//!   ranges fitted to the data (`bag/plots.rs`); with `--reference`, each topic's NEES per
+//!   drawn message with its 95 % bound and ANEES band (`bag/nees.rs`).
 //!
 //! Views: one whole-log view per frame (`header.frame_id`: topics in different frames are
 //! never overlaid as if they were one), and one robot view per topic.
@@ -34,11 +35,13 @@ use crate::scene::{
 use crate::uncertain::{Confidence, Method};
 
 mod message;
+mod nees;
 mod plots;
 mod robot;
 mod rviz;
 mod text;
 
+pub use nees::verdict_word;
 pub use text::{description, issue_sentence, issue_word};
 
 /// RViz's default covariance colour (its position shape).
@@ -119,6 +122,7 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
         .flat_map(|s| s.points.iter().map(|q| q.0));
     p.scene.timeline = Timeline::for_stamps(stamps.chain(series));
     plots::plots(&mut p.scene, e);
+    nees::plots(&mut p.scene, e);
     p.scene.views = log_views(&p.scene, e, planar);
     p.scene
 }

@@ -199,6 +199,9 @@ pub struct TopicEvaluation {
     pub series: Vec<SeriesPoint>,
     /// σ per ROS axis (x, y, z, roll, pitch, yaw; m and rad), `None` where never estimated.
     pub sigma: [Option<SigmaSummary>; 6],
+    /// NEES against the reference (`--reference`), streamed over every message
+    /// ([`crate::eval::nees`]); `None` without a reference, or for the reference topic itself.
+    pub consistency: Option<crate::eval::nees::TopicConsistency>,
 }
 
 /// A log's numbers.
@@ -208,6 +211,21 @@ pub struct BagEvaluation {
     pub topics: Vec<TopicEvaluation>,
     /// The ROS reading every covariance was read in.
     pub reading: RosReading,
+}
+
+impl BagEvaluation {
+    /// Attaches each topic's NEES ([`crate::eval::nees::NeesObserver::finish`]) by name.
+    pub fn with_consistency(
+        mut self,
+        results: Vec<(String, crate::eval::nees::TopicConsistency)>,
+    ) -> Self {
+        for (name, c) in results {
+            if let Some(t) = self.topics.iter_mut().find(|t| t.name == name) {
+                t.consistency = Some(c);
+            }
+        }
+        self
+    }
 }
 
 /// Evaluates every topic of a log.
@@ -298,6 +316,7 @@ fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) ->
         sigma: std::array::from_fn(|axis| {
             sigma_summary(topic.sigma_stats[axis], &topic.series, axis)
         }),
+        consistency: None,
     }
 }
 
@@ -307,7 +326,7 @@ fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) ->
 /// (ρx, ρy, θz) block is SE(2)'s tangent. A placeholder (≥ 1e6, "not estimated") on an axis
 /// the motion uses — x, y or yaw when planar, any axis in 3-D — is no variance: such a message
 /// cannot be drawn as a Gaussian (RViz's clipped picture and a cross say it instead).
-fn meaning(
+pub(super) fn meaning(
     mean: &Se3,
     cov_ros: &Matrix6<f64>,
     unestimated: &[bool; 6],

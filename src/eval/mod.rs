@@ -45,6 +45,7 @@ mod findings;
 pub mod graph;
 pub mod groups;
 mod model;
+pub mod nees;
 mod ops;
 mod propagations;
 mod reports;

@@ -34,6 +34,7 @@ pub mod graph;
 mod located;
 pub mod scenario;
 pub mod suggest;
+pub mod tum;
 
 pub use format::{Format, InputKind};
 pub use located::{InputError, Locator, not_text};

@@ -17,8 +17,19 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+mod decimate;
+mod reference;
+pub use decimate::Decimator;
+pub use reference::{EstimateMessage, LogObserver, ReferenceInLog, ReferenceRead, ReferenceSample};
+
 /// A variance at or above this is a placeholder ("not estimated"), not a measurement.
 pub const PLACEHOLDER: f64 = 1e6;
+
+/// Default number of messages drawn per topic (at most; evenly spaced).
+pub const DEFAULT_MAX_DRAWN: usize = 200;
+/// However `--every` is set, at most this many messages per topic are drawn (the stride is
+/// doubled beyond, and the text panel says so).
+pub const MAX_DRAWN_LIMIT: usize = 5000;
 
 /// Number of entries of a ROS 6 × 6 covariance (row-major).
 pub const COV_LEN: usize = 36;
@@ -513,4 +524,6 @@ pub struct LogSummary {
     pub messages_total: u64,
     /// The read stopped early (Ctrl-C): everything before was read.
     pub cancelled: bool,
+    /// What the reader saw of the reference asked for in the log (`--reference`), if any.
+    pub reference: Option<ReferenceRead>,
 }

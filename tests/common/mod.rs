@@ -306,3 +306,4 @@ pub fn odometry_plan<G: LieGroup<N>, const N: usize>(
     );
     plan
 }
+pub mod logs;

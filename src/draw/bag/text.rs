@@ -297,6 +297,9 @@ fn topic(
             r2(6)
         )
     };
+    if let Some(c) = &e.consistency {
+        super::nees::paragraph(s, c);
+    }
     if e.reading_difference > READINGS_APART {
         let _ = writeln!(
             s,

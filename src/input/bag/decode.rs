@@ -85,13 +85,14 @@ pub fn ros2_kind(schema_name: &str) -> Option<PoseMessageKind> {
 // --------------------------------------------------------------------------------------------
 // ROS 1.
 
-struct Ros1<'a> {
-    bytes: &'a [u8],
-    at: usize,
+/// A ROS 1 message being read, field by field (little endian, strings length-prefixed).
+pub(super) struct Ros1<'a> {
+    pub(super) bytes: &'a [u8],
+    pub(super) at: usize,
 }
 
 impl<'a> Ros1<'a> {
-    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], DecodeError> {
+    pub(super) fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], DecodeError> {
         let end = self.at.checked_add(n).filter(|e| *e <= self.bytes.len());
         let Some(end) = end else {
             return Err(DecodeError(format!(
@@ -104,11 +105,11 @@ impl<'a> Ros1<'a> {
         self.at = end;
         Ok(s)
     }
-    fn u32(&mut self, what: &str) -> Result<u32, DecodeError> {
+    pub(super) fn u32(&mut self, what: &str) -> Result<u32, DecodeError> {
         let b = self.take(4, what)?;
         Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
-    fn f64s<const N: usize>(&mut self, what: &str) -> Result<[f64; N], DecodeError> {
+    pub(super) fn f64s<const N: usize>(&mut self, what: &str) -> Result<[f64; N], DecodeError> {
         let b = self.take(8 * N, what)?;
         Ok(std::array::from_fn(|i| {
             let mut w = [0u8; 8];
@@ -116,12 +117,12 @@ impl<'a> Ros1<'a> {
             f64::from_le_bytes(w)
         }))
     }
-    fn string(&mut self, what: &str) -> Result<String, DecodeError> {
+    pub(super) fn string(&mut self, what: &str) -> Result<String, DecodeError> {
         let n = self.u32(what)? as usize;
         Ok(String::from_utf8_lossy(self.take(n, what)?).into_owned())
     }
     /// `std_msgs/Header`: seq, stamp (secs, nsecs), frame_id.
-    fn header(&mut self) -> Result<(Option<i64>, String), DecodeError> {
+    pub(super) fn header(&mut self) -> Result<(Option<i64>, String), DecodeError> {
         let _seq = self.u32("header.seq")?;
         let secs = self.u32("header.stamp.secs")?;
         let nsecs = self.u32("header.stamp.nsecs")?;
@@ -279,7 +280,10 @@ pub fn nested(c: &[f64; COV_LEN]) -> [[f64; 6]; 6] {
 /// 0x0001 / 0x0003 (little endian).
 const CDR_HEADER: usize = 4;
 
-fn cdr<T: for<'de> Deserialize<'de>>(bytes: &[u8], what: &str) -> Result<T, DecodeError> {
+pub(super) fn cdr<T: for<'de> Deserialize<'de>>(
+    bytes: &[u8],
+    what: &str,
+) -> Result<T, DecodeError> {
     let Some(body) = bytes.get(CDR_HEADER..) else {
         return Err(DecodeError(format!(
             "truncated: {} bytes, no CDR encapsulation header",
@@ -301,7 +305,7 @@ fn cdr<T: for<'de> Deserialize<'de>>(bytes: &[u8], what: &str) -> Result<T, Deco
         .map_err(|e| DecodeError(format!("{what}: {e}")))
 }
 
-fn header_stamp(h: &Header) -> Option<i64> {
+pub(super) fn header_stamp(h: &Header) -> Option<i64> {
     stamp(i64::from(h.stamp.sec), h.stamp.nanosec)
 }
 

@@ -18,6 +18,7 @@ use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOp
 
 use super::decode::ros2_kind;
 use super::mcap_records::{ChunkHeader, McapRecord, parse};
+use super::reference::ros2_reference_type;
 use super::{Codec, Collector, RECORD_LIMIT, Stream};
 use crate::input::InputError;
 
@@ -29,7 +30,7 @@ const OPCODE_LEN: usize = 9;
 /// Streams every message of the file into `collector`.
 pub(super) fn read(
     path: &Path,
-    collector: &mut Collector<'_>,
+    collector: &mut Collector<'_, '_>,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<(), InputError> {
     let io = |source: std::io::Error| InputError::Read {
@@ -120,7 +121,7 @@ impl Streams {
     fn take(
         &mut self,
         record: McapRecord<'_>,
-        collector: &mut Collector<'_>,
+        collector: &mut Collector<'_, '_>,
     ) -> Result<Flow, String> {
         match record {
             McapRecord::Schema { id, name, encoding } => {
@@ -142,20 +143,28 @@ impl Streams {
                         ))
                     }
                 });
+                let reference = ros2_reference_type(&schema).map(|k| {
+                    if message_encoding == "cdr" {
+                        Ok(k)
+                    } else {
+                        Err(format!(
+                            "{schema} in {message_encoding} encoding; posecov reads cdr"
+                        ))
+                    }
+                });
                 let type_name = if schema.is_empty() {
                     format!("(no schema, {message_encoding} encoding)")
                 } else {
                     schema
                 };
-                collector.declare(&topic, &type_name, kind.as_ref());
-                self.channels.insert(
-                    id,
-                    Stream {
-                        topic,
-                        type_name,
-                        kind,
-                    },
-                );
+                let stream = Stream {
+                    topic,
+                    type_name,
+                    kind,
+                    reference,
+                };
+                collector.declare_stream(&stream);
+                self.channels.insert(id, stream);
             }
             McapRecord::Message {
                 channel_id,

@@ -20,22 +20,26 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::plan::bag::{LogSummary, PoseMessageKind, SkippedTopic};
+use crate::plan::bag::{
+    EstimateMessage, LogObserver, LogSummary, PoseMessageKind, ReferenceInLog, ReferenceRead,
+    SkippedTopic,
+};
 
 use super::format::{self, Format};
 use super::suggest;
 use super::{InputError, Located, Place};
 
 pub mod bundled;
-mod decimate;
 pub mod decode;
 pub mod health;
 mod mcap;
 mod mcap_records;
+pub mod reference;
 mod ros1;
 mod topic;
 
 use decode::{DecodeError, Decoded};
+use reference::ReferenceType;
 use topic::TopicState;
 
 /// The largest record or decompressed chunk of a log read (1 GiB): larger ones are refused,
@@ -46,11 +50,7 @@ pub const RECORD_LIMIT: usize = 1 << 30;
 /// refused before anything is allocated for it.
 pub const MAX_CHUNK_RATIO: u64 = 1024;
 
-/// Default number of messages drawn per topic (at most; evenly spaced).
-pub const DEFAULT_MAX_DRAWN: usize = 200;
-/// However `--every` is set, at most this many messages per topic are drawn (the stride is
-/// doubled beyond, and the text panel says so).
-pub const MAX_DRAWN_LIMIT: usize = 5000;
+pub use crate::plan::bag::{DEFAULT_MAX_DRAWN, MAX_DRAWN_LIMIT};
 /// Points kept per topic for the trajectory and the time series (density halves beyond).
 pub const MAX_SERIES: usize = 20_000;
 
@@ -61,6 +61,9 @@ pub struct BagOptions {
     pub topics: Vec<String>,
     /// Draw every N-th message (`--every N`); `None`: at most [`DEFAULT_MAX_DRAWN`].
     pub every: Option<u64>,
+    /// The reference in the log (`--reference`): its samples go to the observer of
+    /// [`read_located_observed`], and what was seen of it to [`LogSummary::reference`].
+    pub reference: Option<ReferenceInLog>,
 }
 
 /// Reads a log file into a [`LogSummary`], its format by content and extension
@@ -104,29 +107,43 @@ pub fn read_located(
     progress: &mut dyn FnMut(u64, u64),
     cancel: Option<&AtomicBool>,
 ) -> Result<LogSummary, InputError> {
+    read_located_observed(located, options, progress, cancel, None)
+}
+
+/// [`read_located`], handing every reference sample (`options.reference`) and every estimate
+/// message to `observer` in file order, while the log streams by.
+///
+/// ```
+/// use posecov::input::{locate, bag::{BagOptions, read_located_observed}};
+/// use posecov::plan::bag::{EstimateMessage, LogObserver, ReferenceSample};
+/// struct Count(u64);
+/// impl LogObserver for Count {
+///     fn reference(&mut self, _: &str, _: ReferenceSample) {}
+///     fn estimate(&mut self, _: &EstimateMessage<'_>) { self.0 += 1; }
+/// }
+/// let mut count = Count(0);
+/// let log = locate("covariance_health").unwrap();
+/// let plan = read_located_observed(&log, &BagOptions::default(), &mut |_, _| {}, None, Some(&mut count)).unwrap();
+/// assert_eq!(count.0, plan.topics.iter().map(|t| t.count).sum::<u64>());
+/// ```
+pub fn read_located_observed(
+    located: &Located,
+    options: &BagOptions,
+    progress: &mut dyn FnMut(u64, u64),
+    cancel: Option<&AtomicBool>,
+    observer: Option<&mut dyn LogObserver>,
+) -> Result<LogSummary, InputError> {
     let origin = located.origin();
     let read = |path: &Path, progress: &mut dyn FnMut(u64, u64)| {
-        let mut collector = Collector::new(options, cancel);
-        match located.format {
-            Format::Ros1Bag => ros1::read(path, &mut collector, progress)?,
-            Format::Mcap => mcap::read(path, &mut collector, progress)?,
-            other => {
-                return Err(InputError::Format {
-                    file: origin.clone(),
-                    message: format!("a {}, not a robot log (ROS 1 bag or MCAP)", other.name()),
-                });
-            }
-        }
-        let plan = collector.finish(path)?;
-        // Nothing to draw is an error for every command (no empty recording), unless Ctrl-C
-        // stopped the read before the first pose message.
-        if !plan.cancelled && plan.topics.iter().all(|t| t.count == 0) {
-            return Err(InputError::Format {
-                file: path.display().to_string(),
-                message: no_pose_topic(&plan),
-            });
-        }
-        Ok(plan)
+        read_path(
+            path,
+            located.format,
+            &origin,
+            options,
+            progress,
+            cancel,
+            observer,
+        )
     };
     match &located.place {
         Place::File(path) => read(path, progress),
@@ -150,23 +167,59 @@ pub fn read_located(
     }
 }
 
+/// Reads the log file at `path` in `format` (`origin` names it in errors).
+fn read_path(
+    path: &Path,
+    format: Format,
+    origin: &str,
+    options: &BagOptions,
+    progress: &mut dyn FnMut(u64, u64),
+    cancel: Option<&AtomicBool>,
+    observer: Option<&mut dyn LogObserver>,
+) -> Result<LogSummary, InputError> {
+    let mut collector = Collector::new(options, cancel, observer);
+    match format {
+        Format::Ros1Bag => ros1::read(path, &mut collector, progress)?,
+        Format::Mcap => mcap::read(path, &mut collector, progress)?,
+        other => {
+            return Err(InputError::Format {
+                file: origin.to_owned(),
+                message: format!("a {}, not a robot log (ROS 1 bag or MCAP)", other.name()),
+            });
+        }
+    }
+    let plan = collector.finish(path)?;
+    // Nothing to draw is an error for every command (no empty recording), unless Ctrl-C
+    // stopped the read before the first pose message.
+    if !plan.cancelled && plan.topics.iter().all(|t| t.count == 0) {
+        return Err(InputError::Format {
+            file: path.display().to_string(),
+            message: no_pose_topic(&plan),
+        });
+    }
+    Ok(plan)
+}
+
 /// A connection (ROS 1) or channel (MCAP): its topic, type and what posecov makes of it
 /// (`None`: another type; `Some(Err(why))`: a pose type in another definition or encoding).
 struct Stream {
     topic: String,
     type_name: String,
     kind: Option<Result<PoseMessageKind, String>>,
+    /// What a reference can be read from it (`Err(why)`: a reference type in another
+    /// definition or encoding).
+    reference: Option<Result<ReferenceType, String>>,
 }
 
 /// How a message's bytes are encoded.
 #[derive(Debug, Clone, Copy)]
-enum Codec {
+pub(crate) enum Codec {
     Ros1,
     Cdr,
 }
 
 /// Receives every message of a log in file order.
-struct Collector<'a> {
+struct Collector<'a, 'o> {
     options: &'a BagOptions,
     cancel: Option<&'a AtomicBool>,
     cancelled: bool,
@@ -174,10 +227,16 @@ struct Collector<'a> {
     skipped: BTreeMap<String, (String, u64)>,
     not_selected: BTreeMap<String, ()>,
     total: u64,
+    observer: Option<&'o mut dyn LogObserver>,
+    reference: Option<ReferenceRead>,
 }
 
-impl<'a> Collector<'a> {
-    fn new(options: &'a BagOptions, cancel: Option<&'a AtomicBool>) -> Self {
+impl<'a, 'o> Collector<'a, 'o> {
+    fn new(
+        options: &'a BagOptions,
+        cancel: Option<&'a AtomicBool>,
+        observer: Option<&'o mut dyn LogObserver>,
+    ) -> Self {
         Self {
             options,
             cancel,
@@ -186,6 +245,84 @@ impl<'a> Collector<'a> {
             skipped: BTreeMap::new(),
             not_selected: BTreeMap::new(),
             total: 0,
+            observer,
+            reference: options.reference.as_ref().map(|_| ReferenceRead::default()),
+        }
+    }
+
+    /// Whether `topic` carries the reference asked for (its topic, or `/tf` for `tf:CHILD`).
+    fn is_reference(&self, topic: &str) -> bool {
+        match &self.options.reference {
+            Some(ReferenceInLog::Topic(name)) => name == topic,
+            Some(ReferenceInLog::Tf { .. }) => topic == "/tf",
+            None => false,
+        }
+    }
+
+    /// A stream the log declares: its topic, and the reference if it is the reference's.
+    fn declare_stream(&mut self, stream: &Stream) {
+        self.declare(&stream.topic, &stream.type_name, stream.kind.as_ref());
+        self.declare_reference(stream);
+    }
+
+    /// Notes the reference's stream (its type), once.
+    fn declare_reference(&mut self, stream: &Stream) {
+        if self.is_reference(&stream.topic)
+            && let Some(read) = &mut self.reference
+            && !read.found
+        {
+            read.found = true;
+            read.message_type = Some(match &stream.reference {
+                Some(Err(why)) => why.clone(),
+                _ => stream.type_name.clone(),
+            });
+            let tf = matches!(self.options.reference, Some(ReferenceInLog::Tf { .. }));
+            read.readable = match stream.reference {
+                Some(Ok(ReferenceType::TfMessage)) => tf,
+                Some(Ok(_)) => !tf,
+                _ => false,
+            };
+        }
+    }
+
+    /// A message on the reference's stream: its poses (those of the child frame asked for, in
+    /// `/tf`) to the observer.
+    fn reference_message(&mut self, stream: &Stream, log_time_ns: i64, bytes: &[u8], codec: Codec) {
+        self.declare_reference(stream);
+        let Some(read) = &mut self.reference else {
+            return;
+        };
+        let Some(Ok(kind)) = stream.reference else {
+            return;
+        };
+        if !read.readable {
+            return;
+        }
+        let poses = match reference::decode_reference(kind, codec, bytes) {
+            Ok(poses) => poses,
+            Err(_) => {
+                read.undecodable += 1;
+                return;
+            }
+        };
+        let child = match &self.options.reference {
+            Some(ReferenceInLog::Tf { child }) => Some(child.trim_start_matches('/')),
+            _ => None,
+        };
+        for pose in poses {
+            if let Some(child) = child {
+                if pose.child_frame_id.trim_start_matches('/') != child {
+                    continue;
+                }
+                let parent = pose.frame_id.trim_start_matches('/');
+                if !read.parents.iter().any(|p| p == parent) {
+                    read.parents.push(parent.to_owned());
+                }
+            }
+            read.samples += 1;
+            if let Some(observer) = self.observer.as_deref_mut() {
+                observer.reference(&pose.frame_id, pose.sample(log_time_ns));
+            }
         }
     }
 
@@ -248,6 +385,9 @@ impl<'a> Collector<'a> {
             ));
         };
         let log_ns = i64::try_from(log_time).unwrap_or(i64::MAX);
+        if self.is_reference(&stream.topic) {
+            self.reference_message(stream, log_ns, bytes, codec);
+        }
         let kind = stream.kind.as_ref();
         self.message(&stream.topic, &stream.type_name, kind, log_ns, bytes, codec);
         Ok(())
@@ -298,7 +438,20 @@ impl<'a> Collector<'a> {
             Codec::Ros1 => decode::decode_ros1(state.kind, bytes),
             Codec::Cdr => decode::decode_cdr(state.kind, bytes),
         };
-        state.add(decoded, log_time_ns);
+        let added = state.add(decoded, log_time_ns);
+        if let (Some(observer), Some(a)) = (self.observer.as_deref_mut(), added) {
+            observer.estimate(&EstimateMessage {
+                topic,
+                frame_id: &a.decoded.frame_id,
+                index: a.index,
+                stamp_ns: a.stamp_ns,
+                position: a.decoded.position,
+                orientation_xyzw: a.decoded.orientation_xyzw,
+                covariance: &a.decoded.covariance,
+                usable: a.usable,
+                unestimated: a.unestimated,
+            });
+        }
     }
 
     fn finish(self, path: &Path) -> Result<LogSummary, InputError> {
@@ -348,6 +501,7 @@ impl<'a> Collector<'a> {
             not_selected: self.not_selected.into_keys().collect(),
             messages_total: self.total,
             cancelled: self.cancelled,
+            reference: self.reference,
         })
     }
 }
@@ -394,7 +548,7 @@ mod tests {
     #[test]
     fn a_declared_topic_without_messages_is_listed() {
         let options = BagOptions::default();
-        let mut c = Collector::new(&options, None);
+        let mut c = Collector::new(&options, None, None);
         let kind = Ok(PoseMessageKind::PoseWithCovarianceStamped);
         c.declare(
             "/empty",

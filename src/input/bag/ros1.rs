@@ -22,6 +22,7 @@ fn conn_of(c: &rosbag::record_types::Connection<'_>) -> Stream {
         topic: c.topic.to_owned(),
         type_name: c.tp.to_owned(),
         kind: ros1_kind(c.tp, &md5),
+        reference: super::reference::ros1_reference_type(c.tp, &md5),
     }
 }
 
@@ -151,7 +152,7 @@ fn check_chunk(file: &mut std::fs::File, pos: u64) -> Result<(), String> {
 /// Streams every message of the bag into `collector`.
 pub(super) fn read(
     path: &Path,
-    collector: &mut Collector<'_>,
+    collector: &mut Collector<'_, '_>,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<(), InputError> {
     check_header(path)?;
@@ -171,7 +172,7 @@ pub(super) fn read(
         match record {
             Ok(IndexRecord::Connection(c)) => {
                 let conn = conn_of(&c);
-                collector.declare(&conn.topic, &conn.type_name, conn.kind.as_ref());
+                collector.declare_stream(&conn);
                 conns.insert(c.id, conn);
             }
             Ok(IndexRecord::ChunkInfo(info)) => chunk_positions.push(info.chunk_pos),

@@ -4,14 +4,22 @@
 //! decimators, whatever the log's length.
 
 use crate::plan::bag::{
-    AxisStats, DrawnMessage, Health, Issue, IssueCount, PoseMessage, PoseMessageKind, SeriesPoint,
-    TopicPlan, is_odom_frame,
+    AxisStats, Decimator, DrawnMessage, Health, Issue, IssueCount, PoseMessage, PoseMessageKind,
+    SeriesPoint, TopicPlan, is_odom_frame,
 };
 
-use super::decimate::Decimator;
 use super::decode::{DecodeError, Decoded};
 use super::health;
 use super::{DEFAULT_MAX_DRAWN, MAX_DRAWN_LIMIT, MAX_SERIES};
+
+/// A message [`TopicState::add`] took: what an observer of every message needs.
+pub(super) struct Added {
+    pub(super) index: u64,
+    pub(super) stamp_ns: i64,
+    pub(super) usable: bool,
+    pub(super) unestimated: [bool; 6],
+    pub(super) decoded: Decoded,
+}
 
 /// The per-topic streaming state.
 pub(super) struct TopicState {
@@ -60,14 +68,19 @@ impl TopicState {
         }
     }
 
-    pub(super) fn add(&mut self, decoded: Result<Decoded, DecodeError>, log_time_ns: i64) {
+    /// Takes the next message (`None` back when it could not be decoded).
+    pub(super) fn add(
+        &mut self,
+        decoded: Result<Decoded, DecodeError>,
+        log_time_ns: i64,
+    ) -> Option<Added> {
         let index = self.count;
         self.count += 1;
         let d = match decoded {
             Ok(d) => d,
             Err(_) => {
                 self.health.note(Issue::Undecodable, log_time_ns, index);
-                return;
+                return None;
             }
         };
         let (stamp_ns, from_log_time) = match d.stamp_ns {
@@ -156,6 +169,13 @@ impl TopicState {
                 },
             );
         }
+        Some(Added {
+            index,
+            stamp_ns,
+            usable,
+            unestimated: h.unestimated,
+            decoded: d,
+        })
     }
 
     pub(super) fn into_plan(self, name: String) -> TopicPlan {

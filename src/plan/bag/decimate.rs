@@ -1,15 +1,30 @@
-//! Bounded, even thinning of a log's per-message series.
+//! Bounded, even thinning of a log's per-message series: the drawn messages and series the
+//! reader keeps (`input::bag`), and the NEES series kept at the same messages (`eval::nees`).
 
 /// Keeps items at indices that are multiples of `stride`; when more than `cap` are kept, the
 /// stride doubles and every other one is dropped. Memory stays bounded by `cap`.
-pub(super) struct Decimator<T> {
+///
+/// ```
+/// use posecov::plan::bag::Decimator;
+/// let mut d = Decimator::new(1, 4);
+/// for i in 0..10u64 {
+///     if d.wants(i) {
+///         d.push(i, i * 10);
+///     }
+/// }
+/// assert_eq!(d.stride(), 4);
+/// assert_eq!(d.into_items(), [0, 40, 80]);
+/// ```
+#[derive(Debug, Clone)]
+pub struct Decimator<T> {
     items: Vec<(u64, T)>,
     stride: u64,
     cap: usize,
 }
 
 impl<T> Decimator<T> {
-    pub(super) fn new(stride: u64, cap: usize) -> Self {
+    /// Keeps every `stride`-th index, at most `cap` items (see the type's example).
+    pub fn new(stride: u64, cap: usize) -> Self {
         Self {
             items: Vec::new(),
             stride: stride.max(1),
@@ -17,13 +32,15 @@ impl<T> Decimator<T> {
         }
     }
     /// The current stride: every `stride`-th index is kept.
-    pub(super) fn stride(&self) -> u64 {
+    pub fn stride(&self) -> u64 {
         self.stride
     }
-    pub(super) fn wants(&self, index: u64) -> bool {
+    /// Whether item `index` would be kept now.
+    pub fn wants(&self, index: u64) -> bool {
         index.is_multiple_of(self.stride)
     }
-    pub(super) fn push(&mut self, index: u64, item: T) {
+    /// Keeps item `index` if [`wants`](Self::wants) it (indices in increasing order).
+    pub fn push(&mut self, index: u64, item: T) {
         if !self.wants(index) {
             return;
         }
@@ -34,7 +51,8 @@ impl<T> Decimator<T> {
             self.items.retain(|(i, _)| i.is_multiple_of(stride));
         }
     }
-    pub(super) fn into_items(self) -> Vec<T> {
+    /// The kept items, in the order pushed.
+    pub fn into_items(self) -> Vec<T> {
         self.items.into_iter().map(|(_, t)| t).collect()
     }
 }
