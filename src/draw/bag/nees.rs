@@ -59,10 +59,19 @@ pub(super) fn plots(scene: &mut Scene, e: &BagEvaluation) {
         let topic = topic_path(name);
         let plot = format!("nees_{}", topic.replace(['/', '-', '.'], "_"));
         let verdict = c.verdict.map_or("", verdict_word);
+        // From 0 to the largest of the NEES, the bound and the band: all in view.
+        let top = c
+            .series
+            .iter()
+            .map(|p| p.1)
+            .chain([c.bound_95])
+            .chain(c.anees.map(|a| a.band[1]))
+            .fold(0.0_f64, f64::max);
         scene.plots.push(Plot {
             id: plot.clone(),
             title: format!("NEES of {name} against {} — {verdict}", c.reference),
             unit: String::new(),
+            range: (top.is_finite() && top > 0.0).then_some([0.0, 1.05 * top]),
         });
         let (first, last) = (c.series[0].0, c.series[c.series.len() - 1].0);
         let flat = |v: f64| vec![(first, v), (last, v)];
