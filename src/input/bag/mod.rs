@@ -124,7 +124,10 @@ pub fn read_located(
 /// let mut count = Count(0);
 /// let log = locate("covariance_health").unwrap();
 /// let plan = read_located_observed(&log, &BagOptions::default(), &mut |_, _| {}, None, Some(&mut count)).unwrap();
-/// assert_eq!(count.0, plan.topics.iter().map(|t| t.count).sum::<u64>());
+/// // Every message that decodes (an undecodable one has no pose to hand on).
+/// use posecov::plan::bag::Issue;
+/// let decoded: u64 = plan.topics.iter().map(|t| t.count - t.health.count(Issue::Undecodable)).sum();
+/// assert_eq!(count.0, decoded);
 /// ```
 pub fn read_located_observed(
     located: &Located,

@@ -50,8 +50,8 @@ pub struct ReferenceSample {
     pub orientation_xyzw: [f64; 4],
 }
 
-/// One pose-with-covariance message of an estimate topic, as read (every message, usable or
-/// not).
+/// One pose-with-covariance message of an estimate topic, as read (every message that
+/// decodes, usable or not).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EstimateMessage<'a> {
     /// The topic.
