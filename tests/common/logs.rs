@@ -43,7 +43,11 @@ pub struct McapLog {
 impl McapLog {
     pub fn new() -> Self {
         Self {
-            writer: mcap::Writer::new(Cursor::new(Vec::new())).unwrap(),
+            // The `ros2` profile, as rosbag2 writes it (rosbags' reader asks for it).
+            writer: mcap::WriteOptions::new()
+                .profile("ros2")
+                .create(Cursor::new(Vec::new()))
+                .unwrap(),
             channels: BTreeMap::new(),
             schemas: BTreeMap::new(),
             sequence: 0,
@@ -123,9 +127,15 @@ pub const T0: f64 = 100.0;
 pub const SECONDS: f64 = 60.0;
 /// Estimates at 10 Hz from `T0 − 0.2 + 0.0037` s (two before the truth, three after its last
 /// sample at `T0 + SECONDS`): never on a 10 ms truth sample.
-pub const ESTIMATES: usize = 605;
+pub const ESTIMATES: usize = estimates(SECONDS);
 pub const BEFORE: u64 = 2;
 pub const AFTER: u64 = 3;
+
+/// The estimates of a log whose truth spans `seconds`: 10 Hz, `BEFORE` before the truth and
+/// `AFTER` after it.
+pub const fn estimates(seconds: f64) -> usize {
+    (seconds * 10.0) as usize + (BEFORE + AFTER) as usize
+}
 
 fn ns(t: f64) -> i64 {
     (t * 1e9).round() as i64
@@ -145,17 +155,24 @@ pub fn nees_log(seed: u64) -> Vec<u8> {
 
 /// [`nees_log`] with the truth's PoseStamped topic named `truth_topic`.
 pub fn nees_log_named(seed: u64, truth_topic: &str) -> Vec<u8> {
+    nees_log_spanning(seed, truth_topic, SECONDS)
+}
+
+/// [`nees_log_named`] whose truth spans `seconds` (the benchmark's one-hour log:
+/// `examples/nees_bench.rs`).
+pub fn nees_log_spanning(seed: u64, truth_topic: &str, seconds: f64) -> Vec<u8> {
+    let estimate_count = estimates(seconds);
     let mut log = McapLog::new();
     let cov = published_cov();
     let chol = Cholesky::new(cov).unwrap().l();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let truth_count = (SECONDS * 100.0) as usize + 1;
+    let truth_count = (seconds * 100.0).round() as usize + 1;
     let mut next_estimate = 0;
     let estimate_time = |k: usize| T0 - 0.2 + 0.0037 + 0.1 * k as f64;
     for i in 0..truth_count {
         let t = T0 + 0.01 * i as f64;
         // Estimates logged in time order among the truth samples.
-        while next_estimate < ESTIMATES && estimate_time(next_estimate) < t {
+        while next_estimate < estimate_count && estimate_time(next_estimate) < t {
             let te = estimate_time(next_estimate);
             put_estimates(&mut log, te, &truth(te), &chol, &cov, &mut rng);
             next_estimate += 1;
@@ -187,7 +204,7 @@ pub fn nees_log_named(seed: u64, truth_topic: &str) -> Vec<u8> {
         };
         log.put("/tf", "tf2_msgs/msg/TFMessage", ns(t), &cdr(&tf));
     }
-    while next_estimate < ESTIMATES {
+    while next_estimate < estimate_count {
         let te = estimate_time(next_estimate);
         put_estimates(&mut log, te, &truth(te), &chol, &cov, &mut rng);
         next_estimate += 1;
