@@ -38,12 +38,17 @@ use super::rerun::{STAMP_TIMELINE, STEP_TIMELINE};
 use super::{APPLICATION_ID, SinkError};
 use crate::scene::{self, Camera, Scene, View3d};
 
+/// The most plots side by side in one row under the views ([`Scene::plots_below`]).
+pub const PLOTS_PER_ROW: usize = 3;
+
 /// Sends the layout of `scene` through `rec` and makes it the active and default blueprint:
 /// the 3-D views on the left (two thirds; several views in a grid, each with its camera and
 /// its hidden entities), on the right the description above one time-series view per
 /// [`Plot`](crate::scene::Plot) (its title and unit as the view's name, its value range when
-/// the scene fits one); with [`Scene::plots_below`], the plots in a row under the views and
-/// the description the whole right column (two fifths). Panels collapsed; the time panel shows the `step` timeline following the latest data, so a recording opens on its
+/// the scene fits one); with [`Scene::plots_below`], the plots in rows of at most
+/// [`PLOTS_PER_ROW`] under the views (a log with `--reference` adds its NEES plots, which a
+/// single row would squeeze to a fifth of the width each) and the description the whole
+/// right column (two fifths). Panels collapsed; the time panel shows the `step` timeline following the latest data, so a recording opens on its
 /// last step.
 ///
 /// # Errors
@@ -123,15 +128,23 @@ fn layout_messages(
     }
     // Ids in creation order; the root is created after its children.
     let root = if scene.plots_below && !plots.is_empty() {
-        // The views above a row of plots on the left, the text panel the whole right column.
-        let row = log_container(&bp, &mut ids, ContainerKind::Horizontal, &plots, &[])?;
-        let left = log_container(
-            &bp,
-            &mut ids,
-            ContainerKind::Vertical,
-            &[left, row],
-            &[3.0, 2.0],
-        )?;
+        // The views above rows of plots on the left, the text panel the whole right column.
+        let mut column = vec![left];
+        for row in plots.chunks(PLOTS_PER_ROW) {
+            column.push(log_container(
+                &bp,
+                &mut ids,
+                ContainerKind::Horizontal,
+                row,
+                &[],
+            )?);
+        }
+        // The views keep three fifths of the height with one row, half with more.
+        let rows = column.len() - 1;
+        let shares: Vec<f32> = std::iter::once(if rows == 1 { 3.0 } else { 2.0 * rows as f32 })
+            .chain(std::iter::repeat_n(2.0, rows))
+            .collect();
+        let left = log_container(&bp, &mut ids, ContainerKind::Vertical, &column, &shares)?;
         let root = ids.next();
         log_container_at(
             &bp,
