@@ -178,6 +178,39 @@ fn dragging_a_slider_in_chromium_re_streams_the_viewer() {
         serde_json::from_slice(output.stdout.trim_ascii()).expect("one JSON line");
     let value = report["value"].as_f64().unwrap();
     assert!(value > 20.0, "{report}");
+    // Only the methods that apply: no closed form on a camera mount.
+    let methods: Vec<&str> = report["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|m| m.as_str())
+        .collect();
+    assert!(methods.contains(&"sigma_points"), "{report}");
+    assert!(!methods.contains(&"closed_form"), "{report}");
+    // Plain words on the status line.
+    let status = report["statusText"].as_str().unwrap();
+    assert!(status.starts_with("showing change "), "{status}");
+    assert!(!status.contains("generation"), "{status}");
+    // A cleared field names the field, not serde's enum.
+    let empty = report["emptyError"].as_str().unwrap();
+    assert!(
+        empty.contains("pose map_from_robot σ θ is empty: type a number"),
+        "{empty}"
+    );
+    assert!(!empty.contains("EditValue"), "{empty}");
+    // At 800 px the controls stack above the viewer, both the page's width.
+    let narrow = &report["narrow"];
+    let (panel, viewer) = (&narrow["panel"], &narrow["viewer"]);
+    let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
+    assert!(
+        f(panel, "y") + f(panel, "height") <= f(viewer, "y") + 1.0,
+        "not stacked: {narrow}"
+    );
+    assert!(
+        f(viewer, "width") >= 780.0 && f(panel, "width") >= 780.0,
+        "{narrow}"
+    );
+    assert!(f(viewer, "height") >= 360.0, "{narrow}");
     // "Save" wrote a scenario that `posecov check` accepts, with the new σ and the file's
     // comments.
     assert_eq!(report["saved"].as_str(), saved.to_str(), "{report}");
@@ -294,4 +327,145 @@ fn watch_re_streams_in_place_on_the_served_viewer() {
     wait_for("[1] streamed");
     wait_until_stream_shows(&received, &expected_for(&edited));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// One HTTP/1.1 request to `port` on loopback (`Host` as given); the status, the headers and
+/// up to `want` bytes of the body (a stream is not read to its end).
+fn http(port: u16, host: &str, request: &str, body: &[u8], want: usize) -> (u16, String, Vec<u8>) {
+    use std::io::{Read as _, Write as _};
+    let mut stream = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(30)))
+        .unwrap();
+    let head = format!("{request} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n");
+    stream.write_all(head.as_bytes()).unwrap();
+    stream.write_all(b"\r\n").unwrap();
+    stream.write_all(body).unwrap();
+    let mut got = Vec::new();
+    let mut buf = [0u8; 65536];
+    loop {
+        let end = got.windows(4).position(|w| w == b"\r\n\r\n");
+        if end.is_some_and(|e| got.len() >= (e + 4).saturating_add(want)) {
+            break;
+        }
+        match stream.read(&mut buf) {
+            Ok(0) | Err(_) => break,
+            Ok(n) => got.extend_from_slice(&buf[..n]),
+        }
+    }
+    let end = got
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .expect("an HTTP answer");
+    let headers = String::from_utf8_lossy(&got[..end]).into_owned();
+    let status = headers.split(' ').nth(1).unwrap().parse().unwrap();
+    (status, headers, got[end + 4..].to_vec())
+}
+
+/// The page shows the served web viewer through itself (same origin): the viewer's files and
+/// its gRPC-web stream come from the page's port, under the page's Host checks, while the
+/// viewer's own servers stay on loopback; and the page still stops on time with a stream
+/// open.
+#[test]
+fn the_page_serves_the_viewer_and_its_stream_from_its_own_origin() {
+    let grpc_port = free_port();
+    let child = Command::new(env!("CARGO_BIN_EXE_posecov"))
+        .args(["live", "camera_on_robot", "--serve", "--web-port", "0"])
+        .args(["--grpc-port", &grpc_port.to_string()])
+        .args(["--bind", "127.0.0.1:0", "--serve-seconds", "25"])
+        .env("POSECOV_RERUN", "/nonexistent")
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap();
+    let mut child = Running(child);
+    let mut lines = BufReader::new(child.0.stdout.take().unwrap()).lines();
+    let page = loop {
+        let line = lines.next().expect("the Controls URL").unwrap();
+        if let Some(url) = line.strip_prefix("Controls: ") {
+            break url.to_owned();
+        }
+    };
+    let host = page
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_owned();
+    let port: u16 = host.rsplit_once(':').unwrap().1.parse().unwrap();
+
+    let (status, _, body) = http(port, &host, "GET /api/state", b"", usize::MAX);
+    assert_eq!(status, 200);
+    let state: serde_json::Value = serde_json::from_slice(&body).unwrap();
+    assert_eq!(state["viewer_url"], "/viewer/", "{state}");
+    assert_eq!(state["viewer_same_origin"], true, "{state}");
+
+    let (status, _, body) = http(port, &host, "GET /viewer/", b"", usize::MAX);
+    assert_eq!(status, 200);
+    assert!(String::from_utf8_lossy(&body).contains("re_viewer.js"));
+    // (Chunked or not: the module's magic number within the first bytes.)
+    let (status, _, body) = http(port, &host, "GET /viewer/re_viewer_bg.wasm", b"", 16);
+    assert_eq!(status, 200);
+    assert!(body.windows(4).any(|w| w == b"\0asm"), "{:?}", &body[..16]);
+    // Another name for this machine is refused, as for the page itself (DNS rebinding).
+    let (status, ..) = http(
+        port,
+        &format!("evil.example:{port}"),
+        "GET /viewer/",
+        b"",
+        0,
+    );
+    assert_eq!(status, 403);
+
+    // The viewer's stream, as the web viewer asks for it: gRPC-web, one empty request frame.
+    let request = "POST /rerun.sdk_comms.v1alpha1.MessageProxyService/ReadMessages";
+    let frame = [0u8, 0, 0, 0, 0];
+    let head = format!(
+        "{request} HTTP/1.1\r\nHost: {host}\r\nContent-Type: application/grpc-web+proto\r\nX-Grpc-Web: 1\r\nContent-Length: {}\r\nConnection: close",
+        frame.len()
+    );
+    let mut stream = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    {
+        use std::io::{Read as _, Write as _};
+        stream
+            .set_read_timeout(Some(Duration::from_secs(30)))
+            .unwrap();
+        stream.write_all(head.as_bytes()).unwrap();
+        stream.write_all(b"\r\n\r\n").unwrap();
+        stream.write_all(&frame).unwrap();
+        let mut got = Vec::new();
+        let mut buf = [0u8; 65536];
+        // Headers and the first kilobytes of the recording.
+        while !got.windows(4).any(|w| w == b"\r\n\r\n") || got.len() < 4096 {
+            match stream.read(&mut buf) {
+                Ok(0) | Err(_) => break,
+                Ok(n) => got.extend_from_slice(&buf[..n]),
+            }
+        }
+        let text = String::from_utf8_lossy(&got);
+        assert!(
+            text.starts_with("HTTP/1.1 200"),
+            "{}",
+            &text[..text.len().min(400)]
+        );
+        assert!(
+            text.to_ascii_lowercase()
+                .contains("content-type: application/grpc-web"),
+            "{}",
+            &text[..text.len().min(400)]
+        );
+        assert!(got.len() >= 4096, "the stream sent {} bytes", got.len());
+    }
+    // The stream is still open: the page stops at --serve-seconds all the same.
+    let deadline = Instant::now() + Duration::from_secs(90);
+    loop {
+        if child.0.try_wait().unwrap().is_some() {
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "posecov live did not stop with a viewer stream open"
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    drop(stream);
 }

@@ -35,7 +35,10 @@ function render(state) {
   if (state.save_to) $("save").title = `Write the current values to ${state.save_to}`;
   if (state.viewer_url && $("viewer").hidden) {
     $("viewer").hidden = false;
-    $("viewer-frame").src = state.viewer_url;
+    // Through this page's own server (same origin): the viewer reads its stream from the
+    // host this page was reached at, so a tablet that reaches the page gets the viewer too.
+    const stream = encodeURIComponent(`rerun+${location.protocol}//${location.host}/proxy`);
+    $("viewer-frame").src = state.viewer_same_origin ? `${state.viewer_url}?url=${stream}` : state.viewer_url;
   }
   document.body.classList.toggle("no-viewer", !state.viewer_url);
   const form = $("controls");
@@ -105,10 +108,14 @@ function numberRow(c) {
     send(c.id, Number(range.value));
   });
   const typed = () => {
-    const v = number.value.trim() === "" ? NaN : Number(number.value);
-    if (Number(range.min) > v) range.min = v;
-    if (Number(range.max) < v) range.max = v;
-    range.value = v;
+    // A cleared field (or one the browser cannot read as a number) is sent as null: the
+    // server refuses it naming the field.
+    const v = number.value.trim() === "" ? null : Number(number.value);
+    if (v !== null && Number.isFinite(v)) {
+      if (Number(range.min) > v) range.min = v;
+      if (Number(range.max) < v) range.max = v;
+      range.value = v;
+    }
     send(c.id, v);
   };
   number.addEventListener("change", typed);
@@ -175,11 +182,14 @@ function updateStatus(s) {
   const el = $("status");
   const busy = s.phase !== "idle";
   el.classList.toggle("busy", busy);
-  const shown = s.shown === null ? "nothing yet" : `generation ${s.shown}`;
+  // Each accepted change (and Reset) is numbered; 0 is the file as opened.
+  const change = (n) => (n === 0 ? "the file's values" : `change ${n}`);
+  const shown = s.shown === null ? "nothing yet" : change(s.shown);
   const samples = s.shown_samples ? `, ${s.shown_samples} samples` : "";
   const first = s.first_picture_ms !== null ? ` · first picture ${s.first_picture_ms.toFixed(0)} ms` : "";
   const final = s.final_picture_ms !== null && s.done ? ` · final ${s.final_picture_ms.toFixed(0)} ms` : "";
-  const doing = busy ? ` · ${s.phase} of ${s.generation} (${s.samples} samples)…` : "";
+  const phase = s.phase === "preview" ? "quick preview" : "full picture";
+  const doing = busy ? ` · ${phase} of ${change(s.generation)} (${s.samples} samples)…` : "";
   el.textContent = `showing ${shown}${s.done ? "" : " (preview)"}${samples}${first}${final}${doing}${coverageText(s.coverage)}`;
   el.dataset.generation = s.generation;
   el.dataset.shown = s.shown === null ? "" : s.shown;

@@ -436,6 +436,40 @@ impl AnyEvaluation {
         with_evaluation!(self, e => super::consistency::last_output_summary(&e.nodes))
     }
 
+    /// The methods this evaluation computed an operation's result with, or tried and reported
+    /// failing ([`Finding::MethodFailed`]), in [`Method::ALL`]'s order. Evaluated with every
+    /// method asked for, these are the methods that apply to the plan: the evaluation is the
+    /// one rule of which method works on which operation (a closed form only for a
+    /// differential drive, fourth order only for compounding, …).
+    ///
+    /// ```
+    /// use posecov::app::{load, resolve, evaluate};
+    /// use posecov::uncertain::Method;
+    /// let loaded = load("camera_on_robot").unwrap();
+    /// let mut settings = resolve(&loaded.input, &Default::default(), None).unwrap();
+    /// settings.eval.methods = Method::ALL.to_vec();
+    /// settings.eval.samples = 16;
+    /// let methods = evaluate(&loaded, &settings.eval).unwrap().methods_that_ran();
+    /// assert!(methods.contains(&Method::SigmaPoints));
+    /// assert!(!methods.contains(&Method::ClosedForm), "{methods:?}");
+    /// ```
+    pub fn methods_that_ran(&self) -> Vec<Method> {
+        let mut seen: Vec<Method> = with_evaluation!(self, e => e
+            .nodes
+            .iter()
+            .filter(|n| n.op.is_some())
+            .flat_map(|n| n.estimates.iter().map(|x| x.result.method))
+            .collect());
+        seen.extend(self.findings().iter().filter_map(|f| match f {
+            Finding::MethodFailed { method, .. } => Some(*method),
+            _ => None,
+        }));
+        Method::ALL
+            .into_iter()
+            .filter(|m| seen.contains(m))
+            .collect()
+    }
+
     /// [`Evaluation::along_track`] of any group.
     ///
     /// ```

@@ -36,6 +36,8 @@ enum GuardKind {
     Serve {
         _web: Box<dyn Any + Send>,
         url: String,
+        /// The web viewer's files and the gRPC server (both loopback).
+        addrs: (std::net::SocketAddr, std::net::SocketAddr),
     },
     Memory(rr::sink::MemorySinkStorage),
     Stdout(rr::sink::MemorySinkStorage),
@@ -148,11 +150,19 @@ fn serve(
     })
     .map_err(|err| SinkError::WebViewer(err.to_string()))?;
     let url = format!("{}/?url={}", web.server_url(), percent_encode(&grpc_url));
+    let web_addr = web
+        .server_url()
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .parse()
+        .map_err(|e| SinkError::WebViewer(format!("{}: {e}", web.server_url())))?;
+    let grpc_addr = std::net::SocketAddr::from(([127, 0, 0, 1], grpc_port));
     Ok((
         rec,
         GuardKind::Serve {
             _web: Box::new(web),
             url,
+            addrs: (web_addr, grpc_addr),
         },
     ))
 }
@@ -185,6 +195,15 @@ impl SinkGuard {
     pub fn viewer_url(&self) -> Option<&str> {
         match &self.kind {
             GuardKind::Serve { url, .. } => Some(url),
+            _ => None,
+        }
+    }
+
+    /// For [`Sink::Serve`]: where the web viewer's files and its gRPC stream are served
+    /// (both on loopback), for a page that shows the viewer through itself.
+    pub fn served_addrs(&self) -> Option<(std::net::SocketAddr, std::net::SocketAddr)> {
+        match &self.kind {
+            GuardKind::Serve { addrs, .. } => Some(*addrs),
             _ => None,
         }
     }

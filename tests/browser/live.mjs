@@ -2,8 +2,10 @@
 // playwright-core. Usage: node live.mjs CONTROL_PAGE_URL [SCREENSHOT.png]
 //
 // Opens the control page, drags the heading σ slider of camera_on_robot with the mouse,
-// waits until the page reports the new generation's final picture as sent, clicks Save when
-// the page offers it, and prints one JSON line {"id", "value", "generation", "saved"} for the
+// waits until the page reports the new change's final picture as sent, clicks Save when
+// the page offers it, reads the methods offered and the status line, clears the typed field
+// (refused, naming it), narrows the window to 800 px (the layout stacks), and prints one JSON
+// line {"id", "value", "generation", "saved", "methods", "statusText", "emptyError", "narrow"} for the
 // Rust side (tests/live_browser.rs), which
 // checks on the viewer's gRPC stream that the new data arrived.
 import { chromium } from "playwright-core";
@@ -77,7 +79,23 @@ try {
     await page.waitForTimeout(3000);
     await page.screenshot({ path: screenshot });
   }
-  console.log(JSON.stringify({ id: ID, value: after, generation, saved }));
+  // Only the methods that apply are offered (camera_on_robot: no closed form).
+  const methods = await page.$$eval("input[type=checkbox][data-id^='scenario.methods.']",
+    (boxes) => boxes.map((b) => b.dataset.id.replace("scenario.methods.", "")));
+  const statusText = await status.textContent();
+  // A cleared field is refused with a message naming it; the last good picture stays.
+  const number = page.locator(`input[type=number][data-id="${ID}"]`);
+  await number.fill("");
+  await number.press("Enter");
+  await page.locator("#error").waitFor({ state: "visible", timeout: 10000 });
+  const emptyError = await page.locator("#error").textContent();
+  // Under 900 px the controls stack above the viewer, each the page's width.
+  await page.setViewportSize({ width: 800, height: 1000 });
+  await page.waitForTimeout(300);
+  const boxOf = async (sel) => page.locator(sel).boundingBox();
+  const narrow = { panel: await boxOf("#panel"), viewer: await boxOf("#viewer") };
+  if (screenshot) await page.screenshot({ path: screenshot.replace(/\.png$/, "") + "-narrow.png", fullPage: true });
+  console.log(JSON.stringify({ id: ID, value: after, generation, saved, methods, statusText, emptyError, narrow }));
   code = 0;
 } catch (e) {
   console.error(String(e && e.stack || e));

@@ -57,6 +57,7 @@ impl Server {
             std::thread::spawn(move || {
                 let page = PageOptions {
                     viewer_url: None,
+                    upstream: None,
                     save_to: None,
                 };
                 serve_page(live, listener, page, cancel, None, |_| {}).expect("serves");

@@ -86,8 +86,9 @@ pub(super) struct Slot {
 const SETTINGS: [&str; 3] = ["samples", "seed", "confidence"];
 
 /// Every control of `doc` (an already valid scenario of group `group`), in file order:
-/// settings, methods, draw switches, then each pose and operation.
-pub(super) fn slots(doc: &DocumentMut, group: GroupKind) -> Vec<Slot> {
+/// settings, the methods among `applicable` (those that apply to its operations), draw
+/// switches, then each pose and operation.
+pub(super) fn slots(doc: &DocumentMut, group: GroupKind, applicable: &[Method]) -> Vec<Slot> {
     let mut out = Vec::new();
     let header = doc.get("scenario").and_then(Item::as_table_like);
     for key in SETTINGS {
@@ -98,7 +99,10 @@ pub(super) fn slots(doc: &DocumentMut, group: GroupKind) -> Vec<Slot> {
         });
     }
     let methods = header.map(methods_of).unwrap_or_default();
-    for method in Method::ALL.into_iter().filter(|m| *m != Method::Exact) {
+    let offered = Method::ALL
+        .into_iter()
+        .filter(|m| *m != Method::Exact && applicable.contains(m));
+    for method in offered {
         let slug = method.slug();
         out.push(Slot {
             control: Control {

@@ -10,6 +10,7 @@ use std::path::Path;
 use toml_edit::{Array, DocumentMut, Item, Value};
 
 use super::controls::{self, Control, ControlKind, Place, Seg, Slot};
+use super::prose;
 use crate::app::{AppError, Loaded, load_text};
 use crate::input::scenario::bundled;
 use crate::uncertain::Method;
@@ -26,14 +27,20 @@ pub struct Edit {
     pub value: EditValue,
 }
 
-/// A number or a switch.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+/// A number or a switch, as the page sends it. A number field the user cleared arrives as
+/// `null` ([`EditValue::Empty`]), a typed text that is no JSON number as a string
+/// ([`EditValue::Text`]); both are refused naming the field, as is NaN.
+#[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(untagged)]
 pub enum EditValue {
     /// For a number control.
     Number(f64),
     /// For a toggle.
     Toggle(bool),
+    /// A number typed as text (`"1e-3"`, `"NaN"`): read as a number, else refused.
+    Text(String),
+    /// A cleared field (`null`): refused, naming the field.
+    Empty,
 }
 
 /// Why an edit was refused. The document is unchanged.
@@ -82,6 +89,8 @@ pub struct LiveDocument {
     loaded: Loaded,
     /// The controls as the file has them (what [`changes`] compares with).
     file_controls: Vec<Control>,
+    /// The methods that apply to the scenario ([`applicable_methods`]): the only ones offered.
+    methods: Vec<Method>,
 }
 
 impl LiveDocument {
@@ -99,12 +108,14 @@ impl LiveDocument {
     pub fn new(text: &str, origin: &str) -> Result<Self, AppError> {
         let loaded = load_text(text, origin)?;
         let doc = parse(text, origin)?;
+        let methods = applicable_methods(&loaded);
         let mut live = Self {
             origin: origin.to_owned(),
             source: text.to_owned(),
             doc,
             loaded,
             file_controls: Vec::new(),
+            methods,
         };
         live.file_controls = live.controls();
         Ok(live)
@@ -147,6 +158,10 @@ impl LiveDocument {
     }
 
     fn slots(&self) -> Vec<Slot> {
+        self.slots_of(&self.doc)
+    }
+
+    fn slots_of(&self, doc: &DocumentMut) -> Vec<Slot> {
         use crate::lie::GroupKind;
         use crate::plan::AnyPlan;
         let group = match &self.loaded.input.plan {
@@ -155,7 +170,7 @@ impl LiveDocument {
             AnyPlan::So3(_) => GroupKind::So3,
             AnyPlan::Se3(_) => GroupKind::Se3,
         };
-        controls::slots(&self.doc, group)
+        controls::slots(doc, group, &self.methods)
     }
 
     /// The current input (always valid).
@@ -198,7 +213,9 @@ impl LiveDocument {
                 id: edit.id.clone(),
             })?;
         let mut doc = self.doc.clone();
-        write(&mut doc, &slot, edit.value)?;
+        write(&mut doc, &slot, &edit.value)?;
+        let now: Vec<Control> = self.slots_of(&doc).into_iter().map(|s| s.control).collect();
+        restate_words(&mut doc, &self.source, &self.file_controls, &now);
         let text = doc.to_string();
         let mut loaded = load_text(&text, &self.origin)?;
         // The file's checks pass; its numbers must also evaluate and draw (a control of 1e16
@@ -234,6 +251,24 @@ impl LiveDocument {
         *self = next;
         Ok(())
     }
+}
+
+/// The methods that apply to `loaded`'s operations: those its evaluation with every method
+/// asked for (and a few samples) ran or reported failing
+/// ([`AnyEvaluation::methods_that_ran`](crate::eval::AnyEvaluation::methods_that_ran), the one
+/// rule). Should that evaluation fail, every method is offered, as before.
+fn applicable_methods(loaded: &Loaded) -> Vec<Method> {
+    let quick = crate::app::Overrides {
+        samples: Some(EDIT_CHECK_SAMPLES),
+        ..Default::default()
+    };
+    crate::app::resolve(&loaded.input, &quick, None)
+        .ok()
+        .and_then(|mut settings| {
+            settings.eval.methods = Method::ALL.to_vec();
+            crate::app::evaluate(loaded, &settings.eval).ok()
+        })
+        .map_or_else(|| Method::ALL.to_vec(), |e| e.methods_that_ran())
 }
 
 /// The values changed from the file, as a paragraph for the description (the file's prose
@@ -274,9 +309,34 @@ fn changes(file: &[Control], now: &[Control]) -> String {
     }
 }
 
+/// Restates the numbers of `[scenario]`'s title and description (the file's, in `source`)
+/// that state a value edited from `file` to `now` ([`prose::restate`]), keeping the file's
+/// quoting and layout.
+fn restate_words(doc: &mut DocumentMut, source: &str, file: &[Control], now: &[Control]) {
+    let Ok(file_doc) = source.parse::<DocumentMut>() else {
+        return;
+    };
+    for key in ["title", "description"] {
+        let raw = match file_doc.get("scenario").and_then(|s| s.get(key)) {
+            Some(Item::Value(Value::String(f))) => f.display_repr().into_owned(),
+            _ => continue,
+        };
+        let Ok(new) = prose::restate(&raw, file, now).parse::<Value>() else {
+            continue;
+        };
+        if let Some(old) = doc
+            .get_mut("scenario")
+            .and_then(|s| s.get_mut(key))
+            .and_then(Item::as_value_mut)
+        {
+            replace(old, new);
+        }
+    }
+}
+
 /// A number in six significant digits, without trailing zeros: `40`, `0.05`, `0.3` (for
 /// 0.30000000000000004), `1.5e-5`.
-fn trim(x: f64) -> String {
+pub(super) fn trim(x: f64) -> String {
     let magnitude = x.abs();
     if x == 0.0 || !x.is_finite() {
         return x.to_string();
@@ -308,12 +368,13 @@ fn parse(text: &str, origin: &str) -> Result<DocumentMut, AppError> {
 
 /// Writes `value` into `doc` where `slot` lives, keeping the old value's decoration
 /// (spacing and trailing comment).
-fn write(doc: &mut DocumentMut, slot: &Slot, value: EditValue) -> Result<(), EditError> {
+fn write(doc: &mut DocumentMut, slot: &Slot, value: &EditValue) -> Result<(), EditError> {
     let id = &slot.control.id;
     let wrong = |message: &str| EditError::Value {
         id: id.clone(),
         message: message.to_owned(),
     };
+    let value = number_of(&slot.control, value)?;
     match (&slot.control.kind, value) {
         (ControlKind::Number { integer, .. }, EditValue::Number(x)) => {
             let new = if *integer {
@@ -353,11 +414,53 @@ fn write(doc: &mut DocumentMut, slot: &Slot, value: EditValue) -> Result<(), Edi
         (ControlKind::Number { .. }, EditValue::Toggle(_)) => {
             return Err(wrong("is a number; send a number"));
         }
-        (ControlKind::Toggle { .. }, EditValue::Number(_)) => {
+        (ControlKind::Toggle { .. }, _) => {
             return Err(wrong("is a switch; send true or false"));
         }
+        (ControlKind::Number { .. }, _) => return Err(wrong("is a number; type one")),
     }
     Ok(())
+}
+
+/// A number control's value as a number, or why not in the field's words: a cleared field, a
+/// text that is no number, NaN or an infinity name the field (`pose[0].cov.std_deg[2]: pose
+/// map_from_robot σ θ is empty: type a number`). Switches keep their value.
+fn number_of(control: &Control, value: &EditValue) -> Result<EditValue, EditError> {
+    let ControlKind::Number { .. } = control.kind else {
+        return match value {
+            EditValue::Toggle(_) | EditValue::Number(_) => Ok(value.clone()),
+            EditValue::Text(_) | EditValue::Empty => Err(EditError::Value {
+                id: control.id.clone(),
+                message: format!(
+                    "{} {} is a switch: on or off",
+                    control.section, control.label
+                ),
+            }),
+        };
+    };
+    let field = format!("{} {}", control.section, control.label);
+    let refuse = |message: String| EditError::Value {
+        id: control.id.clone(),
+        message,
+    };
+    let x = match value {
+        EditValue::Number(x) => *x,
+        EditValue::Toggle(_) => return Ok(value.clone()),
+        EditValue::Empty => return Err(refuse(format!("{field} is empty: type a number"))),
+        EditValue::Text(t) if t.trim().is_empty() => {
+            return Err(refuse(format!("{field} is empty: type a number")));
+        }
+        EditValue::Text(t) => t
+            .trim()
+            .parse::<f64>()
+            .map_err(|_| refuse(format!("{field}: `{t}` is not a number")))?,
+    };
+    if !x.is_finite() {
+        return Err(refuse(format!(
+            "{field}: {x} is not a number; type a finite one"
+        )));
+    }
+    Ok(EditValue::Number(x))
 }
 
 /// Replaces `old` by `new`, keeping `old`'s spacing and comment.

@@ -7,10 +7,14 @@
 //! - [`document`]: edits, reset, the text to save.
 //! - `worker` (viewer feature): the evaluation thread and its status.
 //! - `server` (viewer feature): the page and its JSON API on loopback.
+//! - `proxy` (viewer feature): the served web viewer through the page (same origin).
 //! - `run` (viewer feature): the `live` command and `--watch`.
 
 pub mod controls;
 pub mod document;
+mod prose;
+#[cfg(feature = "viewer")]
+mod proxy;
 #[cfg(feature = "viewer")]
 mod run;
 #[cfg(feature = "viewer")]
@@ -20,6 +24,8 @@ mod worker;
 
 pub use controls::{Control, ControlKind};
 pub use document::{Edit, EditError, EditValue, LiveDocument};
+#[cfg(feature = "viewer")]
+pub use proxy::{Upstream, VIEWER_PATH};
 #[cfg(feature = "viewer")]
 pub use run::{LiveOptions, live, watch_in_place};
 #[cfg(feature = "viewer")]
@@ -59,8 +65,8 @@ mod tests {
         }
     }
 
-    /// 3 settings, the methods but `exact`, the draw switches.
-    const SETTINGS_AND_SWITCHES: usize = 3 + 9 + 7;
+    /// 3 settings and the draw switches (methods: only those that apply).
+    const SETTINGS_AND_SWITCHES: usize = 3 + 7;
 
     #[test]
     fn a_heading_sigma_edit_keeps_the_comment_and_reset_restores_the_file() {
@@ -106,7 +112,7 @@ mod tests {
         let e = live
             .apply(&Edit {
                 id: "pose[0].cov.std_deg[2]".into(),
-                value: EditValue::Number(f64::NAN),
+                value: EditValue::Number(-4.0),
             })
             .unwrap_err();
         assert_eq!(e.field().as_deref(), Some("pose[0].cov"), "{e}");
@@ -114,6 +120,33 @@ mod tests {
             e.to_string().contains("camera_on_robot.toml (bundled):"),
             "{e}"
         );
+        // A cleared field, NaN and a text that is no number name the field in words.
+        for (value, words) in [
+            (EditValue::Empty, "is empty: type a number"),
+            (EditValue::Number(f64::NAN), "NaN is not a number"),
+            (EditValue::Text("NaN".into()), "NaN is not a number"),
+            (EditValue::Text(" ".into()), "is empty: type a number"),
+            (EditValue::Text("abc".into()), "`abc` is not a number"),
+        ] {
+            let e = live
+                .apply(&Edit {
+                    id: "pose[0].cov.std_deg[2]".into(),
+                    value,
+                })
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with("pose[0].cov.std_deg[2]: pose map_from_robot σ θ")
+                    && e.contains(words),
+                "{e}"
+            );
+        }
+        live.apply(&Edit {
+            id: "pose[0].cov.std_deg[2]".into(),
+            value: EditValue::Text("25".into()),
+        })
+        .unwrap();
+        live.reset().unwrap();
         let e = live
             .apply(&Edit {
                 id: "scenario.samples".into(),

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::document::{Edit, EditValue, LiveDocument};
+use super::proxy::Upstream;
 use super::server::{PageOptions, bind_page, serve_page};
 use super::worker::{Live, passes};
 use crate::app::sinks::{
@@ -82,9 +83,10 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
         watch: false,
         png: None,
     };
-    let (live, viewer_url) = start(doc, &view)?;
+    let (live, viewer_url, upstream) = start(doc, &view)?;
     let page = PageOptions {
         viewer_url: viewer_url.clone(),
+        upstream,
         save_to: options.save_scenario.clone(),
     };
     if !options.bind.ip().is_loopback() {
@@ -114,8 +116,12 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
 }
 
 /// Opens the viewer's stream (the blueprint from a quick preview of the scene) and starts
-/// the evaluation thread on it. Returns the session and the web viewer's URL if served.
-fn start(doc: LiveDocument, view: &ViewOptions) -> Result<(Arc<Live>, Option<String>), AppError> {
+/// the evaluation thread on it. Returns the session, and the web viewer's URL and loopback
+/// servers if served.
+fn start(
+    doc: LiveDocument,
+    view: &ViewOptions,
+) -> Result<(Arc<Live>, Option<String>, Option<Upstream>), AppError> {
     let sink = choose_sink(view)?;
     if matches!(sink, Sink::Save(_) | Sink::Stdout) {
         return Err(AppError::Live(
@@ -129,7 +135,14 @@ fn start(doc: LiveDocument, view: &ViewOptions) -> Result<(Arc<Live>, Option<Str
     ids.recording_id.push_str("/live");
     let (rec, guard) = open_stream(&sink, &ids, &scene)?;
     let url = guard.viewer_url().map(str::to_owned);
-    Ok((Live::start(doc, rec, guard, view.overrides.clone()), url))
+    let upstream = guard
+        .served_addrs()
+        .map(|(web, grpc)| Upstream { web, grpc });
+    Ok((
+        Live::start(doc, rec, guard, view.overrides.clone()),
+        url,
+        upstream,
+    ))
 }
 
 /// `--watch` on a viewer: one recording, re-streamed in place on every change of the file;
@@ -158,7 +171,7 @@ pub fn watch_in_place(options: &ViewOptions, cancel: &AtomicBool) -> Result<u8, 
         overrides: options.overrides.clone(),
         ..options.clone()
     };
-    let (live, url) = start(doc, &live_view)?;
+    let (live, url, _) = start(doc, &live_view)?;
     if let Some(url) = url {
         println!("Web viewer: {url}");
     }

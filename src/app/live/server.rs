@@ -10,6 +10,7 @@
 //! | `POST /api/reframe` | the picture again with the layout, cameras fitted to it |
 //! | `POST /api/save` | writes the current scenario to the `--save-scenario` file |
 //! | `GET /api/scenario.toml` | the current scenario as a download |
+//! | `/viewer/…`, `/rerun.…` | the served web viewer and its stream, forwarded to its loopback servers ([`proxy`](super::proxy)) |
 //!
 //! Every request must name this server in `Host` (and in `Origin` when a browser sends one),
 //! so a page elsewhere cannot drive it (nor a DNS-rebinding name); `POST`s must carry JSON,
@@ -30,6 +31,7 @@ use axum::response::Response;
 use serde_json::{Value as Json, json};
 
 use super::document::{Edit, EditError};
+use super::proxy::{self, Upstream};
 use super::worker::Live;
 use crate::app::AppError;
 
@@ -45,6 +47,9 @@ const MAX_BODY: usize = 64 * 1024;
 pub struct PageOptions {
     /// The web viewer to show beside the controls, if one is served.
     pub viewer_url: Option<String>,
+    /// The served viewer's loopback servers: the page then shows the viewer through itself
+    /// (same origin, [`proxy`](super::proxy)), so whoever reaches the page gets the viewer.
+    pub upstream: Option<Upstream>,
     /// Where "save" writes (`--save-scenario`); `None`: download only.
     pub save_to: Option<PathBuf>,
 }
@@ -99,7 +104,7 @@ pub fn bind_page(addr: SocketAddr) -> Result<std::net::TcpListener, AppError> {
 /// let (rec, guard) = open_stream(&Sink::Spawn, &RecordingIds::for_scenario("camera", 7), &layout).unwrap();
 /// let live = Live::start(doc, rec, guard, Default::default());
 /// let listener = bind_page("127.0.0.1:9091".parse().unwrap()).unwrap();
-/// let page = PageOptions { viewer_url: None, save_to: None };
+/// let page = PageOptions { viewer_url: None, upstream: None, save_to: None };
 /// serve_page(live, listener, page, Arc::new(AtomicBool::new(false)), None, |url| println!("Controls: {url}")).unwrap();
 /// ```
 pub fn serve_page(
@@ -131,17 +136,27 @@ pub fn serve_page(
     let router = Router::new().fallback(handle).with_state(app);
     ready(&url);
     let start = Instant::now();
+    let stopped = move || {
+        let cancel = Arc::clone(&cancel);
+        async move {
+            while !cancel.load(Ordering::Relaxed) && limit.is_none_or(|l| start.elapsed() < l) {
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+        }
+    };
     runtime.block_on(async move {
         let listener = tokio::net::TcpListener::from_std(listener)
             .map_err(|e| AppError::Live(e.to_string()))?;
-        axum::serve(listener, router)
-            .with_graceful_shutdown(async move {
-                while !cancel.load(Ordering::Relaxed) && limit.is_none_or(|l| start.elapsed() < l) {
-                    tokio::time::sleep(Duration::from_millis(50)).await;
-                }
-            })
-            .await
-            .map_err(|e| AppError::Live(format!("serving the page: {e}")))
+        let server = std::future::IntoFuture::into_future(
+            axum::serve(listener, router).with_graceful_shutdown(stopped()),
+        );
+        // A viewer's stream never ends by itself: a second after the stop, whatever is still
+        // open is dropped with the runtime.
+        let stop = stopped();
+        tokio::select! {
+            served = server => served.map_err(|e| AppError::Live(format!("serving the page: {e}"))),
+            () = async { stop.await; tokio::time::sleep(Duration::from_secs(1)).await } => Ok(()),
+        }
     })
 }
 
@@ -186,6 +201,7 @@ fn allowed(
     hosts: &[String],
     open: bool,
     method: &Method,
+    path: &str,
     headers: &HeaderMap,
 ) -> Result<(), &'static str> {
     let host = headers
@@ -218,12 +234,21 @@ fn allowed(
         }
     }
     if method == Method::POST {
-        let json = headers
+        // Neither type is one a cross-site form can send.
+        let (wanted, why) = if proxy::is_viewer_path(path) {
+            (
+                "application/grpc-web",
+                "the viewer's POSTs must be application/grpc-web",
+            )
+        } else {
+            ("application/json", "POST bodies must be application/json")
+        };
+        let typed = headers
             .get(header::CONTENT_TYPE)
             .and_then(|v| v.to_str().ok())
-            .is_some_and(|v| v.starts_with("application/json"));
-        if !json {
-            return Err("POST bodies must be application/json");
+            .is_some_and(|v| v.starts_with(wanted));
+        if !typed {
+            return Err(why);
         }
     }
     Ok(())
@@ -236,7 +261,7 @@ async fn handle(
     headers: HeaderMap,
     body: Bytes,
 ) -> Response {
-    if let Err(why) = allowed(&app.hosts, app.open, &method, &headers) {
+    if let Err(why) = allowed(&app.hosts, app.open, &method, uri.path(), &headers) {
         return reply(StatusCode::FORBIDDEN, &json!({ "error": why }));
     }
     if body.len() > MAX_BODY {
@@ -244,6 +269,13 @@ async fn handle(
             StatusCode::PAYLOAD_TOO_LARGE,
             &json!({ "error": "body too large" }),
         );
+    }
+    let forwarded = app.options.upstream.as_ref().and_then(|up| {
+        let path = uri.path_and_query().map_or(uri.path(), |p| p.as_str());
+        proxy::target(up, path)
+    });
+    if let Some((to, path)) = forwarded {
+        return proxy::forward(to, path, method, &headers, body).await;
     }
     let app2 = Arc::clone(&app);
     let path = uri.path().to_owned();
@@ -267,10 +299,23 @@ fn route(app: &App, method: &Method, path: &str, body: &[u8]) -> Response {
         ("GET", "/api/status") => reply(StatusCode::OK, &json!(app.live.status())),
         ("GET", "/api/scenario.toml") => download(app),
         ("POST", "/api/edit") => match serde_json::from_slice::<Edit>(body) {
-            Err(e) => reply(
-                StatusCode::BAD_REQUEST,
-                &json!({ "error": format!("expected {{\"id\": …, \"value\": number or true/false}}: {e}") }),
-            ),
+            Err(_) => {
+                // Name the control when the request does (never serde's enum names).
+                let id = serde_json::from_slice::<Json>(body)
+                    .ok()
+                    .and_then(|v| v.get("id").and_then(Json::as_str).map(str::to_owned));
+                let error = match &id {
+                    Some(id) => {
+                        format!("{id}: the value must be a number, or true/false for a switch")
+                    }
+                    None => "expected {\"id\": …, \"value\": a number, or true/false for a switch}"
+                        .to_owned(),
+                };
+                reply(
+                    StatusCode::BAD_REQUEST,
+                    &json!({ "error": error, "field": id }),
+                )
+            }
             Ok(edit) => match app.live.apply(&edit) {
                 Ok(_) => reply(StatusCode::OK, &state(app)),
                 Err(e) => refused(&e),
@@ -313,7 +358,13 @@ fn state(app: &App) -> Json {
         "origin": origin,
         "controls": controls,
         "status": app.live.status(),
-        "viewer_url": app.options.viewer_url,
+        // Through this server when it can (the page builds the viewer's `?url=` from the
+        // host it was reached at), else the viewer's own loopback URL.
+        "viewer_url": match app.options.upstream {
+            Some(_) => Some(proxy::VIEWER_PATH.to_owned()),
+            None => app.options.viewer_url.clone(),
+        },
+        "viewer_same_origin": app.options.upstream.is_some(),
         "save_to": app.options.save_to.as_ref().map(|p| p.display().to_string()),
     })
 }
@@ -419,10 +470,10 @@ mod tests {
         let hosts = hosts_of("127.0.0.1:8123".parse().unwrap(), Some("lab-pc"));
         let json = (header::CONTENT_TYPE, "application/json");
         let get = |pairs: &[(header::HeaderName, &str)]| {
-            allowed(&hosts, false, &Method::GET, &headers(pairs))
+            allowed(&hosts, false, &Method::GET, "/api/state", &headers(pairs))
         };
         let post = |pairs: &[(header::HeaderName, &str)]| {
-            allowed(&hosts, false, &Method::POST, &headers(pairs))
+            allowed(&hosts, false, &Method::POST, "/api/edit", &headers(pairs))
         };
         assert!(get(&[(header::HOST, "127.0.0.1:8123")]).is_ok());
         assert!(get(&[(header::HOST, "localhost:8123")]).is_ok());
@@ -466,7 +517,7 @@ mod tests {
         // this port, still same-origin only; never a foreign name (DNS rebinding).
         let open_hosts = hosts_of("0.0.0.0:8123".parse().unwrap(), Some("lab-pc"));
         let open = |pairs: &[(header::HeaderName, &str)]| {
-            allowed(&open_hosts, true, &Method::GET, &headers(pairs))
+            allowed(&open_hosts, true, &Method::GET, "/viewer/", &headers(pairs))
         };
         for host in [
             "192.168.1.20:8123",
@@ -498,6 +549,22 @@ mod tests {
                 (header::ORIGIN, "http://192.168.1.20:8123")
             ])
             .is_ok()
+        );
+        // The viewer's stream through the page: same checks, and gRPC-web only.
+        let grpc = "/rerun.sdk_comms.v1alpha1.MessageProxyService/ReadMessages";
+        let viewer_post = |pairs: &[(header::HeaderName, &str)]| {
+            allowed(&hosts, false, &Method::POST, grpc, &headers(pairs))
+        };
+        let grpc_web = (header::CONTENT_TYPE, "application/grpc-web+proto");
+        assert!(viewer_post(&[(header::HOST, "127.0.0.1:8123"), grpc_web.clone()]).is_ok());
+        assert!(viewer_post(&[(header::HOST, "127.0.0.1:8123"), json.clone()]).is_err());
+        assert!(
+            viewer_post(&[
+                (header::HOST, "127.0.0.1:8123"),
+                (header::ORIGIN, "http://evil.example"),
+                grpc_web
+            ])
+            .is_err()
         );
         // Bound to loopback, an IP address is no name of this server unless it is loopback.
         assert!(get(&[(header::HOST, "192.168.1.20:8123")]).is_err());
