@@ -115,13 +115,13 @@ pub fn live(options: &LiveOptions, cancel: &Arc<AtomicBool>) -> Result<u8, AppEr
     Ok(0)
 }
 
+/// A live session and, when the web viewer is served, its URL and loopback servers.
+type Started = (Arc<Live>, Option<String>, Option<Upstream>);
+
 /// Opens the viewer's stream (the blueprint from a quick preview of the scene) and starts
 /// the evaluation thread on it. Returns the session, and the web viewer's URL and loopback
 /// servers if served.
-fn start(
-    doc: LiveDocument,
-    view: &ViewOptions,
-) -> Result<(Arc<Live>, Option<String>, Option<Upstream>), AppError> {
+fn start(doc: LiveDocument, view: &ViewOptions) -> Result<Started, AppError> {
     let sink = choose_sink(view)?;
     if matches!(sink, Sink::Save(_) | Sink::Stdout) {
         return Err(AppError::Live(

@@ -48,7 +48,7 @@ pub struct PageOptions {
     /// The web viewer to show beside the controls, if one is served.
     pub viewer_url: Option<String>,
     /// The served viewer's loopback servers: the page then shows the viewer through itself
-    /// (same origin, [`proxy`](super::proxy)), so whoever reaches the page gets the viewer.
+    /// (same origin, see [`Upstream`]), so whoever reaches the page gets the viewer.
     pub upstream: Option<Upstream>,
     /// Where "save" writes (`--save-scenario`); `None`: download only.
     pub save_to: Option<PathBuf>,
