@@ -4,6 +4,16 @@
 //! and the series kept. The twin, reading the same bag with the Python `rosbags` package, is
 //! `benches/bag_rosbags.py`; `benches/run_rosbags.sh` runs both side by side (BENCHMARKS.md).
 //!
+//! Two more groups measure the issue-19 performance rules on the same ROS 1 bags:
+//!
+//! - `bag_libbz2/NAME` (bz2 bags): libbz2 alone — every chunk of the bag decompressed (the
+//!   `rosbag` crate's chunk record, through the `bzip2` crate's C library) and nothing else, in
+//!   the same parallel batches on the same rayon threads as posecov's reader. posecov's read
+//!   should stay within 1.2× of it.
+//! - `bag_health/NAME`: the health classes and σ statistics alone
+//!   ([`TopicHealth::add`](posecov::input::bag::health::TopicHealth) over every pose message,
+//!   decoded beforehand): their share of the read's time should stay ≤ 10 %.
+//!
 //! Run: `cargo bench --no-default-features --bench bag_read -- --warm-up-time 1 --measurement-time 3`
 //! (`POSECOV_BENCH_BAGS=a.bag:b.bag` adds those bags, as `benches/run_rosbags.sh` does with
 //! test2.bag rewritten ten times over with no, lz4 and bz2 chunk compression).
@@ -12,7 +22,11 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use posecov::input::bag::decode::{Decoded, decode_ros1, ros1_kind};
+use posecov::input::bag::health::TopicHealth;
 use posecov::input::bag::{BagOptions, read_bag};
+use rayon::prelude::*;
+use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
 const TEST2: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -34,8 +48,8 @@ fn pose_messages(path: &str) -> u64 {
     plan.topics.iter().map(|t| t.count).sum()
 }
 
-fn bag_read(c: &mut Criterion) {
-    let mut group = c.benchmark_group("bag_read");
+/// The bags measured: (name, path).
+fn bags() -> Vec<(String, String)> {
     let extra = std::env::var("POSECOV_BENCH_BAGS").unwrap_or_default();
     let mut bags: Vec<(String, String)> = vec![
         ("ros1_test2_bz2".into(), TEST2.into()),
@@ -47,24 +61,134 @@ fn bag_read(c: &mut Criterion) {
             .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
         bags.push((stem, path.to_owned()));
     }
-    for (name, path) in &bags {
-        let path = path.as_str();
-        group.throughput(Throughput::Elements(pose_messages(path)));
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                let plan = read_bag(
-                    Path::new(black_box(path)),
-                    &BagOptions::default(),
-                    &mut |_, _| {},
-                    None,
-                )
-                .unwrap();
-                black_box(plan)
-            })
-        });
+    bags
+}
+
+/// Per bag, its three measures one right after the other (a shared machine's load changes
+/// over minutes: what is compared is measured seconds apart).
+fn bag_benches(c: &mut Criterion) {
+    for (name, path) in &bags() {
+        bag_read(c, name, path);
+        if name.contains("bz2") {
+            bag_libbz2(c, name, path);
+        }
+        if path.ends_with(".bag") {
+            bag_health(c, name, path);
+        }
     }
+}
+
+fn bag_read(c: &mut Criterion, name: &str, path: &str) {
+    let mut group = c.benchmark_group("bag_read");
+    group.throughput(Throughput::Elements(pose_messages(path)));
+    group.bench_function(name, |b| {
+        b.iter(|| {
+            let plan = read_bag(
+                Path::new(black_box(path)),
+                &BagOptions::default(),
+                &mut |_, _| {},
+                None,
+            )
+            .unwrap();
+            black_box(plan)
+        })
+    });
     group.finish();
 }
 
-criterion_group!(benches, bag_read);
+/// A ROS 1 bag's chunk positions, from its index.
+fn chunks(bag: &RosBag) -> Vec<u64> {
+    let mut positions: Vec<u64> = bag
+        .index_records()
+        .filter_map(|r| match r {
+            Ok(IndexRecord::ChunkInfo(info)) => Some(info.chunk_pos),
+            _ => None,
+        })
+        .collect();
+    positions.sort_unstable();
+    positions
+}
+
+/// Decompresses every chunk of `bag` as posecov's reader batches them (two per rayon thread
+/// at a time), keeping nothing: the decompression library alone. Returns the chunks.
+fn decompress_all(bag: &RosBag, positions: &[u64]) -> usize {
+    let batch = 2 * rayon::current_num_threads().max(1);
+    let mut done = 0;
+    for group in positions.chunks(batch) {
+        done += group
+            .par_iter()
+            .map(|&pos| {
+                let mut records = bag.chunk_records();
+                records.seek(pos).unwrap();
+                match records.next() {
+                    Some(Ok(ChunkRecord::Chunk(chunk))) => {
+                        // The decompressed chunk's first record header, so nothing is skipped.
+                        black_box(chunk.messages().next().is_some()) as usize
+                    }
+                    _ => panic!("no chunk at {pos}"),
+                }
+            })
+            .sum::<usize>();
+    }
+    done
+}
+
+fn bag_libbz2(c: &mut Criterion, name: &str, path: &str) {
+    let mut group = c.benchmark_group("bag_libbz2");
+    let bag = RosBag::new(path).unwrap();
+    let positions = chunks(&bag);
+    group.throughput(Throughput::Elements(pose_messages(path)));
+    group.bench_function(name, |b| b.iter(|| decompress_all(&bag, &positions)));
+    group.finish();
+}
+
+/// Every pose message of a ROS 1 bag, decoded.
+fn decoded(path: &str) -> Vec<(i64, Decoded)> {
+    let bag = RosBag::new(path).unwrap();
+    let mut kinds = std::collections::HashMap::new();
+    let mut out = Vec::new();
+    for pos in chunks(&bag) {
+        let mut records = bag.chunk_records();
+        records.seek(pos).unwrap();
+        let Some(Ok(ChunkRecord::Chunk(chunk))) = records.next() else {
+            panic!("no chunk at {pos}")
+        };
+        for m in chunk.messages() {
+            match m.unwrap() {
+                MessageRecord::Connection(c) => {
+                    let md5: String = c.md5sum.iter().map(|b| format!("{b:02x}")).collect();
+                    if let Some(Ok(kind)) = ros1_kind(c.tp, &md5) {
+                        kinds.insert(c.id, kind);
+                    }
+                }
+                MessageRecord::MessageData(m) => {
+                    if let Some(kind) = kinds.get(&m.conn_id)
+                        && let Ok(d) = decode_ros1(*kind, m.data)
+                    {
+                        out.push((m.time as i64, d));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn bag_health(c: &mut Criterion, name: &str, path: &str) {
+    let mut group = c.benchmark_group("bag_health");
+    let messages = decoded(path);
+    group.throughput(Throughput::Elements(messages.len() as u64));
+    group.bench_function(name, |b| {
+        b.iter(|| {
+            let mut topic = TopicHealth::default();
+            for (k, (stamp, d)) in messages.iter().enumerate() {
+                black_box(topic.add(k as u64, *stamp, d, true));
+            }
+            black_box(topic)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bag_benches);
 criterion_main!(benches);

@@ -71,7 +71,7 @@ enum Command {
         more: Vec<String>,
         /// Accept this defect class on purpose (repeatable): non_finite, asymmetric, not_psd,
         /// undecodable, bad_orientation, unknown_marker, all_zero, placeholder_used_axis,
-        /// constant, frozen_stamp.
+        /// constant, frozen_stamp, type_change. A log cut short is always reported (exit 1).
         #[arg(long = "allow", value_name = "NAME")]
         allow: Vec<String>,
     },

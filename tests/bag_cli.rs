@@ -192,10 +192,18 @@ fn errors_name_the_file_and_the_flag() {
     let cut = dir.join("cut.bag");
     let bytes = std::fs::read(TEST2).unwrap();
     std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
-    let (code, _, err) = run(&["report", cut.to_str().unwrap()]);
-    assert_eq!(code, Some(2));
+    // A bag cut short keeps its whole chunks (read without the index it lost) and says where
+    // it stops: drawn and reported, and `check` fails on it.
+    let (code, out, _) = run(&["report", cut.to_str().unwrap()]);
+    assert_eq!(code, Some(0));
     assert!(
-        err.contains("cut.bag:") && err.contains("outside the file"),
+        out.contains("The log stops early") && out.contains("outside the file"),
+        "{out}"
+    );
+    let (code, _, err) = run(&["check", cut.to_str().unwrap()]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("cut.bag") && err.contains("the log stops early"),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).ok();

@@ -110,8 +110,12 @@ fn damaged_bags_are_errors_not_panics() {
         std::fs::write(&path, &data).unwrap();
         match read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None) {
             Err(e) => assert!(e.to_string().contains(name), "{e}"),
-            // Flipped bytes inside messages are counted, not fatal.
-            Ok(plan) => assert_eq!(name, "garbage.bag", "{plan:?}"),
+            // Flipped bytes inside messages are counted, not fatal; a bag cut short keeps its
+            // whole chunks and says where it stops (tests/bag_bad_input.rs).
+            Ok(plan) => assert!(
+                name == "garbage.bag" || (name == "truncated.bag" && plan.cut.is_some()),
+                "{name}: {plan:?}"
+            ),
         }
     }
     std::fs::remove_dir_all(&dir).ok();

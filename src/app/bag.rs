@@ -322,6 +322,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
             "ros_reading": run.evaluation.reading,
             "messages": plan.messages_total,
             "cancelled": plan.cancelled,
+            "cut_short": plan.cut,
         },
         "topics": topics,
         "skipped": plan.skipped,
@@ -392,6 +393,14 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
             ));
         }
     }
+    if let Some(cut) = &plan.cut {
+        // Not a covariance defect, but the log cannot be trusted whole: CI must see it.
+        defects.push(format!(
+            "{file}: the log stops early, {}; read its first {} whole chunk(s), up to byte {} of \
+             its {}: every finding here is from them",
+            cut.reason, cut.chunks_read, cut.at_byte, cut.file_bytes
+        ));
+    }
     let facts = format!(
         "{} messages, {} drawn items{}",
         plan.messages_total,
@@ -405,9 +414,14 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
         format!("{name}: ok ({} pose topic(s), {facts})", plan.topics.len())
     } else {
         format!(
-            "{name}: defects on {} of {} pose topic(s) ({facts}; the first of each on stderr)",
-            defects.len(),
-            plan.topics.len()
+            "{name}: defects on {} of {} pose topic(s){} ({facts}; the first of each on stderr)",
+            defects.len() - usize::from(plan.cut.is_some()),
+            plan.topics.len(),
+            if plan.cut.is_some() {
+                ", the log stops early"
+            } else {
+                ""
+            }
         )
     };
     Checked { line, defects }

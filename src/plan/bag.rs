@@ -21,6 +21,8 @@ mod decimate;
 mod reference;
 pub use decimate::Decimator;
 pub use reference::{EstimateMessage, LogObserver, ReferenceInLog, ReferenceRead, ReferenceSample};
+mod cut;
+pub use cut::LogCut;
 
 /// A variance at or above this is a placeholder ("not estimated"), not a measurement.
 pub const PLACEHOLDER: f64 = 1e6;
@@ -145,6 +147,9 @@ pub enum Issue {
     Constant,
     /// The same header stamp on consecutive messages.
     FrozenStamp,
+    /// Messages of another type on the topic (another publisher, a changed definition): not
+    /// read; the types are [`Health::other_types`].
+    TypeChange,
     /// A variance ≥ 1e6 on an axis planar motion does not use (z, roll, pitch): "not
     /// estimated".
     Placeholder,
@@ -162,7 +167,7 @@ pub enum Issue {
 
 impl Issue {
     /// Every finding, defects first.
-    pub const ALL: [Issue; 15] = [
+    pub const ALL: [Issue; 16] = [
         Issue::NonFinite,
         Issue::Asymmetric,
         Issue::NotPsd,
@@ -173,6 +178,7 @@ impl Issue {
         Issue::PlaceholderUsedAxis,
         Issue::Constant,
         Issue::FrozenStamp,
+        Issue::TypeChange,
         Issue::Placeholder,
         Issue::StampFallback,
         Issue::StampOrder,
@@ -199,6 +205,7 @@ impl Issue {
             Issue::PlaceholderUsedAxis => "placeholder_used_axis",
             Issue::Constant => "constant",
             Issue::FrozenStamp => "frozen_stamp",
+            Issue::TypeChange => "type_change",
             Issue::Placeholder => "placeholder",
             Issue::StampFallback => "stamp_fallback",
             Issue::StampOrder => "stamp_order",
@@ -292,6 +299,8 @@ pub struct Health {
     pub min_eigenvalue: Option<f64>,
     /// The longest stretch without growth while moving (when it makes a `constant` finding).
     pub constant: Option<Stretch>,
+    /// The other message types seen on the topic (a `type_change` finding), in order seen.
+    pub other_types: Vec<String>,
 }
 
 impl Health {
@@ -526,4 +535,7 @@ pub struct LogSummary {
     pub cancelled: bool,
     /// What the reader saw of the reference asked for in the log (`--reference`), if any.
     pub reference: Option<ReferenceRead>,
+    /// The read stopped at a cut or a damage before the file's end: everything before was
+    /// read.
+    pub cut: Option<LogCut>,
 }

@@ -170,6 +170,8 @@ fn judge(file: &str, run: Run<Result<serde_json::Value, String>>, limits: &Limit
                 "median_of_kept",
                 // No --reference: no NEES.
                 ".topics[#].consistency",
+                // Read to the end of the file: no cut.
+                ".meta.cut_short",
             ];
             if let Some(path) = json_null(&json, &optional) {
                 found.push(finding("nonfinite_json", format!("null at {path}")));

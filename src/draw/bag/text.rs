@@ -33,6 +33,7 @@ pub fn issue_word(issue: Issue) -> &'static str {
         Issue::PlaceholderUsedAxis => "placeholder on a used axis",
         Issue::Constant => "constant while moving",
         Issue::FrozenStamp => "frozen stamp",
+        Issue::TypeChange => "another message type",
         Issue::Placeholder => "placeholder (≥ 1e6)",
         Issue::StampFallback => "stamp from the log time",
         Issue::StampOrder => "stamp out of order",
@@ -99,6 +100,16 @@ pub fn issue_sentence(issue: Issue, t: &TopicPlan) -> String {
             None => "the covariance does not change while the pose moves.".to_owned(),
         },
         Issue::FrozenStamp => "the same header stamp as the message before.".to_owned(),
+        Issue::TypeChange => format!(
+            "the topic also carries {} (another publisher or definition): those messages are \
+             not read, only its {} ones.",
+            if t.health.other_types.is_empty() {
+                "another type".to_owned()
+            } else {
+                t.health.other_types.join(", ")
+            },
+            t.kind.ros1_name()
+        ),
         Issue::Placeholder => {
             "z, roll or pitch ≥ 1e6, \"not estimated\" on axes planar motion does not use."
                 .to_owned()
@@ -172,6 +183,14 @@ pub fn description(
         let _ = writeln!(
             s,
             "\n**Interrupted (Ctrl-C)**: only the messages before the interruption were read."
+        );
+    }
+    if let Some(cut) = &plan.cut {
+        let _ = writeln!(
+            s,
+            "\n**The log stops early** ({}): read its first {} whole chunk(s), up to byte {} of \
+             its {}; everything here is from them.",
+            cut.reason, cut.chunks_read, cut.at_byte, cut.file_bytes
         );
     }
     for (t, te) in plan.topics.iter().zip(&e.topics) {

@@ -4,7 +4,8 @@
 
 use nalgebra::{DMatrix, SymmetricEigen};
 
-use crate::plan::bag::{COV_LEN, Issue, Stretch};
+use super::decode::Decoded;
+use crate::plan::bag::{AxisStats, COV_LEN, Health, Issue, Stretch};
 use crate::uncertain::{psd_tolerance, symmetry_tolerance};
 
 pub use crate::plan::bag::PLACEHOLDER;
@@ -26,7 +27,8 @@ pub struct MessageHealth {
     pub issues: Vec<Issue>,
     /// Axes whose variance is ≥ [`PLACEHOLDER`] or exactly 0, per ROS axis.
     pub unestimated: [bool; 6],
-    /// Smallest eigenvalue of the estimated block (when finite and symmetric).
+    /// Smallest eigenvalue of the estimated block, computed when it is finite, symmetric and
+    /// not positive definite (`None` otherwise: a positive definite block is PSD).
     pub min_eigenvalue: Option<f64>,
     /// Trace of the estimated position block, m² (usable messages only).
     pub position_trace: Option<f64>,
@@ -37,6 +39,33 @@ impl MessageHealth {
     pub fn usable(&self) -> bool {
         !self.issues.iter().any(|i| i.unusable())
     }
+}
+
+/// Whether the symmetrised block of `cov` on the `kept` axes is positive definite (its
+/// factorisation L D Lᵀ exists with D > 0, computed here on the stack, without square
+/// roots): then its smallest eigenvalue is positive, above any −tolerance, and it is positive
+/// semi-definite by the one rule without computing it.
+fn positive_definite(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
+    // l[r][c] = L_rc · D_c (c < r), d_inv[c] = 1 / D_c.
+    let mut ld = [[0.0f64; 6]; 6];
+    let mut d_inv = [0.0f64; 6];
+    for (r, &i) in kept.iter().enumerate() {
+        for (c, &j) in kept.iter().enumerate().take(r + 1) {
+            let mut v = 0.5 * (cov[i * 6 + j] + cov[j * 6 + i]);
+            for k in 0..c {
+                v -= ld[r][k] * ld[c][k] * d_inv[k];
+            }
+            if r == c {
+                if v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                    return false;
+                }
+                d_inv[r] = 1.0 / v;
+            } else {
+                ld[r][c] = v;
+            }
+        }
+    }
+    true
 }
 
 /// Classifies one covariance (ROS layout) and its orientation quaternion.
@@ -70,7 +99,13 @@ pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHeal
         };
     }
     // The estimated axes: not a placeholder (a huge row would swamp the rounding of the rest).
-    let kept: Vec<usize> = (0..6).filter(|&i| diag[i] < PLACEHOLDER).collect();
+    let mut axes = [0usize; 6];
+    let mut n = 0;
+    for i in (0..6).filter(|&i| diag[i] < PLACEHOLDER) {
+        axes[n] = i;
+        n += 1;
+    }
+    let kept = &axes[..n];
     if cov[0] == -1.0 {
         issues.push(Issue::UnknownMarker);
     } else if !kept.is_empty()
@@ -98,7 +133,13 @@ pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHeal
     let mut min_eigenvalue = None;
     if asymmetric {
         issues.push(Issue::Asymmetric);
-    } else if !kept.is_empty() && !issues.contains(&Issue::UnknownMarker) {
+    } else if !kept.is_empty()
+        && !issues.contains(&Issue::UnknownMarker)
+        && !positive_definite(cov, kept)
+    {
+        // Only a block that is not positive definite needs its eigenvalues (most messages'
+        // are: one fixed-size Cholesky factorisation decides, the eigen-decomposition was
+        // most of the health classes' time).
         let block = DMatrix::from_fn(kept.len(), kept.len(), |r, c| {
             0.5 * (cov[kept[r] * 6 + kept[c]] + cov[kept[c] * 6 + kept[r]])
         });
@@ -262,6 +303,93 @@ impl Constancy {
     }
 }
 
+/// A topic's health classes and σ statistics, streamed over its messages: per message what
+/// [`classify`], [`Trend`] and [`Constancy`] find, counted per issue in [`Health`], and σ per
+/// axis ([`AxisStats`]). This is the work a log's read does per message on top of decoding
+/// and keeping the drawn set and series (`benches/bag_read.rs` measures its share).
+///
+/// ```
+/// use posecov::input::bag::decode::Decoded;
+/// use posecov::input::bag::health::TopicHealth;
+/// use posecov::plan::bag::Issue;
+/// let mut covariance = [0.0; 36];
+/// for (i, v) in [0.001, 0.001, 1e6, 1e6, 1e6, 0.03].iter().enumerate() { covariance[i * 7] = *v; }
+/// let d = Decoded { stamp_ns: Some(1), frame_id: "odom".into(), child_frame_id: String::new(),
+///     position: [0.0; 3], orientation_xyzw: [0.0, 0.0, 0.0, 1.0], covariance, twist_covariance: None };
+/// let mut topic = TopicHealth::default();
+/// let (h, sigma) = topic.add(0, 1, &d, true);
+/// assert!(h.usable() && topic.planar);
+/// assert_eq!(topic.health.count(Issue::Placeholder), 1);
+/// assert!((sigma[5].unwrap() - 0.03f64.sqrt()).abs() < 1e-15 && sigma[2].is_none());
+/// ```
+#[derive(Debug, Clone)]
+pub struct TopicHealth {
+    /// Per issue, the count and the first message.
+    pub health: Health,
+    pub(super) trend: Trend,
+    pub(super) constancy: Constancy,
+    /// Usable messages (drawable as a Gaussian).
+    pub usable: u64,
+    /// Every usable message so far has placeholders on z, roll and pitch.
+    pub planar: bool,
+    /// σ per ROS axis over the usable messages that estimate it.
+    pub sigma_stats: [Option<AxisStats>; 6],
+}
+
+impl Default for TopicHealth {
+    fn default() -> Self {
+        Self {
+            health: Health::default(),
+            trend: Trend::default(),
+            constancy: Constancy::default(),
+            usable: 0,
+            planar: true,
+            sigma_stats: [None; 6],
+        }
+    }
+}
+
+impl TopicHealth {
+    /// Message number `index` at `stamp_ns` (`dead_reckoned`: an Odometry in an odom frame):
+    /// its health and its σ per ROS axis (`None` where not estimated, or unusable).
+    pub fn add(
+        &mut self,
+        index: u64,
+        stamp_ns: i64,
+        d: &Decoded,
+        dead_reckoned: bool,
+    ) -> (MessageHealth, [Option<f64>; 6]) {
+        let mut h = classify(&d.covariance, d.orientation_xyzw);
+        if let Some(trace) = h.position_trace {
+            h.issues.extend(self.trend.next(trace));
+        }
+        for issue in &h.issues {
+            self.health.note(*issue, stamp_ns, index);
+        }
+        if h.issues.contains(&Issue::NotPsd) {
+            let lo = h.min_eigenvalue.unwrap_or(0.0);
+            self.health.min_eigenvalue = Some(self.health.min_eigenvalue.map_or(lo, |m| m.min(lo)));
+        }
+        let usable = h.usable();
+        if usable {
+            self.usable += 1;
+            self.planar &= h.unestimated[2] && h.unestimated[3] && h.unestimated[4];
+            self.constancy
+                .next(index, stamp_ns, &d.covariance, d.position, dead_reckoned);
+        }
+        let sigma: [Option<f64>; 6] = std::array::from_fn(|i| {
+            let v = d.covariance[i * 7];
+            (usable && !h.unestimated[i]).then(|| v.max(0.0).sqrt())
+        });
+        for (stats, s) in self.sigma_stats.iter_mut().zip(sigma) {
+            if let Some(s) = s {
+                AxisStats::add(stats, s);
+            }
+        }
+        (h, sigma)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -318,7 +446,20 @@ mod tests {
         // 1.79e308 next to 1e-3: eigenvalues of the whole matrix would be rounding noise.
         let h = classify(&diag([1e-3, 1e-3, 1.79e308, 1e6, 1e6, 0.03]), Q);
         assert!(h.usable());
-        assert_eq!(h.min_eigenvalue, Some(1e-3));
+        // Positive definite: decided by Cholesky, no eigenvalue computed.
+        assert_eq!(h.min_eigenvalue, None);
         assert_eq!(h.position_trace, Some(2e-3));
+        // Singular but PSD (x and y fully correlated): the eigenvalues decide, within the
+        // tolerance.
+        let mut s = diag([1e-3, 1e-3, 1e6, 1e6, 1e6, 0.03]);
+        s[1] = 1e-3;
+        s[6] = 1e-3;
+        let h = classify(&s, Q);
+        assert!(
+            h.issues.iter().all(|i| *i != Issue::NotPsd),
+            "{:?}",
+            h.issues
+        );
+        assert!(h.min_eigenvalue.unwrap().abs() < 1e-15);
     }
 }

@@ -21,8 +21,8 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::plan::bag::{
-    EstimateMessage, LogObserver, LogSummary, PoseMessageKind, ReferenceInLog, ReferenceRead,
-    SkippedTopic,
+    EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessageKind, ReferenceInLog,
+    ReferenceRead, SkippedTopic,
 };
 
 use super::format::{self, Format};
@@ -36,6 +36,7 @@ mod mcap;
 mod mcap_records;
 pub mod reference;
 mod ros1;
+mod ros1_linear;
 mod topic;
 
 use decode::{DecodeError, Decoded};
@@ -195,9 +196,13 @@ fn read_path(
     // Nothing to draw is an error for every command (no empty recording), unless Ctrl-C
     // stopped the read before the first pose message.
     if !plan.cancelled && plan.topics.iter().all(|t| t.count == 0) {
+        let cut = match &plan.cut {
+            Some(cut) => format!("; the log stops early: {}", cut.reason),
+            None => String::new(),
+        };
         return Err(InputError::Format {
             file: path.display().to_string(),
-            message: no_pose_topic(&plan),
+            message: format!("{}{cut}", no_pose_topic(&plan)),
         });
     }
     Ok(plan)
@@ -227,11 +232,14 @@ struct Collector<'a, 'o> {
     cancel: Option<&'a AtomicBool>,
     cancelled: bool,
     topics: BTreeMap<String, TopicState>,
-    skipped: BTreeMap<String, (String, u64)>,
+    /// Per topic of another type: its type, messages and the first one's log time.
+    skipped: BTreeMap<String, (String, u64, i64)>,
     not_selected: BTreeMap<String, ()>,
     total: u64,
     observer: Option<&'o mut dyn LogObserver>,
     reference: Option<ReferenceRead>,
+    /// Where a read without an index stopped before the file's end.
+    cut: Option<LogCut>,
 }
 
 impl<'a, 'o> Collector<'a, 'o> {
@@ -250,6 +258,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             total: 0,
             observer,
             reference: options.reference.as_ref().map(|_| ReferenceRead::default()),
+            cut: None,
         }
     }
 
@@ -361,7 +370,7 @@ impl<'a, 'o> Collector<'a, 'o> {
                         Some(Err(why)) => why.clone(),
                         _ => type_name.to_owned(),
                     };
-                    self.skipped.insert(topic.to_owned(), (label, 0));
+                    self.skipped.insert(topic.to_owned(), (label, 0, i64::MAX));
                 }
             }
         }
@@ -408,17 +417,22 @@ impl<'a, 'o> Collector<'a, 'o> {
         codec: Codec,
     ) {
         self.total += 1;
+        let label = |other: Option<&Result<PoseMessageKind, String>>| match other {
+            Some(Err(why)) => why.clone(),
+            _ => type_name.to_owned(),
+        };
         let kind = match kind {
             Some(Ok(kind)) => *kind,
             other => {
-                if let Some(entry) = self.skipped.get_mut(topic) {
+                if let Some(state) = self.topics.get_mut(topic) {
+                    // A pose topic that carries another type too: not read, a defect.
+                    state.other_type(&label(other), log_time_ns);
+                } else if let Some(entry) = self.skipped.get_mut(topic) {
                     entry.1 += 1;
+                    entry.2 = entry.2.min(log_time_ns);
                 } else {
-                    let label = match other {
-                        Some(Err(why)) => why.clone(),
-                        _ => type_name.to_owned(),
-                    };
-                    self.skipped.insert(topic.to_owned(), (label, 1));
+                    self.skipped
+                        .insert(topic.to_owned(), (label(other), 1, log_time_ns));
                 }
                 return;
             }
@@ -437,6 +451,10 @@ impl<'a, 'o> Collector<'a, 'o> {
         let Some(state) = self.topics.get_mut(topic) else {
             return;
         };
+        if state.kind != kind {
+            state.other_type(type_name, log_time_ns);
+            return;
+        }
         let decoded: Result<Decoded, DecodeError> = match codec {
             Codec::Ros1 => decode::decode_ros1(state.kind, bytes),
             Codec::Cdr => decode::decode_cdr(state.kind, bytes),
@@ -457,11 +475,18 @@ impl<'a, 'o> Collector<'a, 'o> {
         }
     }
 
-    fn finish(self, path: &Path) -> Result<LogSummary, InputError> {
+    fn finish(mut self, path: &Path) -> Result<LogSummary, InputError> {
+        // A topic declared (or first seen) with another type before its pose messages: those
+        // messages are the pose topic's type change, not a topic of their own.
+        for (name, state) in &mut self.topics {
+            if let Some((label, count, first)) = self.skipped.remove(name) {
+                state.other_type_before(label, count, first);
+            }
+        }
         for wanted in &self.options.topics {
             if !self.topics.contains_key(wanted) && !self.cancelled {
                 let why = match self.skipped.get(wanted) {
-                    Some((t, _)) => format!("its messages are {t}, not a pose with covariance"),
+                    Some((t, ..)) => format!("its messages are {t}, not a pose with covariance"),
                     None => {
                         let have: Vec<&str> = self
                             .topics
@@ -495,7 +520,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             skipped: self
                 .skipped
                 .into_iter()
-                .map(|(name, (message_type, count))| SkippedTopic {
+                .map(|(name, (message_type, count, _))| SkippedTopic {
                     name,
                     message_type,
                     count,
@@ -505,6 +530,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             messages_total: self.total,
             cancelled: self.cancelled,
             reference: self.reference,
+            cut: self.cut,
         })
     }
 }

@@ -12,7 +12,7 @@ use rosbag::record_types::Chunk;
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
 use super::decode::ros1_kind;
-use super::{Codec, Collector, MAX_CHUNK_RATIO, RECORD_LIMIT, Stream};
+use super::{Codec, Collector, MAX_CHUNK_RATIO, RECORD_LIMIT, Stream, ros1_linear};
 use crate::input::InputError;
 use crate::input::format::ROSBAG_MAGIC as ROS1_MAGIC;
 
@@ -26,9 +26,18 @@ fn conn_of(c: &rosbag::record_types::Connection<'_>) -> Stream {
     }
 }
 
+/// Where a bag's chunks begin, and its index position if it can be used (`Err(why)`: a bag
+/// whose recording was interrupted has `index_pos = 0`; a copy cut short has one beyond its
+/// end; either is read linearly, [`super::ros1_linear`]).
+struct Layout {
+    chunks_start: u64,
+    file_bytes: u64,
+    index_pos: Result<u64, String>,
+}
+
 /// Checks the bag header before the crate maps it: the index position must lie inside the
-/// file (a bag whose recording was interrupted has `index_pos = 0` and must be reindexed).
-fn check_header(path: &Path) -> Result<(), InputError> {
+/// file.
+fn check_header(path: &Path) -> Result<Layout, InputError> {
     let err = |what: String| InputError::Format {
         file: path.display().to_string(),
         message: what,
@@ -60,31 +69,31 @@ fn check_header(path: &Path) -> Result<(), InputError> {
     let header = rest
         .get(4..4 + header_len)
         .ok_or_else(|| err("truncated bag header".into()))?;
-    let mut at = 0;
-    let mut index_pos = None;
-    while let Some(field_len) = u32_at(header, at) {
-        let Some(field) = header.get(at + 4..at + 4 + field_len as usize) else {
-            break;
-        };
-        if let Some(v) = field.strip_prefix(b"index_pos=")
-            && v.len() == 8
-        {
-            index_pos = Some(u64::from_le_bytes(v.try_into().unwrap_or([0; 8])));
-        }
-        at += 4 + field_len as usize;
-    }
-    match index_pos {
-        Some(0) => Err(err(
-            "the bag has no index (index_pos = 0: its recording was interrupted); \
-             run `rosbag reindex` on it first"
-                .into(),
+    let padding = u32_at(rest, 4 + header_len).ok_or_else(|| err("truncated bag header".into()))?;
+    let chunks_start = (ROS1_MAGIC.len() + 8 + header_len) as u64 + u64::from(padding);
+    let fields = ros1_linear::fields(header).map_err(|e| err(format!("the bag header: {e}")))?;
+    let index_pos = fields
+        .iter()
+        .find(|(name, v)| *name == "index_pos" && v.len() == 8)
+        .map(|(_, v)| u64::from_le_bytes(v[..8].try_into().unwrap_or([0; 8])))
+        .ok_or_else(|| err("the bag header has no index_pos field".into()))?;
+    let index_pos = match index_pos {
+        0 => Err(
+            "the bag has no index (index_pos = 0: its recording was interrupted; \
+                   `rosbag reindex` would rebuild it)"
+                .to_owned(),
+        ),
+        p if p > len || p < chunks_start => Err(format!(
+            "the bag header puts its index at byte {p}, outside the file ({len} bytes): \
+             the file is cut short (a copy that did not finish?) or damaged"
         )),
-        Some(p) if p > len || p < (ROS1_MAGIC.len() + 4 + header_len) as u64 => Err(err(format!(
-            "the bag header's index_pos {p} is outside the file ({len} bytes): truncated copy?"
-        ))),
-        Some(_) => Ok(()),
-        None => Err(err("the bag header has no index_pos field".into())),
-    }
+        p => Ok(p),
+    };
+    Ok(Layout {
+        chunks_start,
+        file_bytes: len,
+        index_pos,
+    })
 }
 
 /// Checks a chunk record's header before the crate reads it: the record lies inside the file,
@@ -119,19 +128,12 @@ fn check_chunk(file: &mut std::fs::File, pos: u64) -> Result<(), String> {
         ));
     }
     let (mut size, mut compression) = (None, None);
-    let mut rest = &header[..];
-    while rest.len() >= 4 {
-        let field_len = u32_of(rest) as usize;
-        let Some(field) = rest.get(4..4 + field_len) else {
-            return Err("a header field runs past the header".to_owned());
-        };
-        if let Some(v) = field.strip_prefix(b"size=").filter(|v| v.len() == 4) {
-            size = Some(u64::from(u32_of(v)));
+    for (name, v) in ros1_linear::fields(&header)? {
+        match name {
+            "size" if v.len() == 4 => size = Some(u64::from(u32_of(v))),
+            "compression" => compression = Some(String::from_utf8_lossy(v).into_owned()),
+            _ => {}
         }
-        if let Some(v) = field.strip_prefix(b"compression=") {
-            compression = Some(String::from_utf8_lossy(v).into_owned());
-        }
-        rest = &rest[4 + field_len..];
     }
     let (Some(size), Some(compression)) = (size, compression) else {
         return Err("the chunk header lacks its size or compression".to_owned());
@@ -155,7 +157,14 @@ pub(super) fn read(
     collector: &mut Collector<'_, '_>,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<(), InputError> {
-    check_header(path)?;
+    let layout = check_header(path)?;
+    let start = layout.chunks_start;
+    let index_pos = match &layout.index_pos {
+        Ok(p) => *p,
+        Err(why) => {
+            return ros1_linear::read(path, start, layout.file_bytes, why, collector, progress);
+        }
+    };
     let fail = |what: String| InputError::Format {
         file: path.display().to_string(),
         message: what,
@@ -177,13 +186,15 @@ pub(super) fn read(
             }
             Ok(IndexRecord::ChunkInfo(info)) => chunk_positions.push(info.chunk_pos),
             Ok(_) => {}
-            Err(e) => return Err(fail(format!("index section: {}", words(&e)))),
+            Err(e) => {
+                let why = format!("its index section is damaged ({})", words(&e));
+                return ros1_linear::read(path, start, index_pos, &why, collector, progress);
+            }
         }
     }
     if chunk_positions.is_empty() {
-        return Err(fail(
-            "the index lists no chunks (an unindexed or empty bag; run `rosbag reindex`)".into(),
-        ));
+        let why = "its index lists no chunks (an unindexed or empty bag)".to_owned();
+        return ros1_linear::read(path, start, index_pos, &why, collector, progress);
     }
     chunk_positions.sort_unstable();
     chunk_positions.dedup();

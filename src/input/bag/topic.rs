@@ -4,12 +4,12 @@
 //! decimators, whatever the log's length.
 
 use crate::plan::bag::{
-    AxisStats, Decimator, DrawnMessage, Health, Issue, IssueCount, PoseMessage, PoseMessageKind,
-    SeriesPoint, TopicPlan, is_odom_frame,
+    Decimator, DrawnMessage, Issue, IssueCount, PoseMessage, PoseMessageKind, SeriesPoint,
+    TopicPlan, is_odom_frame,
 };
 
 use super::decode::{DecodeError, Decoded};
-use super::health;
+use super::health::TopicHealth;
 use super::{DEFAULT_MAX_DRAWN, MAX_DRAWN_LIMIT, MAX_SERIES};
 
 /// A message [`TopicState::add`] took: what an observer of every message needs.
@@ -31,15 +31,11 @@ pub(super) struct TopicState {
     out_of_order: u64,
     last_stamp: Option<i64>,
     range: Option<(i64, i64)>,
-    health: Health,
-    trend: health::Trend,
-    constancy: health::Constancy,
-    usable: u64,
-    planar: bool,
+    /// Health classes and σ statistics.
+    pub(super) checks: TopicHealth,
     drawn: Decimator<DrawnMessage>,
     trajectory: Decimator<(i64, [f64; 3])>,
     series: Decimator<SeriesPoint>,
-    sigma_stats: [Option<AxisStats>; 6],
 }
 
 impl TopicState {
@@ -53,18 +49,13 @@ impl TopicState {
             out_of_order: 0,
             last_stamp: None,
             range: None,
-            health: Health::default(),
-            trend: health::Trend::default(),
-            constancy: health::Constancy::default(),
-            usable: 0,
-            planar: true,
+            checks: TopicHealth::default(),
             drawn: match every {
                 Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
                 None => Decimator::new(1, DEFAULT_MAX_DRAWN),
             },
             trajectory: Decimator::new(1, MAX_SERIES),
             series: Decimator::new(1, MAX_SERIES),
-            sigma_stats: [None; 6],
         }
     }
 
@@ -79,7 +70,9 @@ impl TopicState {
         let d = match decoded {
             Ok(d) => d,
             Err(_) => {
-                self.health.note(Issue::Undecodable, log_time_ns, index);
+                self.checks
+                    .health
+                    .note(Issue::Undecodable, log_time_ns, index);
                 return None;
             }
         };
@@ -90,14 +83,16 @@ impl TopicState {
         let headed = self.kind != PoseMessageKind::PoseWithCovariance;
         if from_log_time && headed {
             self.from_log += 1;
-            self.health.note(Issue::StampFallback, stamp_ns, index);
+            self.checks
+                .health
+                .note(Issue::StampFallback, stamp_ns, index);
         }
         if self.last_stamp.is_some_and(|last| stamp_ns < last) {
             self.out_of_order += 1;
-            self.health.note(Issue::StampOrder, stamp_ns, index);
+            self.checks.health.note(Issue::StampOrder, stamp_ns, index);
         }
         if headed && !from_log_time && self.last_stamp == Some(stamp_ns) {
-            self.health.note(Issue::FrozenStamp, stamp_ns, index);
+            self.checks.health.note(Issue::FrozenStamp, stamp_ns, index);
         }
         self.last_stamp = Some(stamp_ns);
         self.range = Some(match self.range {
@@ -110,37 +105,12 @@ impl TopicState {
         if self.child_frame_id.is_none() && !d.child_frame_id.is_empty() {
             self.child_frame_id = Some(d.child_frame_id.clone());
         }
-        let mut h = health::classify(&d.covariance, d.orientation_xyzw);
-        if let Some(trace) = h.position_trace {
-            h.issues.extend(self.trend.next(trace));
-        }
-        for issue in &h.issues {
-            self.health.note(*issue, stamp_ns, index);
-        }
-        if h.issues.contains(&Issue::NotPsd) {
-            let lo = h.min_eigenvalue.unwrap_or(0.0);
-            self.health.min_eigenvalue = Some(self.health.min_eigenvalue.map_or(lo, |m| m.min(lo)));
-        }
+        let dead_reckoned = self.kind == PoseMessageKind::Odometry
+            && self.frame_id.as_deref().is_some_and(is_odom_frame);
+        let (h, sigma) = self.checks.add(index, stamp_ns, &d, dead_reckoned);
         let usable = h.usable();
-        if usable {
-            self.usable += 1;
-            self.planar &= h.unestimated[2] && h.unestimated[3] && h.unestimated[4];
-            let dead_reckoned = self.kind == PoseMessageKind::Odometry
-                && self.frame_id.as_deref().is_some_and(is_odom_frame);
-            self.constancy
-                .next(index, stamp_ns, &d.covariance, d.position, dead_reckoned);
-            if d.position.iter().all(|v| v.is_finite()) {
-                self.trajectory.push(index, (stamp_ns, d.position));
-            }
-        }
-        let sigma: [Option<f64>; 6] = std::array::from_fn(|i| {
-            let v = d.covariance[i * 7];
-            (usable && !h.unestimated[i]).then(|| v.max(0.0).sqrt())
-        });
-        for (stats, s) in self.sigma_stats.iter_mut().zip(sigma) {
-            if let Some(s) = s {
-                AxisStats::add(stats, s);
-            }
+        if usable && d.position.iter().all(|v| v.is_finite()) {
+            self.trajectory.push(index, (stamp_ns, d.position));
         }
         self.series.push(
             index,
@@ -178,19 +148,46 @@ impl TopicState {
         })
     }
 
+    /// A message of another type on this topic (`type_name`, logged at `log_time_ns`): not
+    /// read, counted as a [`Issue::TypeChange`] after the messages read so far.
+    pub(super) fn other_type(&mut self, type_name: &str, log_time_ns: i64) {
+        let health = &mut self.checks.health;
+        if !health.other_types.iter().any(|t| t == type_name) {
+            health.other_types.push(type_name.to_owned());
+        }
+        health.note(Issue::TypeChange, log_time_ns, self.count);
+    }
+
+    /// `count` messages of another type (`type_name`, the first logged at `first_log_ns`)
+    /// seen on this topic before it was known as a pose topic.
+    pub(super) fn other_type_before(&mut self, type_name: String, count: u64, first_log_ns: i64) {
+        if count == 0 {
+            return;
+        }
+        let health = &mut self.checks.health;
+        health.other_types.push(type_name);
+        let first = IssueCount {
+            count,
+            first_stamp_ns: first_log_ns,
+            first_index: 0,
+        };
+        health.add(Issue::TypeChange, first);
+    }
+
     pub(super) fn into_plan(self, name: String) -> TopicPlan {
         let stride = self.drawn.stride();
         let mut trajectory = self.trajectory.into_items();
         trajectory.sort_by_key(|p| p.0);
         let mut series = self.series.into_items();
         series.sort_by_key(|p| p.stamp_ns);
-        let planar = self.planar && self.usable > 0;
-        let mut health = self.health;
+        let checks = self.checks;
+        let planar = checks.planar && checks.usable > 0;
+        let mut health = checks.health;
         if !planar && let Some(on_used_axes) = health.issues.remove(&Issue::Placeholder) {
             // z, roll and pitch are axes a 3-D topic uses.
             health.add(Issue::PlaceholderUsedAxis, on_used_axes);
         }
-        if let Some(stretch) = self.constancy.finding() {
+        if let Some(stretch) = checks.constancy.finding() {
             health.add(
                 Issue::Constant,
                 IssueCount {
@@ -216,7 +213,7 @@ impl TopicState {
             stride,
             trajectory,
             series,
-            sigma_stats: self.sigma_stats,
+            sigma_stats: checks.sigma_stats,
         }
     }
 }
