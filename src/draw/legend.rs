@@ -12,10 +12,11 @@ pub(super) fn who(estimate: Estimate, label: &str) -> String {
     }
 }
 
-/// An entry.
-pub(super) fn entry(label: String, color: Color, swatch: Swatch) -> LegendEntry {
+/// An entry with what the run measured about it (`detail`, possibly empty).
+pub(super) fn entry(label: String, detail: String, color: Color, swatch: Swatch) -> LegendEntry {
     LegendEntry {
         label,
+        detail,
         color: color.with_alpha(255),
         swatch,
     }
@@ -25,6 +26,7 @@ pub(super) fn entry(label: String, color: Color, swatch: Swatch) -> LegendEntry 
 pub(super) fn axes(what: &str) -> LegendEntry {
     entry(
         format!("{what}: x red, y green, z blue"),
+        String::new(),
         Color::rgb(0, 0, 0),
         Swatch::Axes,
     )

@@ -115,11 +115,9 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
         if bananas && !rotation_only && method != Method::VectorSpace {
             let point_of = |x: &G| *x.to_se3().translation();
             if is_primary || p.layout == Layout::PerMethod {
-                p.legend(
-                    format!(
-                        "{who}: Exp-mapped {region} region{}",
-                        held(node, evaluated, &[Region::Tangent])
-                    ),
+                p.legend_with(
+                    format!("{who}: Exp-mapped {region} region"),
+                    held(node, evaluated, &[Region::Tangent]),
                     color,
                     Swatch::Region,
                 );
@@ -181,19 +179,19 @@ fn coinciding(p: &mut Painter, pose: &str, drawn: &[Drawn]) {
             continue;
         }
         let region = p.confidence().to_string();
-        let own = format!("{}{held}", cartesian_label(p, who, *method));
+        let own = cartesian_label(p, who, *method);
         let label = format!(
-            "{who}: Cartesian {region} ellipse = the vector-space one here (same matrix; drawn under it){held}"
+            "{who}: Cartesian {region} ellipse = the vector-space one here (same matrix; drawn under it)"
         );
         let color = method.color().with_alpha(255);
         match p
             .scene
             .legend
             .iter_mut()
-            .find(|e| e.label == own && e.color == color)
+            .find(|e| e.label == own && e.detail == *held && e.color == color)
         {
             Some(entry) => entry.label = label,
-            None => p.legend(label, method.color(), Swatch::Dashed),
+            None => p.legend_with(label, held.clone(), method.color(), Swatch::Dashed),
         }
         let sentence = format!(
             "**{pose}:** the vector-space ellipse ({}) coincides with the {who} Cartesian one ({}) here: same matrix, so only one line shows.\n\n",
@@ -210,7 +208,7 @@ fn coinciding(p: &mut Painter, pose: &str, drawn: &[Drawn]) {
 /// its whole Gaussian in (x, y[, z])), with the share of samples it holds (`held`).
 fn cartesian_legend(p: &mut Painter, who: String, method: Method, held: &str) {
     let label = cartesian_label(p, &who, method);
-    p.legend(format!("{label}{held}"), method.color(), Swatch::Dashed);
+    p.legend_with(label, held.to_owned(), method.color(), Swatch::Dashed);
 }
 
 /// The words of a method's Cartesian ellipse in the legend.

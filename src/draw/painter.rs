@@ -82,7 +82,19 @@ impl Painter {
 
     /// Adds a legend entry (once per label and colour).
     pub(super) fn legend(&mut self, label: String, color: Color, swatch: Swatch) {
-        self.scene.add_legend(legend::entry(label, color, swatch));
+        self.legend_with(label, String::new(), color, swatch);
+    }
+
+    /// Adds a legend entry with what the run measured about it ([`LegendEntry::detail`](crate::scene::LegendEntry::detail)).
+    pub(super) fn legend_with(
+        &mut self,
+        label: String,
+        detail: String,
+        color: Color,
+        swatch: Swatch,
+    ) {
+        self.scene
+            .add_legend(legend::entry(label, detail, color, swatch));
     }
 
     /// An item on the step timeline (static without a step).

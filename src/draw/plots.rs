@@ -6,15 +6,17 @@ use std::collections::BTreeSet;
 use crate::eval::{Evaluation, Node, Role};
 use crate::lie::LieGroup;
 use crate::plan::OpKind;
-use crate::scene::{self, Plot, ScalarSeries};
+use crate::scene::{self, Corner, Plot, ScalarSeries};
 use crate::uncertain::{Method, Region};
 
-/// A kind of plot: entity id, title (what and in which frame) and unit.
+/// A kind of plot: entity id, title (what and in which frame), unit, and the corner its legend
+/// sits in: where its lines do not go.
 #[derive(Clone, Copy, PartialEq, Eq)]
 struct PlotKind {
     id: &'static str,
     title: &'static str,
     unit: &'static str,
+    legend: Corner,
 }
 
 const TRACE_POSITION: PlotKind = PlotKind {
@@ -22,32 +24,38 @@ const TRACE_POSITION: PlotKind = PlotKind {
     // Short enough that a narrow view's title still shows the unit.
     title: "trace Σ_ρρ, body frame",
     unit: "m²",
+    legend: Corner::LeftTop,
 };
 const TRACE_ROTATION: PlotKind = PlotKind {
     id: "trace_of_rotation_covariance_rad",
     title: "trace Σ_θθ",
     unit: "rad²",
+    legend: Corner::LeftTop,
 };
 const ALONG_TRACK: PlotKind = PlotKind {
     id: "along_track_variance_x_x_left_form_m",
     title: "along-track Σ_ρxρx, world",
     unit: "m²",
+    legend: Corner::LeftTop,
 };
 const ORTHOGONALITY: PlotKind = PlotKind {
     id: "orthogonality_error_max_r_t_r_i",
     title: "max |RᵗR − I|",
     unit: "",
+    legend: Corner::LeftTop,
 };
 
 const COVERAGE: PlotKind = PlotKind {
     id: "share_of_monte_carlo_samples_inside_the_tangent_region",
     title: "samples inside the drawn region",
     unit: "",
+    legend: Corner::LeftBottom,
 };
 const ANEES: PlotKind = PlotKind {
     id: "anees_of_monte_carlo_samples",
     title: "ANEES of the samples",
     unit: "",
+    legend: Corner::LeftTop,
 };
 
 /// One line of a plot.
@@ -62,6 +70,9 @@ pub(super) struct Line {
     reference: bool,
     /// (step, value).
     pub(super) points: Vec<(i64, f64)>,
+    /// The end of its entity path when two lines share a legend label (a band's two edges:
+    /// one legend entry, two lines).
+    tail: Option<&'static str>,
 }
 
 /// Adds each method's value at `step` to its line (a new line per method).
@@ -83,6 +94,7 @@ fn add(
                 label: method.label().to_owned(),
                 reference: false,
                 points: vec![(step, value)],
+                tail: None,
             }),
         }
     }
@@ -172,15 +184,16 @@ fn along_track_lines<G: LieGroup<N>, const N: usize>(
             .filter_map(|a| Some((a.step as i64, a.variance_m2 + sign * 2.0 * a.stderr_m2?)))
             .collect()
     };
-    for (sign, label) in [(-1.0, "low"), (1.0, "high")] {
+    for (sign, edge) in [(-1.0, "low"), (1.0, "high")] {
         let points = band(sign);
         if !points.is_empty() {
             lines.push(Line {
                 kind: ALONG_TRACK,
                 method: None,
-                label: format!("Monte Carlo ± 2 standard errors, {label}"),
+                label: "Monte Carlo ± 2 standard errors".to_owned(),
                 reference: true,
                 points,
+                tail: Some(edge),
             });
         }
     }
@@ -204,12 +217,19 @@ fn consistency_lines<G: LieGroup<N>, const N: usize>(
             .estimates
             .iter()
             .filter_map(|est| Some((est.result.method, est.consistency.as_ref()?)));
-        let inside = measured.clone().filter_map(|(m, c)| {
-            let region = c
-                .region(Region::Tangent)
-                .or(c.region(Region::VectorSpace))?;
-            Some((m, region.inside))
-        });
+        let inside: Vec<(Method, f64)> = measured
+            .clone()
+            .filter_map(|(m, c)| {
+                let region = c
+                    .region(Region::Tangent)
+                    .or(c.region(Region::VectorSpace))?;
+                Some((m, region.inside))
+            })
+            .collect();
+        // The confidence claimed only beside a region that holds samples: a singular Σ (a
+        // direction with no variance, Barfoot's yaw-only noise) has no coverage, and a plot of
+        // the claim alone would show no data.
+        let covered = !inside.is_empty();
         add(lines, COVERAGE, step, inside);
         add(
             lines,
@@ -219,7 +239,7 @@ fn consistency_lines<G: LieGroup<N>, const N: usize>(
                 .clone()
                 .filter_map(|(m, c)| Some((m, c.anees?.value))),
         );
-        if let Some((_, c)) = measured.clone().next() {
+        if let Some((_, c)) = measured.clone().next().filter(|_| covered) {
             claimed.push((step, c.confidence.get()));
         }
         if let Some(a) = measured.filter_map(|(_, c)| c.anees).find(|a| a.dof == N) {
@@ -234,16 +254,18 @@ fn consistency_lines<G: LieGroup<N>, const N: usize>(
             label: "confidence p drawn".to_owned(),
             reference: true,
             points: claimed,
+            tail: None,
         });
     }
-    for (points, label) in band.into_iter().zip(["95 % band, low", "95 % band, high"]) {
+    for (points, edge) in band.into_iter().zip(["low", "high"]) {
         if !points.is_empty() {
             lines.push(Line {
                 kind: ANEES,
                 method: None,
-                label: label.to_owned(),
+                label: "95 % band of a right Σ".to_owned(),
                 reference: true,
                 points,
+                tail: Some(edge),
             });
         }
     }
@@ -270,6 +292,7 @@ fn orthogonality_lines<G: LieGroup<N>, const N: usize>(
             .iter()
             .map(|f| (f.step as i64, f.orthogonality_error))
             .collect(),
+        tail: None,
     });
     lines.push(Line {
         kind: ORTHOGONALITY,
@@ -280,6 +303,7 @@ fn orthogonality_lines<G: LieGroup<N>, const N: usize>(
             .iter()
             .map(|f| (f.step as i64, f.exp_orthogonality_error))
             .collect(),
+        tail: None,
     });
 }
 
@@ -305,8 +329,10 @@ pub(super) fn plots<G: LieGroup<N>, const N: usize>(
                 consistency_lines(e, name, &mut lines);
             }
             OpKind::Compound => {
-                trace_lines(e, name, &mut lines);
+                // The along-track variance first: Barfoot & Furgale's lesson, the plot a
+                // reader sees first.
                 lines.extend(along_track_lines(e, name));
+                trace_lines(e, name, &mut lines);
                 consistency_lines(e, name, &mut lines);
             }
             _ => orthogonality_lines(e, name, &mut lines),
@@ -323,11 +349,14 @@ pub(super) fn plots<G: LieGroup<N>, const N: usize>(
                 id
             }
         };
-        let (segment, color) = match line.method {
+        let (mut segment, color) = match line.method {
             Some(m) => (m.slug().to_owned(), m.color()),
             None if line.reference => (slug(&line.label), scene::REFERENCE),
             None => (slug(&line.label), scene::NOMINAL),
         };
+        if let Some(tail) = line.tail {
+            segment = format!("{segment}_{tail}");
+        }
         series.push(ScalarSeries {
             path: format!("{}/{id}/{segment}", scene::PLOTS),
             name: line.label,
@@ -342,10 +371,25 @@ pub(super) fn plots<G: LieGroup<N>, const N: usize>(
             id,
             title: k.title.to_owned(),
             unit: k.unit.to_owned(),
-            range: None,
+            range: fixed_range(k, N),
+            legend: k.legend,
         })
         .collect();
     (plots, series)
+}
+
+/// The value range of a plot whose quantity has one, whatever the data (so a re-run keeps its
+/// layout): a share of samples runs from 0 to 1, the claimed p near the top and the legend
+/// below; an ANEES from 0 to 3 d, a right Σ's value d a third of the way up and the legend
+/// above it. Other plots: the viewer's own fit.
+fn fixed_range(kind: PlotKind, dof: usize) -> Option<[f64; 2]> {
+    if kind == COVERAGE {
+        Some([0.0, 1.05])
+    } else if kind == ANEES {
+        Some([0.0, 3.0 * dof as f64])
+    } else {
+        None
+    }
 }
 
 /// An entity-path segment from a label: lower-case letters and digits, `_` between words.

@@ -1,5 +1,7 @@
-//! The text panel: the input's own description, then the convention, the methods and their
-//! colours, each method's error against Monte Carlo, and every finding of the evaluation.
+//! The text panel: the title, then the tables — each method's error against Monte Carlo and
+//! the samples its regions hold, the methods and their colours — and the run's along-track
+//! numbers, then the prose: the input's own description, its source, the convention, and
+//! every finding of the evaluation. Tables first, so they show at 1024 × 640.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -16,25 +18,10 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
 ) -> String {
     let about = &settings.about;
     let fill = |text: &str| words::fill(text, e, settings.confidence);
-    let mut s = format!("# {}\n\n", fill(&about.title));
-    if !about.source.is_empty() {
-        let _ = writeln!(s, "*Source: {}*\n", about.source);
-    }
-    let _ = writeln!(s, "{}", fill(about.description.trim()));
-    if let Some(g) = &e.graph {
-        s.push_str(&super::graph::describe(g));
-    }
-    s.push('\n');
-    let _ = writeln!(
-        s,
-        "**Convention:** {} with tangent order {}; covariances are read as X = μ · Exp(ε) (right / body) unless marked left. \
-         Regions are drawn at {:.1} % confidence (χ² radius {:.3} for the {}-DOF tangent ellipsoid).\n",
-        G::NAME,
-        tangent_order(G::KIND),
-        settings.confidence.get() * 100.0,
-        settings.confidence.radius(N),
-        N
-    );
+    // The title, then the tables and the run's numbers, then the prose: at 1024 × 640 the
+    // panel shows its top, so that is where the numbers go.
+    let mut s = format!("## {}\n\n", fill(&about.title));
+    let caption = errors_table(&mut s, e);
     if !e.methods.is_empty() {
         let _ = writeln!(s, "| method | colour |\n|---|---|");
         for method in &e.methods {
@@ -49,6 +36,26 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
         }
         s.push('\n');
     }
+    along_track(&mut s, e);
+    s.push_str(&caption);
+    let _ = writeln!(s, "{}", fill(about.description.trim()));
+    if let Some(g) = &e.graph {
+        s.push_str(&super::graph::describe(g));
+    }
+    s.push('\n');
+    if !about.source.is_empty() {
+        let _ = writeln!(s, "*Source: {}*\n", about.source);
+    }
+    let _ = writeln!(
+        s,
+        "**Convention:** {} with tangent order {}; covariances are read as X = μ · Exp(ε) (right / body) unless marked left. \
+         Regions are drawn at {:.1} % confidence (χ² radius {:.3} for the {}-DOF tangent ellipsoid).\n",
+        G::NAME,
+        tangent_order(G::KIND),
+        settings.confidence.get() * 100.0,
+        settings.confidence.radius(N),
+        N
+    );
     if e.methods.contains(&Method::SigmaPoints) {
         let u = &e.unscented;
         let _ = writeln!(
@@ -59,8 +66,6 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
             u.alpha, u.beta, u.kappa
         );
     }
-    errors_table(&mut s, e);
-    along_track(&mut s, e);
     for finding in &e.findings {
         let _ = writeln!(s, "{}\n", finding_text(finding));
     }
@@ -119,8 +124,9 @@ fn along_track<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G,
 
 /// Each final node's methods: their error against Monte Carlo and how many Monte Carlo
 /// samples their regions hold ([`crate::eval::consistency`]): the banana (tangent region) and
-/// the Cartesian (or vector-space) ellipse, and the ANEES against its band.
-fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G, N>) {
+/// the Cartesian (or vector-space) ellipse, and the ANEES against its band. Writes the table;
+/// returns what its columns mean, for after the tables (empty without a table).
+fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G, N>) -> String {
     let finals = final_nodes(e);
     let with_errors: Vec<_> = finals
         .iter()
@@ -131,7 +137,7 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
         })
         .collect();
     if with_errors.is_empty() {
-        return;
+        return String::new();
     }
     let measured: Vec<&Consistency> = with_errors
         .iter()
@@ -144,9 +150,11 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
             .copied()
     };
     let has_ellipse = measured.iter().any(|c| ellipse(c).is_some());
+    // The table first, what its columns mean after it.
+    let mut caption = String::new();
     let _ = write!(
-        s,
-        "**Against Monte Carlo**: the error ‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F (right side)"
+        caption,
+        "**Against Monte Carlo** (the first table): the error ‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F (right side)"
     );
     if let Some(first) = measured.first() {
         let worst = measured
@@ -163,7 +171,7 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
             )
         };
         let _ = write!(
-            s,
+            caption,
             "; the share of the {} samples inside {region}, both drawn at {:.1} % (standard error ≤ {:.1} %)",
             first.samples,
             first.confidence.get() * 100.0,
@@ -171,13 +179,13 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
         );
         if let Some(a) = measured.iter().find_map(|c| c.anees) {
             let _ = write!(
-                s,
+                caption,
                 "; and the ANEES, the samples' average εᵗΣ⁻¹ε: {} when Σ is right, 95 % band {:.2}–{:.2}",
                 a.dof, a.band[0], a.band[1]
             );
         }
     }
-    s.push_str(".\n\n");
+    caption.push_str(".\n\n");
     let mut header = "| pose | method | error |".to_owned();
     let mut rule = "|---|---|---|".to_owned();
     if !measured.is_empty() {
@@ -241,6 +249,7 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
         }
     }
     s.push('\n');
+    caption
 }
 
 /// What a finding says, in one paragraph.

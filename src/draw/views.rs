@@ -131,6 +131,7 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
     let aspect = ASPECT * rows as f64 / columns as f64;
     for view in &mut views {
         view.camera = camera(&points_of(scene, view, |_| true), plan, aspect);
+        view.grid_spacing = view.camera.as_ref().map(grid_spacing);
     }
     views
 }
@@ -154,8 +155,24 @@ pub(super) fn before_after(scene: &Scene, plan: &ViewInputs, after: &str) -> Vec
     let aspect = ASPECT / 2.0;
     for view in &mut views {
         view.camera = camera(&points_of(scene, view, |_| true), plan, aspect);
+        view.grid_spacing = view.camera.as_ref().map(grid_spacing);
     }
     views
+}
+
+/// The ground grid's spacing for a view opening with `camera`: a nice length (1, 2 or 5 ×
+/// 10ᵏ m) about a quarter of the eye's height over the grid's plane z = 0 (at least a fifth of
+/// its distance to the target, for an eye level with the plane). The viewer draws lines this
+/// far apart while the eye is less than 10^0.9 ≈ 7.9 spacings from the plane and fades in
+/// every tenth line beyond (Rerun 0.36's `world_grid.wgsl`); here the eye is 2.7–7 spacings
+/// away, so the title's spacing is the one drawn, four to eight lines across the view.
+fn grid_spacing(camera: &Camera) -> f64 {
+    let sight: f64 = (0..3)
+        .map(|i| (camera.position[i] - camera.target[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let height = camera.position[2].abs().max(0.2 * sight);
+    crate::scene::units::nice_step(height, 4)
 }
 
 /// A sentence for the text panel on what the views leave out or hide, if anything.

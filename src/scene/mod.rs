@@ -38,11 +38,12 @@
 
 mod mesh;
 mod palette;
+pub mod units;
 mod validate;
 mod view;
 
 pub use mesh::unit_sphere_mesh;
-pub use palette::{AXIS_COLORS, LINK, NOMINAL, REFERENCE};
+pub use palette::{AXIS_COLORS, LINK, NOMINAL, REFERENCE, color_name};
 pub use view::{Camera, View3d, grid_columns, rotate};
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
@@ -322,13 +323,30 @@ pub struct Plot {
     /// (a constant σ is then a flat line at its level, not lost in the viewer's ±1 default);
     /// `None`: the viewer's own fit.
     pub range: Option<[f64; 2]>,
+    /// The corner of the plot the legend sits in, chosen by the drawing stage where the lines
+    /// are not (a growing quantity leaves the upper left empty).
+    pub legend: Corner,
+}
+
+/// A corner of a plot.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Corner {
+    /// Upper left.
+    #[default]
+    LeftTop,
+    /// Upper right.
+    RightTop,
+    /// Lower left.
+    LeftBottom,
+    /// Lower right.
+    RightBottom,
 }
 
 impl Plot {
     /// The title with its unit, as a view shows it: "trace of rotation covariance (rad²)".
     ///
     /// ```
-    /// let p = posecov::scene::Plot { id: "t".into(), title: "trace".into(), unit: "m²".into(), range: None };
+    /// let p = posecov::scene::Plot { id: "t".into(), title: "trace".into(), unit: "m²".into(), range: None, legend: Default::default() };
     /// assert_eq!(p.label(), "trace (m²)");
     /// ```
     pub fn label(&self) -> String {
@@ -376,10 +394,28 @@ pub enum Swatch {
 pub struct LegendEntry {
     /// What is drawn in this colour, e.g. "first order: Exp-mapped 95 % region".
     pub label: String,
+    /// What the run measured about it, written after the label ("; holds 95.2 % of
+    /// map_from_camera's samples"), or empty. A figure's legend shows it; the viewer's compact
+    /// legend leaves it to the text panel's table.
+    pub detail: String,
     /// The colour (opaque; sinks choose their own transparency).
     pub color: Color,
     /// The mark of the swatch.
     pub swatch: Swatch,
+}
+
+impl LegendEntry {
+    /// The label followed by its detail, as a figure's legend writes it.
+    ///
+    /// ```
+    /// use posecov::scene::{Color, LegendEntry, Swatch};
+    /// let e = LegendEntry { label: "first order: 95 % ellipse".into(), detail: "; holds 70 %".into(),
+    ///     color: Color::rgb(0, 0, 0), swatch: Swatch::Line };
+    /// assert_eq!(e.text(), "first order: 95 % ellipse; holds 70 %");
+    /// ```
+    pub fn text(&self) -> String {
+        format!("{}{}", self.label, self.detail)
+    }
 }
 
 /// Everything one scenario draws.
@@ -441,7 +477,7 @@ impl Scene {
     /// ```
     /// use posecov::scene::{Color, LegendEntry, Scene, Swatch};
     /// let mut scene = Scene::new("t", "");
-    /// let entry = LegendEntry { label: "nominal path".into(), color: Color::rgb(0, 0, 255), swatch: Swatch::Line };
+    /// let entry = LegendEntry { label: "nominal path".into(), detail: String::new(), color: Color::rgb(0, 0, 255), swatch: Swatch::Line };
     /// scene.add_legend(entry.clone());
     /// scene.add_legend(entry);
     /// assert_eq!(scene.legend.len(), 1);
@@ -450,7 +486,7 @@ impl Scene {
         if !self
             .legend
             .iter()
-            .any(|e| e.label == entry.label && e.color == entry.color)
+            .any(|e| e.label == entry.label && e.detail == entry.detail && e.color == entry.color)
         {
             self.legend.push(entry);
         }

@@ -24,6 +24,33 @@ pub const LINK: Color = Color::rgb(110, 110, 110);
 /// yellow, apart from every method's colour.
 pub const REFERENCE: Color = Color::rgb(240, 228, 66);
 
+/// The name of a palette colour, whatever its alpha ("sky blue", "yellow"; the axis colours
+/// "red", "green", "blue"); `None` for a colour outside the palette.
+///
+/// ```
+/// use posecov::scene::{REFERENCE, color_name};
+/// use posecov::uncertain::Method;
+/// assert_eq!(color_name(Method::FirstOrder.color().with_alpha(90)), Some("sky blue"));
+/// assert_eq!(color_name(REFERENCE), Some("yellow"));
+/// ```
+pub fn color_name(color: Color) -> Option<&'static str> {
+    let opaque = color.with_alpha(255);
+    let named = [
+        (NOMINAL, "blue"),
+        (LINK, "dark grey"),
+        (REFERENCE, "yellow"),
+        (AXIS_COLORS[0], "red"),
+        (AXIS_COLORS[1], "green"),
+        (AXIS_COLORS[2], "blue"),
+    ];
+    Method::ALL
+        .iter()
+        .map(|m| (m.color(), m.color_name()))
+        .chain(named)
+        .find(|(c, _)| *c == opaque)
+        .map(|(_, name)| name)
+}
+
 impl Method {
     /// Every method, in legend order.
     pub const ALL: [Self; 10] = [

@@ -113,6 +113,11 @@ pub struct View3d {
     pub hidden: Vec<String>,
     /// The camera; `None` leaves the viewer's automatic framing.
     pub camera: Option<Camera>,
+    /// Metres between the lines of the ground grid (the plane z = 0) as the view opens, chosen
+    /// with the camera so the viewer draws exactly this spacing there (it shows every tenth
+    /// line only once the eye is about 80 spacings from the plane); the view says it in its
+    /// title. `None`: the viewer's own (1 scene unit).
+    pub grid_spacing: Option<f64>,
 }
 
 impl View3d {
@@ -149,6 +154,29 @@ impl View3d {
                 });
             }
         }
+        if let Some(s) = self.grid_spacing
+            && !(s.is_finite() && s > 0.0 && (s as f32).is_normal())
+        {
+            return Err(SceneError::BadCamera {
+                view: self.name.clone(),
+                reason: "the grid spacing is not a positive number (as f32)",
+            });
+        }
         self.camera.map_or(Ok(()), |c| c.check(&self.name))
+    }
+
+    /// The view's title as shown: its name and, when it has one, its grid spacing
+    /// ("3D · grid 0.5 m").
+    ///
+    /// ```
+    /// use posecov::scene::View3d;
+    /// let v = View3d { name: "3D".into(), grid_spacing: Some(0.5), ..Default::default() };
+    /// assert_eq!(v.title(), "3D · grid 0.5 m");
+    /// ```
+    pub fn title(&self) -> String {
+        match self.grid_spacing {
+            Some(s) => format!("{} · grid {}", self.name, super::units::length_label(s)),
+            None => self.name.clone(),
+        }
     }
 }

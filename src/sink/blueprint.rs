@@ -24,31 +24,44 @@ use rr::blueprint::components::{
     ContainerKind, Eye3DKind, IncludedContent, PanelState, PlayState, QueryExpression,
     RootContainer, RowShare, TimelineName, ViewClass,
 };
-use rr::components::{Name, Position3D, Range1D, Vector3D, Visible};
+use rr::components::{Name, Position3D, Vector3D, Visible};
 use rr::external::re_log_types::BlueprintActivationCommand;
 use rr::external::re_sdk_types::blueprint::archetypes::{
-    ContainerBlueprint, EntityBehavior, EyeControls3D, PanelBlueprint, ScalarAxis, TimeAxis,
-    TimePanelBlueprint, ViewBlueprint, ViewContents, ViewportBlueprint,
+    ContainerBlueprint, EntityBehavior, EyeControls3D, LineGrid3D, PanelBlueprint, PlotLegend,
+    ScalarAxis, TimeAxis, TimePanelBlueprint, ViewBlueprint, ViewContents, ViewportBlueprint,
+    VisualBounds2D,
 };
-use rr::external::re_sdk_types::blueprint::components::{ColumnShare, GridColumns, TimeRange};
-use rr::external::re_sdk_types::datatypes::{self, TimeInt, TimeRangeBoundary};
+use rr::external::re_sdk_types::blueprint::components::{
+    ColumnShare, Corner2D, GridColumns, GridSpacing, TimeRange,
+};
+use rr::external::re_sdk_types::datatypes::{self, Range1D, Range2D, TimeInt, TimeRangeBoundary};
 use rr::external::re_sdk_types::datatypes::{Float32, UInt32, Uuid};
 
+use super::legend::{DESIGN_WIDTH, LEGEND, tiles};
 use super::rerun::{STAMP_TIMELINE, STEP_TIMELINE};
 use super::{APPLICATION_ID, SinkError};
-use crate::scene::{self, Camera, Scene, View3d};
+use crate::scene::{self, Camera, Corner, Scene, View3d};
+
+/// Height of the views' area of a 1024 × 640 window (the viewer's top bar and collapsed time
+/// panel left out), in UI points: what the legend's share is reckoned against.
+const DESIGN_HEIGHT: f64 = 584.0;
+/// A view's tab and borders, in UI points.
+const VIEW_CHROME: f64 = 30.0;
 
 /// The most plots side by side in one row under the views ([`Scene::plots_below`]).
 pub const PLOTS_PER_ROW: usize = 3;
 
 /// Sends the layout of `scene` through `rec` and makes it the active and default blueprint:
-/// the 3-D views on the left (two thirds; several views in a grid, each with its camera and
-/// its hidden entities), on the right the description above one time-series view per
-/// [`Plot`](crate::scene::Plot) (its title and unit as the view's name, its value range when
-/// the scene fits one); with [`Scene::plots_below`], the plots in rows of at most
+/// the 3-D views on the left (three fifths; several views in a grid, each with its camera, its
+/// hidden entities and its ground grid's spacing in its title) above the legend view
+/// ([`super::legend`], as tall as its tiles), on the right the description above one
+/// time-series view per [`Plot`](crate::scene::Plot) (its title and unit as the view's name,
+/// its value range when the scene fits one, its legend in the plot's corner; several plots are
+/// tabs of one pane); with [`Scene::plots_below`], the plots in rows of at most
 /// [`PLOTS_PER_ROW`] under the views (a log with `--reference` adds its NEES plots, which a
 /// single row would squeeze to a fifth of the width each) and the description the whole
-/// right column (two fifths). Panels collapsed; the time panel shows the `step` timeline following the latest data, so a recording opens on its
+/// right column (two fifths), no legend view. Panels collapsed; the time
+/// panel shows the `step` timeline following the latest data, so a recording opens on its
 /// last step.
 ///
 /// # Errors
@@ -89,7 +102,7 @@ fn layout_messages(
     for view in views {
         left.push(log_view3d(&bp, &mut ids, view)?);
     }
-    let left = match left.as_slice() {
+    let mut left = match left.as_slice() {
         [one] => one.clone(),
         _ => {
             let grid = log_container(&bp, &mut ids, ContainerKind::Grid, &left, &[])?;
@@ -101,6 +114,26 @@ fn layout_messages(
             grid
         }
     };
+    if has_legend_view(scene) {
+        // The legend under the views, as tall as its tiles need at 1024 × 640.
+        let height = tiles(&scene.legend).height;
+        let legend = log_view(&bp, &mut ids, "2D", &legend_title(scene), LEGEND)?;
+        bp.log(
+            format!("{legend}/VisualBounds2D"),
+            &VisualBounds2D::new(Range2D {
+                x_range: Range1D([0.0, DESIGN_WIDTH]),
+                y_range: Range1D([0.0, height]),
+            }),
+        )?;
+        let share = (height + VIEW_CHROME).min(0.5 * DESIGN_HEIGHT);
+        left = log_container(
+            &bp,
+            &mut ids,
+            ContainerKind::Vertical,
+            &[left, legend],
+            &[(DESIGN_HEIGHT - share) as f32, share as f32],
+        )?;
+    }
     let description = log_view(
         &bp,
         &mut ids,
@@ -121,9 +154,13 @@ fn layout_messages(
         if let Some([low, high]) = plot.range {
             bp.log(
                 format!("{view}/ScalarAxis"),
-                &ScalarAxis::new().with_range(Range1D::new(low, high)),
+                &ScalarAxis::new().with_range(rr::components::Range1D::new(low, high)),
             )?;
         }
+        bp.log(
+            format!("{view}/PlotLegend"),
+            &PlotLegend::new().with_corner(corner(plot.legend)),
+        )?;
         plots.push(view);
     }
     // Ids in creation order; the root is created after its children.
@@ -155,18 +192,35 @@ fn layout_messages(
         )?;
         root
     } else {
-        let shares: Vec<f32> = std::iter::once(3.0)
-            .chain(plots.iter().map(|_| 2.0))
-            .collect();
-        let right: Vec<String> = std::iter::once(description).chain(plots).collect();
-        let right = log_container(&bp, &mut ids, ContainerKind::Vertical, &right, &shares)?;
+        // The text panel over the plots; several plots are tabs of one pane, so the one shown
+        // is tall enough for its legend to sit beside its lines.
+        let right = match plots.as_slice() {
+            [] => description,
+            [one] => log_container(
+                &bp,
+                &mut ids,
+                ContainerKind::Vertical,
+                &[description, one.clone()],
+                &[3.0, 2.0],
+            )?,
+            _ => {
+                let tabs = log_container(&bp, &mut ids, ContainerKind::Tabs, &plots, &[])?;
+                log_container(
+                    &bp,
+                    &mut ids,
+                    ContainerKind::Vertical,
+                    &[description, tabs],
+                    &[3.0, 2.0],
+                )?
+            }
+        };
         let root = ids.next();
         log_container_at(
             &bp,
             &root,
             ContainerKind::Horizontal,
             &[left, right],
-            &[2.0, 1.0],
+            &[3.0, 2.0],
         )?;
         root
     };
@@ -199,6 +253,30 @@ fn layout_messages(
         .map(|m| m.store_id().clone())
         .ok_or_else(|| SinkError::Flush("the blueprint stream produced no messages".into()))?;
     Ok((messages, BlueprintActivationCommand::make_active(store)))
+}
+
+/// Whether the layout has a legend view: a scene with a legend whose plots are not laid out
+/// under its views (a robot log's views and plots fill the window).
+pub fn has_legend_view(scene: &Scene) -> bool {
+    !scene.plots_below && !scene.legend.is_empty()
+}
+
+/// The legend view's title: what its regions hold.
+fn legend_title(scene: &Scene) -> String {
+    match scene.confidence {
+        Some(p) => format!("Legend · regions hold {p}"),
+        None => "Legend".to_owned(),
+    }
+}
+
+/// The viewer's corner.
+fn corner(c: Corner) -> Corner2D {
+    match c {
+        Corner::LeftTop => Corner2D::LeftTop,
+        Corner::RightTop => Corner2D::RightTop,
+        Corner::LeftBottom => Corner2D::LeftBottom,
+        Corner::RightBottom => Corner2D::RightBottom,
+    }
 }
 
 /// A robot log's plot shows the whole log: the time axis spans the first to the last stamp of
@@ -290,11 +368,17 @@ fn log_view3d(bp: &rr::RecordingStream, ids: &mut Ids, view: &View3d) -> Result<
     bp.log(
         path.as_str(),
         &ViewBlueprint::new(ViewClass("3D".into()))
-            .with_display_name(Name(view.name.as_str().into()))
+            .with_display_name(Name(view.title().into()))
             .with_space_origin(format!("/{}", scene::WORLD)),
     )?;
     if let Some(camera) = &view.camera {
         bp.log(format!("{path}/EyeControls3D"), &eye(camera))?;
+    }
+    if let Some(spacing) = view.grid_spacing {
+        bp.log(
+            format!("{path}/LineGrid3D"),
+            &LineGrid3D::new().with_spacing(GridSpacing(Float32(spacing as f32))),
+        )?;
     }
     for hidden in &view.hidden {
         // The viewer's own eye toggle writes here (`ViewContents::blueprint_base_visualizer_

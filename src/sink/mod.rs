@@ -3,6 +3,7 @@
 //! - [`rerun`]: scene → Rerun 0.36 archetypes (batched, one entity per item).
 //! - [`blueprint`]: the default layout, with each 3-D view's camera and hidden entities
 //!   ([`send_layout`]).
+//! - [`legend`]: the legend view's tiles, a swatch and the words per legend entry.
 //! - [`stream`]: opening a [`Sink`] (viewer, file, stdout, web viewer, memory) with
 //!   deterministic content, and finishing it cleanly ([`SinkGuard::finish`]).
 //! - [`restream`]: logging a new scene in place of the last one in the same recording (live
@@ -31,6 +32,7 @@
 
 pub mod blueprint;
 pub mod figure;
+pub mod legend;
 pub mod rerun;
 pub mod restream;
 pub mod stream;

@@ -44,7 +44,8 @@ pub fn log_scene(rec: &rr::RecordingStream, scene: &Scene) -> Result<(), SinkErr
 }
 
 /// Logs `scene` to `rec`: validates it first (so NaN never reaches the viewer), then the
-/// world's view coordinates (right-handed, z up) and the description (static), every static
+/// world's view coordinates (right-handed, z up), the description and the legend's tiles
+/// ([`super::legend`]; static), every static
 /// item, then the items of each step in ascending order, then the plot series (on a stamp
 /// timeline, a robot log's, the series come before the items). `cancel` is
 /// checked before every item: when it is raised, logging stops at a step boundary-or-item and
@@ -84,6 +85,10 @@ pub fn log_scene_cancellable(
             scene.description_markdown.as_str(),
         )],
     )?;
+    if !scene.plots_below {
+        // Every time, even empty: a new scene's legend replaces the last one's whole.
+        super::legend::log_legend(rec, &scene.legend)?;
+    }
     // A robot log's plots (on the stamp timeline) are small and what a reader looks at
     // first: they go before its items, so a viewer still loading the recording shows them.
     let series_first = scene.timeline != scene::Timeline::Step;

@@ -310,8 +310,9 @@ fn clear_all(
     Ok(())
 }
 
-/// What a layout is made of, cameras left out: the views (their names and what they show
-/// and hide), the plots (ids and titles) and the timeline. Two scenes with the same key get
+/// What a layout is made of, cameras (and the grid spacing chosen with them) left out: the
+/// views (their names and what they show and hide), the plots (ids and titles), the timeline
+/// and whether there is a legend view. Two scenes with the same key get
 /// the same layout but for the cameras.
 ///
 /// ```
@@ -331,7 +332,12 @@ pub fn layout_key(scene: &Scene) -> String {
         .iter()
         .map(|v| (&v.name, &v.include, &v.exclude, &v.hidden))
         .collect();
-    format!("{views:?} {:?} {:?}", scene.plots, scene.timeline)
+    format!(
+        "{views:?} {:?} {:?} legend view {}",
+        scene.plots,
+        scene.timeline,
+        super::blueprint::has_legend_view(scene)
+    )
 }
 
 /// `plots/<plot>/<rest>` → `plots/<plot>/g<N>/<rest>`.

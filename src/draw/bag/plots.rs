@@ -7,7 +7,7 @@ use super::super::shapes::AXIS_COLORS;
 use super::{MEANING, topic_path};
 use crate::eval::bag::BagEvaluation;
 use crate::plan::bag::ROS_AXES;
-use crate::scene::{PLOTS, Plot, ScalarSeries, Scene};
+use crate::scene::{Corner, PLOTS, Plot, ScalarSeries, Scene};
 
 /// Room above the largest value.
 const HEADROOM: f64 = 1.15;
@@ -103,6 +103,8 @@ pub(super) fn plots(scene: &mut Scene, e: &BagEvaluation) {
             title: title.into(),
             unit: unit.into(),
             range: Some([0.0, top]),
+            // Where the viewer puts it by default: these plots leave room below their lines.
+            legend: Corner::LeftBottom,
         });
         for (tail, name, color, points) in lines {
             scene.series.push(ScalarSeries {

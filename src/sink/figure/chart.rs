@@ -2,84 +2,9 @@
 
 use super::svg::{Anchor, Px, Svg, darker, num, rgb, text_width, wrap};
 use super::world::Pen;
+/// The numbers of axes and scales, shared with the drawing stage ([`crate::scene::units`]).
+pub use crate::scene::units::{length_label, nice_step, tick_label, ticks};
 use crate::scene::{AXIS_COLORS, Color, LegendEntry, ScalarSeries, Swatch};
-
-/// A "nice" step (1, 2 or 5 × 10ᵏ) giving about `count` intervals over `span`.
-///
-/// ```
-/// use posecov::sink::figure::chart::nice_step;
-/// assert_eq!(nice_step(1.0, 5), 0.2);
-/// assert_eq!(nice_step(37.0, 4), 10.0);
-/// ```
-pub fn nice_step(span: f64, count: usize) -> f64 {
-    if !(span.is_finite() && span > 0.0) {
-        return 1.0;
-    }
-    let raw = span / count.max(1) as f64;
-    let power = 10f64.powf(raw.log10().floor());
-    let m = raw / power;
-    let nice = if m < 1.5 {
-        1.0
-    } else if m < 3.5 {
-        2.0
-    } else if m < 7.5 {
-        5.0
-    } else {
-        10.0
-    };
-    nice * power
-}
-
-/// The ticks of `step` inside [lo, hi].
-pub fn ticks(lo: f64, hi: f64, step: f64) -> Vec<f64> {
-    let first = (lo / step).ceil() as i64;
-    let last = (hi / step).floor() as i64;
-    if last < first || last - first > 1000 {
-        return Vec::new();
-    }
-    (first..=last).map(|k| k as f64 * step).collect()
-}
-
-/// A tick value with as many decimals as `step` needs.
-///
-/// ```
-/// use posecov::sink::figure::chart::tick_label;
-/// assert_eq!(tick_label(0.30000000000000004, 0.1), "0.3");
-/// assert_eq!(tick_label(-0.0, 0.5), "0");
-/// assert_eq!(tick_label(2000.0, 1000.0), "2000");
-/// ```
-pub fn tick_label(v: f64, step: f64) -> String {
-    let decimals = (-step.log10().floor()).max(0.0) as usize;
-    let text = format!("{:.*}", decimals.min(9), v);
-    if text
-        .trim_start_matches('-')
-        .chars()
-        .all(|c| c == '0' || c == '.')
-    {
-        "0".to_owned()
-    } else {
-        text
-    }
-}
-
-/// A length in metres as the scale bar writes it ("0.5 m", "20 mm", "2 km").
-///
-/// ```
-/// use posecov::sink::figure::chart::length_label;
-/// assert_eq!(length_label(0.5), "0.5 m");
-/// assert_eq!(length_label(0.02), "20 mm");
-/// assert_eq!(length_label(5000.0), "5 km");
-/// ```
-pub fn length_label(metres: f64) -> String {
-    let (value, unit) = if metres < 0.1 {
-        (metres * 1000.0, "mm")
-    } else if metres >= 1000.0 {
-        (metres / 1000.0, "km")
-    } else {
-        (metres, "m")
-    };
-    format!("{} {unit}", tick_label(value, nice_step(value, 1)))
-}
 
 /// A rectangle of the figure (pixels): top-left corner and size.
 #[derive(Clone, Copy, Debug)]
@@ -271,7 +196,7 @@ pub fn legend(svg: &mut Svg, area: Rect, entries: &[LegendEntry], pen: Pen) -> f
     let mut y = area.y;
     svg.open("class=\"legend\"");
     for entry in entries {
-        let lines = wrap(&entry.label, f, area.right() - text_x);
+        let lines = wrap(&entry.text(), f, area.right() - text_x);
         let needed = 1.25 * f * lines.len() as f64 + 0.35 * f;
         if y + needed > area.bottom() {
             break;
@@ -386,11 +311,17 @@ impl PlotPanel<'_> {
             h: (area.h - 6.4 * f).max(10.0),
         };
         svg.text([area.x, area.y + f], f, Anchor::Start, "#222", &self.title);
-        // The plot's own legend, in rows above the data: a line swatch and name per series.
+        // The plot's own legend, in rows above the data: a line swatch and name per name.
         let small = 0.85 * f;
         let (mut x, mut row) = (area.x, area.y + 2.3 * f);
         svg.open("class=\"plot-legend\"");
+        let mut named: Vec<&str> = Vec::new();
         for s in &self.series {
+            // Lines that share a name (a band's two edges) share an entry, as in the viewer.
+            if named.contains(&s.name.as_str()) {
+                continue;
+            }
+            named.push(&s.name);
             let width = 1.8 * small + text_width(&s.name, small) + 1.2 * small;
             if x > area.x && x + width > area.right() {
                 (x, row) = (area.x, row + 1.3 * small);
