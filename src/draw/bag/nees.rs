@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use crate::eval::bag::BagEvaluation;
 use crate::eval::nees::{Align, TopicConsistency, Verdict};
-use crate::scene::{Color, PLOTS, Plot, REFERENCE, ScalarSeries, Scene};
+use crate::scene::{Color, Corner, PLOTS, Plot, REFERENCE, ScalarSeries, Scene};
 
 use super::topic_path;
 
@@ -72,6 +72,7 @@ pub(super) fn plots(scene: &mut Scene, e: &BagEvaluation) {
             title: format!("NEES of {name} against {} — {verdict}", c.reference),
             unit: String::new(),
             range: (top.is_finite() && top > 0.0).then_some([0.0, 1.05 * top]),
+            legend: Corner::LeftBottom,
         });
         let (first, last) = (c.series[0].0, c.series[c.series.len() - 1].0);
         let flat = |v: f64| vec![(first, v), (last, v)];
