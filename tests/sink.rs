@@ -101,8 +101,9 @@ fn memory_sink_produces_a_decodable_recording_with_every_entity() {
     }
     assert!(paths.contains(&"/world".to_owned()), "view coordinates");
     assert!(paths.contains(&"/description".to_owned()), "text panel");
-    // One chunk per item, view coordinates, description and name, plus two per series.
-    assert_eq!(chunks.len(), scene.items.len() + 3 + 2 * scene.series.len());
+    // One chunk per item, view coordinates, description and name, the legend's three
+    // entities (bars, dots, axes), plus two per series.
+    assert_eq!(chunks.len(), scene.items.len() + 6 + 2 * scene.series.len());
     // No wall clock anywhere: the only timeline is `step`.
     for chunk in &chunks {
         for name in chunk.timelines().keys() {
@@ -153,8 +154,9 @@ fn a_cancelled_recording_is_still_a_valid_prefix() {
         Some(LogOutcome::Cancelled { next_step: None })
     );
     let bytes = guard.finish(rec).expect("finish").expect("memory bytes");
-    // Name, view coordinates and description were logged before the first item.
-    assert_eq!(recording_chunks(&bytes).len(), 3);
+    // Name, view coordinates, description and the legend's three entities were logged before
+    // the first item.
+    assert_eq!(recording_chunks(&bytes).len(), 6);
 }
 
 #[test]
@@ -167,7 +169,7 @@ fn an_interrupted_save_is_a_valid_file_under_its_name() {
     assert!(matches!(outcome, Ok(LogOutcome::Cancelled { .. })));
     guard.finish(rec).expect("finish");
     let bytes = std::fs::read(&file).expect("the file exists under its final name");
-    assert_eq!(recording_chunks(&bytes).len(), 3);
+    assert_eq!(recording_chunks(&bytes).len(), 6);
     assert_verifies(&file);
     std::fs::remove_dir_all(&dir).ok();
 }
