@@ -65,6 +65,9 @@ try {
   const typed = Number(await page.locator(`input[type=number][data-id="${ID}"]`).inputValue());
   if (Math.abs(typed - after) > 1e-9) throw new Error(`typed value ${typed} does not follow the slider ${after}`);
   const generation = Number(await status.getAttribute("data-generation"));
+  // The status line as the user reads it after the change, before Save writes "saved PATH"
+  // over it (until the next poll): read here, not after Save.
+  const statusText = await status.textContent();
   // "Save" (shown with --save-scenario) writes the current scenario to that file.
   let saved = null;
   if (await page.locator("#save").isVisible()) {
@@ -82,7 +85,6 @@ try {
   // Only the methods that apply are offered (camera_on_robot: no closed form).
   const methods = await page.$$eval("input[type=checkbox][data-id^='scenario.methods.']",
     (boxes) => boxes.map((b) => b.dataset.id.replace("scenario.methods.", "")));
-  const statusText = await status.textContent();
   // A cleared field is refused with a message naming it; the last good picture stays.
   const number = page.locator(`input[type=number][data-id="${ID}"]`);
   await number.fill("");
