@@ -84,7 +84,6 @@ pub mod plan;
 pub mod propagate;
 pub mod sample;
 pub mod scene;
-#[cfg(feature = "viewer")]
 pub mod sink;
 pub mod uncertain;
 

@@ -24,7 +24,6 @@ use crate::scene::{Scene, SceneError};
 
 pub mod bag;
 pub mod commands;
-#[cfg(feature = "viewer")]
 pub mod figure;
 pub mod live;
 pub mod many;
@@ -83,7 +82,6 @@ pub enum AppError {
     #[error(transparent)]
     Sink(#[from] crate::sink::SinkError),
     /// A figure could not be written.
-    #[cfg(feature = "viewer")]
     #[error(transparent)]
     Figure(#[from] crate::sink::figure::FigureError),
     /// `--watch` was given something it cannot watch or a sink it cannot rewrite.

@@ -1,7 +1,8 @@
 //! The text panel: the title, then the tables — each method's error against Monte Carlo and
 //! the samples its regions hold, the methods and their colours — and the run's along-track
 //! numbers, then the prose: the input's own description, its source, the convention, and
-//! every finding of the evaluation. Tables first, so they show at 1024 × 640.
+//! every finding of the evaluation. Tables first, so they show at 1024 × 640, and narrow (one
+//! per pose, short cells and a key), so the panel wraps its prose to its own width.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -124,8 +125,11 @@ fn along_track<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G,
 
 /// Each final node's methods: their error against Monte Carlo and how many Monte Carlo
 /// samples their regions hold ([`crate::eval::consistency`]): the banana (tangent region) and
-/// the Cartesian (or vector-space) ellipse, and the ANEES against its band. Writes the table;
-/// returns what its columns mean, for after the tables (empty without a table).
+/// the Cartesian (or vector-space) ellipse, and the ANEES against its band. One narrow table
+/// per pose, the pose naming its first column, so the tables fit the text panel at
+/// 1024 × 640 (a pose column and a verdict column cut the ANEES off there); a verdict is one
+/// short word, said in full in the key under the tables. Writes the tables and the key;
+/// returns what their columns mean, for after the tables (empty without a table).
 fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G, N>) -> String {
     let finals = final_nodes(e);
     let with_errors: Vec<_> = finals
@@ -150,11 +154,107 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
             .copied()
     };
     let has_ellipse = measured.iter().any(|c| ellipse(c).is_some());
-    // The table first, what its columns mean after it.
+    let caption = errors_caption::<N>(&measured, G::KIND);
+    let mut header_rest = " error |".to_owned();
+    let mut rule = "|---|---|".to_owned();
+    if !measured.is_empty() {
+        header_rest.push_str(if G::KIND.is_rotation_only() {
+            " tangent |"
+        } else {
+            " banana |"
+        });
+        rule.push_str("---|");
+        if has_ellipse {
+            header_rest.push_str(" ellipse |");
+            rule.push_str("---|");
+        }
+        header_rest.push_str(" ANEES |");
+        rule.push_str("---|");
+    }
+    let percent =
+        |c: Option<Coverage>| c.map_or("–".to_owned(), |c| format!("{:.1} %", 100.0 * c.inside));
+    let (mut given, mut over, mut under) = (false, false, false);
+    for node in with_errors {
+        let label = node.step.map_or(format!("`{}`", node.name), |k| {
+            format!("`{}` (step {k})", node.name)
+        });
+        let _ = writeln!(s, "| {label} |{header_rest}\n{rule}");
+        for est in &node.estimates {
+            let c = est.consistency.as_ref();
+            if est.result.method == Method::MonteCarlo && c.is_none() {
+                continue;
+            }
+            let method = if node.role == Role::Input && est.result.method == Method::Exact {
+                given = true;
+                "given Σ (noise floor)"
+            } else {
+                est.result.method.label()
+            };
+            let error = match (est.result.method, est.error_vs_monte_carlo) {
+                (Method::MonteCarlo, _) | (_, None) => "–".to_owned(),
+                (_, Some(err)) => format!("{:.1} %", 100.0 * err),
+            };
+            let mut row = format!("| {method} | {error} |");
+            if !measured.is_empty() {
+                let _ = write!(
+                    row,
+                    " {} |",
+                    percent(c.and_then(|c| c.region(Region::Tangent).copied()))
+                );
+                if has_ellipse {
+                    let _ = write!(row, " {} |", percent(c.and_then(ellipse)));
+                }
+                let anees = c.and_then(|c| c.anees).map_or("–".to_owned(), |a| {
+                    let verdict = if a.value > a.band[1] {
+                        over = true;
+                        " **over**"
+                    } else if a.value < a.band[0] {
+                        under = true;
+                        " *under*"
+                    } else {
+                        ""
+                    };
+                    format!("{:.2}{verdict}", a.value)
+                });
+                let _ = write!(row, " {anees} |");
+            }
+            let _ = writeln!(s, "{row}");
+        }
+        s.push('\n');
+    }
+    // The key: the words the narrow cells leave out.
+    let mut key = Vec::new();
+    if given {
+        key.push(
+            "*given Σ (noise floor)*: the input's own Σ against its samples, the sampling noise floor of the errors".to_owned(),
+        );
+    }
+    if let Some(a) = measured.iter().find_map(|c| c.anees) {
+        if over {
+            key.push(format!(
+                "**over**: overconfident, the ANEES above its 95 % band {:.2}–{:.2} (Σ too small)",
+                a.band[0], a.band[1]
+            ));
+        }
+        if under {
+            key.push(format!(
+                "*under*: underconfident, the ANEES below its 95 % band {:.2}–{:.2} (Σ too large)",
+                a.band[0], a.band[1]
+            ));
+        }
+    }
+    if !key.is_empty() {
+        let _ = writeln!(s, "{}.\n", key.join("; "));
+    }
+    caption
+}
+
+/// What the columns of [`errors_table`] mean.
+fn errors_caption<const N: usize>(measured: &[&Consistency], kind: GroupKind) -> String {
     let mut caption = String::new();
     let _ = write!(
         caption,
-        "**Against Monte Carlo** (the first table): the error ‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F (right side)"
+        "**Against Monte Carlo** (the first tables): the error ‖Σ − Σ_MC‖_F / ‖Σ_MC‖_F (right side)"
     );
     if let Some(first) = measured.first() {
         let worst = measured
@@ -162,12 +262,12 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
             .flat_map(|c| &c.coverage)
             .map(|c| c.stderr)
             .fold(0.0, f64::max);
-        let region = if G::KIND.is_rotation_only() {
-            "the **tangent** region (d = {N})".replace("{N}", &N.to_string())
+        let region = if kind.is_rotation_only() {
+            format!("the **tangent** region (d = {N})")
         } else {
             format!(
                 "the **banana** (the tangent region, d = {N}) and the **ellipse** (Cartesian, k = {})",
-                G::KIND.position_dims()
+                kind.position_dims()
             )
         };
         let _ = write!(
@@ -186,69 +286,6 @@ fn errors_table<G: LieGroup<N>, const N: usize>(s: &mut String, e: &Evaluation<G
         }
     }
     caption.push_str(".\n\n");
-    let mut header = "| pose | method | error |".to_owned();
-    let mut rule = "|---|---|---|".to_owned();
-    if !measured.is_empty() {
-        header.push_str(if G::KIND.is_rotation_only() {
-            " tangent |"
-        } else {
-            " banana |"
-        });
-        rule.push_str("---|");
-        if has_ellipse {
-            header.push_str(" ellipse |");
-            rule.push_str("---|");
-        }
-        header.push_str(" ANEES |");
-        rule.push_str("---|");
-    }
-    let _ = writeln!(s, "{header}\n{rule}");
-    let percent =
-        |c: Option<Coverage>| c.map_or("–".to_owned(), |c| format!("{:.1} %", 100.0 * c.inside));
-    for node in with_errors {
-        let label = node
-            .step
-            .map_or(node.name.clone(), |k| format!("{} (step {k})", node.name));
-        for est in &node.estimates {
-            let c = est.consistency.as_ref();
-            if est.result.method == Method::MonteCarlo && c.is_none() {
-                continue;
-            }
-            let method = if node.role == Role::Input && est.result.method == Method::Exact {
-                "given Σ (sampling noise floor)"
-            } else {
-                est.result.method.label()
-            };
-            let error = match (est.result.method, est.error_vs_monte_carlo) {
-                (Method::MonteCarlo, _) | (_, None) => "–".to_owned(),
-                (_, Some(err)) => format!("{:.1} %", 100.0 * err),
-            };
-            let mut row = format!("| {label} | {method} | {error} |");
-            if !measured.is_empty() {
-                let _ = write!(
-                    row,
-                    " {} |",
-                    percent(c.and_then(|c| c.region(Region::Tangent).copied()))
-                );
-                if has_ellipse {
-                    let _ = write!(row, " {} |", percent(c.and_then(ellipse)));
-                }
-                let anees = c.and_then(|c| c.anees).map_or("–".to_owned(), |a| {
-                    let verdict = if a.value > a.band[1] {
-                        " **overconfident**"
-                    } else if a.value < a.band[0] {
-                        " *underconfident*"
-                    } else {
-                        ""
-                    };
-                    format!("{:.2}{verdict}", a.value)
-                });
-                let _ = write!(row, " {anees} |");
-            }
-            let _ = writeln!(s, "{row}");
-        }
-    }
-    s.push('\n');
     caption
 }
 

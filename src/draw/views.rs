@@ -12,20 +12,20 @@
 //! points, tilted 25° towards up so depth still reads; a scene lying flat, thin within 35° of
 //! up, from 30° off the vertical on the −y side, x to the right), rotations from the (+x, +y,
 //! +z) octant; `[draw] camera` overrides. The eye then stands at the distance at which every
-//! drawn point of the view fits the viewer's 55° field of view with a margin.
+//! drawn point of the view fits the viewer's 55° field of view with a margin, in the shape
+//! the view really has at 1024 × 640 ([`crate::scene::layout::views_aspect`]: the left column
+//! over the legend view, shared among the views).
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::input::{CameraChoice, Layout};
 use crate::scene::WORLD;
-use crate::scene::{Camera, ItemKind, Scene, SceneItem, Vec3, View3d, grid_columns, rotate};
+use crate::scene::layout::views_aspect;
+use crate::scene::{Camera, ItemKind, Scene, SceneItem, Vec3, View3d, rotate};
 use crate::uncertain::Method;
 
 /// Rerun's default vertical field of view of a 3-D view (55°).
 const FOV_Y: f64 = 55.0 * std::f64::consts::PI / 180.0;
-/// Width over height assumed for the 3-D area (two thirds of a 16:10 window); a grid of
-/// views divides it ([`grid_columns`]).
-const ASPECT: f64 = 1.15;
 /// Room left around what is drawn.
 const MARGIN: f64 = 1.2;
 /// Tilt of the top view off the vertical, so that orbiting still turns about z.
@@ -126,9 +126,9 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
     if views.is_empty() {
         views.push(whole("3D"));
     }
-    let columns = grid_columns(views.len());
-    let rows = views.len().div_ceil(columns);
-    let aspect = ASPECT * rows as f64 / columns as f64;
+    // Each view's real shape at 1024 × 640: the left column over the legend view, divided
+    // among the views.
+    let aspect = views_aspect(scene, views.len());
     for view in &mut views {
         view.camera = camera(&points_of(scene, view, |_| true), plan, aspect);
         view.grid_spacing = view.camera.as_ref().map(grid_spacing);
@@ -152,7 +152,7 @@ pub(super) fn before_after(scene: &Scene, plan: &ViewInputs, after: &str) -> Vec
             ..Default::default()
         },
     ];
-    let aspect = ASPECT / 2.0;
+    let aspect = views_aspect(scene, views.len());
     for view in &mut views {
         view.camera = camera(&points_of(scene, view, |_| true), plan, aspect);
         view.grid_spacing = view.camera.as_ref().map(grid_spacing);
@@ -401,6 +401,9 @@ fn fit(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A view's width over height (the one [`views_aspect`] gives without a legend).
+    const ASPECT: f64 = 600.0 / 554.0;
 
     fn plan(poses: &[(String, PoseMethods)], top: bool) -> ViewInputs<'_> {
         ViewInputs {

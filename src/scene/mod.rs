@@ -36,6 +36,7 @@
 //! assert!(scene.validate().is_ok());
 //! ```
 
+pub mod layout;
 mod mesh;
 mod palette;
 pub mod units;

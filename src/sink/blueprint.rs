@@ -37,16 +37,13 @@ use rr::external::re_sdk_types::blueprint::components::{
 use rr::external::re_sdk_types::datatypes::{self, Range1D, Range2D, TimeInt, TimeRangeBoundary};
 use rr::external::re_sdk_types::datatypes::{Float32, UInt32, Uuid};
 
-use super::legend::{DESIGN_WIDTH, LEGEND, tiles};
+use super::legend::LEGEND;
 use super::rerun::{STAMP_TIMELINE, STEP_TIMELINE};
 use super::{APPLICATION_ID, SinkError};
+use crate::scene::layout::{
+    DESIGN_HEIGHT, DESIGN_WIDTH, LEFT_SHARE, RIGHT_SHARE, has_legend_view, legend_share, tiles,
+};
 use crate::scene::{self, Camera, Corner, Scene, View3d};
-
-/// Height of the views' area of a 1024 × 640 window (the viewer's top bar and collapsed time
-/// panel left out), in UI points: what the legend's share is reckoned against.
-const DESIGN_HEIGHT: f64 = 584.0;
-/// A view's tab and borders, in UI points.
-const VIEW_CHROME: f64 = 30.0;
 
 /// The most plots side by side in one row under the views ([`Scene::plots_below`]).
 pub const PLOTS_PER_ROW: usize = 3;
@@ -125,7 +122,7 @@ fn layout_messages(
                 y_range: Range1D([0.0, height]),
             }),
         )?;
-        let share = (height + VIEW_CHROME).min(0.5 * DESIGN_HEIGHT);
+        let share = legend_share(height);
         left = log_container(
             &bp,
             &mut ids,
@@ -188,7 +185,7 @@ fn layout_messages(
             &root,
             ContainerKind::Horizontal,
             &[left, description],
-            &[3.0, 2.0],
+            &[LEFT_SHARE, RIGHT_SHARE],
         )?;
         root
     } else {
@@ -220,7 +217,7 @@ fn layout_messages(
             &root,
             ContainerKind::Horizontal,
             &[left, right],
-            &[3.0, 2.0],
+            &[LEFT_SHARE, RIGHT_SHARE],
         )?;
         root
     };
@@ -253,12 +250,6 @@ fn layout_messages(
         .map(|m| m.store_id().clone())
         .ok_or_else(|| SinkError::Flush("the blueprint stream produced no messages".into()))?;
     Ok((messages, BlueprintActivationCommand::make_active(store)))
-}
-
-/// Whether the layout has a legend view: a scene with a legend whose plots are not laid out
-/// under its views (a robot log's views and plots fill the window).
-pub fn has_legend_view(scene: &Scene) -> bool {
-    !scene.plots_below && !scene.legend.is_empty()
 }
 
 /// The legend view's title: what its regions hold.

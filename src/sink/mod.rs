@@ -9,7 +9,9 @@
 //! - [`restream`]: logging a new scene in place of the last one in the same recording (live
 //!   mode, `--watch`), leaving nothing stale.
 //! - [`viewer`]: finding a native `rerun` 0.36 viewer and rendering PNGs with it.
-//! - [`figure`]: static figures (SVG, PNG, PDF) drawn by posecov itself, no viewer needed.
+//! - [`figure`]: static figures (SVG, PNG, PDF) drawn by posecov itself, no viewer needed:
+//!   the only sink built without the `viewer` feature (the figure benchmark runs so, in
+//!   release).
 //!
 //! # Deterministic content
 //! For a given scene, every run writes the same *content*: the recording id is derived from
@@ -21,31 +23,44 @@
 //!
 //! # Example
 //! ```
+//! # #[cfg(feature = "viewer")] {
 //! use posecov::app::{Overrides, load, pipeline};
 //! use posecov::sink::{RecordingIds, scene_to_rrd_bytes};
 //! let loaded = load("camera_on_robot")?;
 //! let (_, scene) = pipeline(&loaded, &Overrides { samples: Some(50), ..Default::default() }, None)?;
 //! let bytes = scene_to_rrd_bytes(&scene, &RecordingIds::for_scenario("camera_on_robot", 1))?;
 //! assert!(bytes.len() > 1000);
+//! # }
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+#[cfg(feature = "viewer")]
 pub mod blueprint;
 pub mod figure;
+#[cfg(feature = "viewer")]
 pub mod legend;
+#[cfg(feature = "viewer")]
 pub mod rerun;
+#[cfg(feature = "viewer")]
 pub mod restream;
+#[cfg(feature = "viewer")]
 pub mod stream;
+#[cfg(feature = "viewer")]
 pub mod viewer;
 
 use std::path::PathBuf;
 
+#[cfg(feature = "viewer")]
 pub use self::blueprint::send_layout;
+#[cfg(feature = "viewer")]
 pub use self::rerun::{
     LogOutcome, STEP_TIMELINE, log_part_cancellable, log_scene, log_scene_cancellable,
 };
+#[cfg(feature = "viewer")]
 pub use self::restream::Restream;
+#[cfg(feature = "viewer")]
 pub use self::stream::{SinkGuard, open_stream, scene_to_rrd_bytes};
+#[cfg(feature = "viewer")]
 pub use self::viewer::{NativeViewer, find_native_viewer, render_png};
 
 /// Application id of every posecov recording (the viewer groups recordings by it).
@@ -104,6 +119,7 @@ pub enum SinkError {
     #[error("invalid scene: {0}")]
     Scene(#[from] crate::scene::SceneError),
     /// The Rerun SDK refused (bad URL, spawn failure, serialization).
+    #[cfg(feature = "viewer")]
     #[error("rerun: {0}")]
     Rerun(#[from] ::rerun::RecordingStreamError),
     /// A chunk could not be built (a bug: validation should have caught it).

@@ -336,7 +336,7 @@ pub fn layout_key(scene: &Scene) -> String {
         "{views:?} {:?} {:?} legend view {}",
         scene.plots,
         scene.timeline,
-        super::blueprint::has_legend_view(scene)
+        crate::scene::layout::has_legend_view(scene)
     )
 }
 

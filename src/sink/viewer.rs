@@ -89,7 +89,9 @@ fn wait_with_timeout(
 
 /// Renders `rrd` to `png` (`width`×`height` points; the PNG has 2 px per point) in a
 /// headless `viewer` with a fresh, private viewer state (so no earlier layout leaks in):
-/// `rerun --headless --port P IN.rrd --screenshot-to OUT.png --window-size WxH`.
+/// `rerun rrd optimize IN.rrd -o OPT.rrd`, then
+/// `rerun --headless --port P OPT.rrd --screenshot-to OUT.png --window-size WxH` (the
+/// recording compacted first, so that it loads whole before the viewer's screenshot).
 ///
 /// # Errors
 /// [`SinkError::Screenshot`] when the viewer fails, times out or writes nothing.
@@ -130,19 +132,43 @@ fn run_screenshot(
         status,
         stderr,
     };
+    // The viewer takes its screenshot ten frames after it starts, loading or not: a
+    // recording of many small chunks (posecov logs one per item and step; Barfoot's 100 steps
+    // are thousands) is still loading then, its plots empty and its time at step 75 of 100.
+    // Compacted into few large chunks (`rerun rrd optimize`, the same content) it loads whole
+    // before the screenshot, and two shots are the same picture.
+    let optimized = state.join("optimized.rrd");
+    let mut optimize = Command::new(&viewer.path);
+    optimize
+        .args(["rrd", "optimize"])
+        .arg(rrd)
+        .arg("-o")
+        .arg(&optimized);
+    run_viewer(optimize, state, "optimizing the recording").map_err(|(s, e)| fail(s, e))?;
     let port = std::net::TcpListener::bind("127.0.0.1:0")
         .and_then(|l| l.local_addr())
         .map(|a| a.port())
         .map_err(|e| fail("no free port".into(), e.to_string()))?;
-    let stderr_path = state.join("stderr.txt");
-    let stderr_file = std::fs::File::create(&stderr_path)
-        .map_err(|e| fail("cannot capture stderr".into(), e.to_string()))?;
-    let mut child = Command::new(&viewer.path)
-        .args(["--headless", "--port", &port.to_string()])
-        .arg(rrd)
+    let mut shot = Command::new(&viewer.path);
+    shot.args(["--headless", "--port", &port.to_string()])
+        .arg(&optimized)
         .arg("--screenshot-to")
         .arg(png)
-        .args(["--window-size", &format!("{width}x{height}")])
+        .args(["--window-size", &format!("{width}x{height}")]);
+    let tail = run_viewer(shot, state, "rendering").map_err(|(s, e)| fail(s, e))?;
+    if std::fs::metadata(png).map_or(true, |m| m.len() == 0) {
+        return Err(fail("exited without writing the PNG".into(), tail));
+    }
+    Ok(())
+}
+
+/// Runs `command` (the viewer binary) with the private viewer `state`, within
+/// [`SCREENSHOT_TIMEOUT`]; its stderr's tail on success, else what failed and that tail.
+fn run_viewer(mut command: Command, state: &Path, what: &str) -> Result<String, (String, String)> {
+    let stderr_path = state.join("stderr.txt");
+    let stderr_file = std::fs::File::create(&stderr_path)
+        .map_err(|e| ("cannot capture stderr".to_owned(), e.to_string()))?;
+    let mut child = command
         .env("XDG_DATA_HOME", state)
         .env("XDG_RUNTIME_DIR", state)
         // Info/warning toasts would be drawn over the picture.
@@ -151,19 +177,16 @@ fn run_screenshot(
         .stdout(Stdio::null())
         .stderr(stderr_file)
         .spawn()
-        .map_err(|e| fail("could not start".into(), e.to_string()))?;
+        .map_err(|e| (format!("{what}: could not start"), e.to_string()))?;
     let status = wait_with_timeout(&mut child, SCREENSHOT_TIMEOUT);
     let stderr = std::fs::read_to_string(&stderr_path).unwrap_or_default();
     let tail: String = stderr.lines().rev().take(8).collect::<Vec<_>>().join("\n");
     match status {
-        None => Err(fail(
-            format!("timed out after {SCREENSHOT_TIMEOUT:?}"),
+        None => Err((
+            format!("{what}: timed out after {SCREENSHOT_TIMEOUT:?}"),
             tail,
         )),
-        Some(s) if !s.success() => Err(fail(s.to_string(), tail)),
-        Some(_) if std::fs::metadata(png).map_or(true, |m| m.len() == 0) => {
-            Err(fail("exited without writing the PNG".into(), tail))
-        }
-        Some(_) => Ok(()),
+        Some(s) if !s.success() => Err((format!("{what}: {s}"), tail)),
+        Some(_) => Ok(tail),
     }
 }

@@ -1,0 +1,215 @@
+//! The viewer's default layout at its design size, a 1024 × 640 window: how much room the
+//! 3-D views and the legend view get. One place for the numbers that the blueprint gives its
+//! panes (`sink::blueprint`), the legend's tiles are laid out in (`sink::legend`) and the
+//! cameras are fitted to (`draw::views`), so each 3-D view opens framed for the shape it
+//! really has.
+//!
+//! Sizes are in UI points (one point per pixel at 1024 × 640). The window's top bar and the
+//! collapsed time panel leave [`DESIGN_HEIGHT`]; the left column (three fifths) holds the 3-D
+//! views over the legend view ([`legend_share`]), the right one the text panel over the
+//! plots.
+//!
+//! ```
+//! use posecov::scene::{Scene, layout::{DESIGN_WIDTH, views_aspect}};
+//! let scene = Scene::new("t", "d");
+//! // Without a legend one view has the whole left column: 600 × (584 − 30) points.
+//! assert!((views_aspect(&scene, 1) - DESIGN_WIDTH / 554.0).abs() < 1e-12);
+//! // Four views in a 2 × 2 grid: each a quarter, so about the same shape.
+//! assert!((views_aspect(&scene, 4) - 300.0 / 262.0).abs() < 1e-12);
+//! ```
+
+use super::{Color, LegendEntry, Scene, Swatch, color_name, grid_columns};
+
+/// The left column's width at 1024 × 640 (three fifths of the window, less the panes'
+/// borders): the 3-D views' width and the legend view's, in points.
+pub const DESIGN_WIDTH: f64 = 600.0;
+/// The height of the panes' area of a 1024 × 640 window (the viewer's top bar and collapsed
+/// time panel left out), in points.
+pub const DESIGN_HEIGHT: f64 = 584.0;
+/// A view's tab and borders, in points.
+pub const VIEW_CHROME: f64 = 30.0;
+
+/// The left column's share of the window (the text panel and plots have the rest).
+pub const LEFT_SHARE: f32 = 3.0;
+/// The right column's share of the window.
+pub const RIGHT_SHARE: f32 = 2.0;
+
+/// Width of an average character of the viewer's 13-point Inter, with room for word wraps.
+const CHAR_WIDTH: f64 = 7.2;
+/// Height of a line of label text.
+const LINE_HEIGHT: f64 = 17.0;
+/// Above the words: the bar, and the viewer's 5-point gap and 4-point label padding.
+const BAR_SPACE: f64 = 16.0;
+/// Below the words, to the next row.
+const ROW_GAP: f64 = 8.0;
+/// Space between tiles, and the words' inner padding.
+const PAD: f64 = 8.0;
+
+/// The legend view's height in the left column, tab included, for tiles `height` high
+/// ([`Tiles::height`]); 0 without tiles. At most half the column, so the 3-D views keep the
+/// other half.
+///
+/// ```
+/// use posecov::scene::layout::{DESIGN_HEIGHT, legend_share};
+/// assert_eq!(legend_share(0.0), 0.0);
+/// assert_eq!(legend_share(100.0), 130.0);
+/// assert_eq!(legend_share(1000.0), DESIGN_HEIGHT / 2.0);
+/// ```
+pub fn legend_share(height: f64) -> f64 {
+    if height <= 0.0 {
+        0.0
+    } else {
+        (height + VIEW_CHROME).min(0.5 * DESIGN_HEIGHT)
+    }
+}
+
+/// Whether the layout has a legend view: a scene with a legend whose plots are not laid out
+/// under its views (a robot log's views and plots fill the window).
+pub fn has_legend_view(scene: &Scene) -> bool {
+    !scene.plots_below && !scene.legend.is_empty()
+}
+
+/// Width over height of each of `count` 3-D views of `scene` (a grid of them,
+/// [`grid_columns`]) above its legend view, if it has one ([`has_legend_view`]), at
+/// 1024 × 640. Not for a scene with [`Scene::plots_below`], whose plots share the column.
+pub fn views_aspect(scene: &Scene, count: usize) -> f64 {
+    let columns = grid_columns(count);
+    let rows = count.max(1).div_ceil(columns);
+    let legend = if has_legend_view(scene) {
+        legend_share(tiles(&scene.legend).height)
+    } else {
+        0.0
+    };
+    let height = DESIGN_HEIGHT - legend;
+    let view_height = (height / rows as f64 - VIEW_CHROME).max(1.0);
+    DESIGN_WIDTH / columns as f64 / view_height
+}
+
+/// One legend tile: where its bar runs, and its entry.
+pub struct Tile<'a> {
+    /// The entry it shows.
+    pub entry: &'a LegendEntry,
+    /// The bar's left and right ends.
+    pub x: [f64; 2],
+    /// The bar's height in the view (down from the top).
+    pub y: f64,
+}
+
+/// The legend's tiles and the height they take, in the legend view's own units (about one
+/// point each at 1024 × 640: the view is [`DESIGN_WIDTH`] wide).
+pub struct Tiles<'a> {
+    /// The tiles, row by row.
+    pub tiles: Vec<Tile<'a>>,
+    /// The height of all rows, in the view's units.
+    pub height: f64,
+}
+
+/// The words of a tile: the label and the colour's name (an axes entry names its three
+/// colours in its label).
+///
+/// ```
+/// use posecov::scene::{Color, LegendEntry, Swatch, layout::tile_words};
+/// let e = LegendEntry { label: "nominal path".into(), detail: String::new(),
+///     color: Color::rgb(0, 114, 178), swatch: Swatch::Line };
+/// assert_eq!(tile_words(&e), "nominal path — blue");
+/// ```
+pub fn tile_words(entry: &LegendEntry) -> String {
+    match (entry.swatch, color_name(entry.color)) {
+        (Swatch::Axes, _) | (_, None) => entry.label.clone(),
+        (_, Some(name)) => format!("{} — {name}", entry.label),
+    }
+}
+
+/// Colour of the words and bar of an axes entry (its own colour is not used).
+pub const AXES_WORDS: Color = Color::rgb(210, 210, 210);
+
+/// Lines the words take in a tile `width` wide (never 0).
+fn lines(text: &str, width: f64) -> usize {
+    let per_line = ((width - 2.0 * PAD) / CHAR_WIDTH).floor().max(8.0) as usize;
+    let mut lines = 1;
+    let mut used = 0;
+    for word in text.split(' ') {
+        let n = word.chars().count();
+        if used > 0 && used + 1 + n > per_line {
+            lines += 1;
+            used = n;
+        } else {
+            used += if used > 0 { 1 + n } else { n };
+        }
+    }
+    lines
+}
+
+/// Lays the entries out in the number of columns (1–4) that takes the least height.
+///
+/// ```
+/// use posecov::scene::{Color, LegendEntry, Swatch};
+/// use posecov::scene::layout::tiles;
+/// let e = |label: &str| LegendEntry { label: label.into(), detail: String::new(),
+///     color: Color::rgb(175, 175, 175), swatch: Swatch::Dots };
+/// let entries = [e("Monte Carlo samples (4000)"), e("nominal path"), e("links")];
+/// let t = tiles(&entries);
+/// assert!(t.height > 0.0 && t.height < 60.0, "{}", t.height);
+/// assert_eq!(tiles(&[]).height, 0.0);
+/// ```
+pub fn tiles(entries: &[LegendEntry]) -> Tiles<'_> {
+    // One tile per words and mark: entries that differ only in their detail (the share of
+    // samples held by each of two outputs) read the same here.
+    let mut seen: Vec<(String, Swatch)> = Vec::new();
+    let entries: Vec<&LegendEntry> = entries
+        .iter()
+        .filter(|e| {
+            let key = (tile_words(e), e.swatch);
+            let new = !seen.contains(&key);
+            if new {
+                seen.push(key);
+            }
+            new
+        })
+        .collect();
+    let texts: Vec<String> = entries.iter().map(|e| tile_words(e)).collect();
+    let lay = |columns: usize| {
+        let width = DESIGN_WIDTH / columns as f64;
+        let mut tiles = Vec::new();
+        let mut y = 0.0;
+        for (row, chunk) in entries.chunks(columns).enumerate() {
+            let first = row * columns;
+            let most = (0..chunk.len())
+                .map(|i| lines(&texts[first + i], width))
+                .max()
+                .unwrap_or(1);
+            for (i, &entry) in chunk.iter().enumerate() {
+                let x0 = i as f64 * width + PAD;
+                tiles.push(Tile {
+                    entry,
+                    x: [x0, x0 + width - 2.0 * PAD],
+                    y: y + 4.0,
+                });
+            }
+            y += BAR_SPACE + most as f64 * LINE_HEIGHT + ROW_GAP;
+        }
+        Tiles { tiles, height: y }
+    };
+    (1..=4)
+        .rev()
+        .map(lay)
+        .reduce(|best, t| if t.height < best.height { t } else { best })
+        .unwrap_or(Tiles {
+            tiles: Vec::new(),
+            height: 0.0,
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::lines;
+
+    #[test]
+    fn words_wrap_at_the_tile_width() {
+        assert_eq!(lines("short", 200.0), 1);
+        // 200 − 16 = 184 units: 25 characters a line.
+        let long = "first order: Exp-mapped 95 % region — sky blue";
+        assert_eq!(lines(long, 200.0), 2);
+        assert_eq!(lines(long, 600.0), 1);
+    }
+}
