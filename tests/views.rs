@@ -32,8 +32,8 @@ fn positions(kind: &ItemKind) -> Vec<[f64; 3]> {
     }
 }
 
-/// Every drawn point of `view` lies inside its camera's 55° field of view (at the aspect of a
-/// quarter of a 1024×640 window, the narrowest cell a scenario's grid gives).
+/// Every drawn point of `view` lies inside its camera's 55° field of view, at the view's shape
+/// in a 1024 × 640 window (its cell of the left column, above the legend view).
 fn assert_in_view(name: &str, scene: &Scene, view: &View3d) {
     let camera = view
         .camera
@@ -43,9 +43,7 @@ fn assert_in_view(name: &str, scene: &Scene, view: &View3d) {
     let right = forward.cross(&Vector3::from(camera.up)).normalize();
     let up = right.cross(&forward);
     let tan_y = (55.0f64.to_radians() / 2.0).tan();
-    let columns = posecov::scene::grid_columns(scene.views.len());
-    let rows = scene.views.len().div_ceil(columns);
-    let tan_x = tan_y * 1.15 * rows as f64 / columns as f64;
+    let tan_x = tan_y * posecov::scene::layout::views_aspect(scene, scene.views.len());
     let mut count = 0;
     for item in scene.items.iter().filter(|i| view.shows(&i.path)) {
         for p in positions(&item.kind) {
