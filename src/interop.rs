@@ -34,8 +34,8 @@ use crate::uncertain::{Side, UncertainPose, validate_covariance};
 
 mod ros;
 pub use ros::{
-    ROS_COVARIANCE_LEN, RosPoseWithCovariance, RosReading, ros_cov_from_right, ros_cov_to_right,
-    ros_error_jacobian,
+    ROS_COVARIANCE_LEN, RosPoseWithCovariance, RosReading, ros_cov_from_right, ros_cov_moved,
+    ros_cov_to_right, ros_error_jacobian,
 };
 
 // --------------------------------------------------------------------------------------------

@@ -12,6 +12,7 @@
 
 use std::sync::atomic::AtomicBool;
 
+mod frames;
 mod nees;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -305,6 +306,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 "ros_reading": run.evaluation.reading,
                 "ros_readings_apart": e.reading_difference,
                 "consistency": e.consistency.as_ref().map(nees::consistency_json),
+                "frame_join": frames::join_json(e),
             })
         })
         .collect();
@@ -325,6 +327,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
             "cut_short": plan.cut,
         },
         "topics": topics,
+        "frames": frames::frames_json(&plan.tf, &run.evaluation),
         "skipped": plan.skipped,
         "not_selected": plan.not_selected,
     })
@@ -401,6 +404,9 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
             cut.reason, cut.chunks_read, cut.at_byte, cut.file_bytes
         ));
     }
+    let tf_defects = frames::tf_defects(&file, &run.evaluation);
+    let log_defects = usize::from(plan.cut.is_some()) + tf_defects.len();
+    defects.extend(tf_defects);
     let facts = format!(
         "{} messages, {} drawn items{}",
         plan.messages_total,
@@ -415,12 +421,16 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
     } else {
         format!(
             "{name}: defects on {} of {} pose topic(s){} ({facts}; the first of each on stderr)",
-            defects.len() - usize::from(plan.cut.is_some()),
+            defects.len() - log_defects,
             plan.topics.len(),
-            if plan.cut.is_some() {
-                ", the log stops early"
-            } else {
-                ""
+            match (
+                plan.cut.is_some(),
+                log_defects > usize::from(plan.cut.is_some())
+            ) {
+                (true, false) => ", the log stops early",
+                (false, true) => ", its /tf is broken",
+                (true, true) => ", the log stops early, its /tf is broken",
+                (false, false) => "",
             }
         )
     };

@@ -16,7 +16,8 @@
 //!   drawn message with its 95 % bound and ANEES band (`bag/nees.rs`).
 //!
 //! Views: one whole-log view per frame (`header.frame_id`: topics in different frames are
-//! never overlaid as if they were one), and one robot view per topic.
+//! never overlaid as if they were one — unless the log's `/tf` joins them, then they share
+//! the common frame's view, `eval::frames`, said in the panel), and one robot view per topic.
 //!
 //! All regions at the chosen confidence: χ²(d) with d = 2 / 3 (planar position, pose) or
 //! 3 / 6 (3-D), and d = 2 for RViz's discs, 1 for its yaw fan.
@@ -34,6 +35,7 @@ use crate::scene::{
 };
 use crate::uncertain::{Confidence, Method};
 
+mod frames;
 mod message;
 mod nees;
 mod plots;
@@ -41,6 +43,7 @@ mod robot;
 mod rviz;
 mod text;
 
+pub use frames::frame_problem_sentence;
 pub use nees::verdict_word;
 pub use text::{description, issue_sentence, issue_word};
 
@@ -192,8 +195,19 @@ fn log_views(scene: &Scene, e: &BagEvaluation, planar: bool) -> Vec<View3d> {
     };
     let mut out = Vec::new();
     for (frame, topics) in by_frame(e) {
+        let joined: Vec<String> = topics
+            .iter()
+            .filter_map(|t| {
+                let j = t.joined.as_ref()?;
+                Some(format!("{} joined from {} by /tf", t.name, j.from))
+            })
+            .collect();
         let mut view = View3d {
-            name: format!("frame {frame}: the whole log"),
+            name: if joined.is_empty() {
+                format!("frame {frame}: the whole log")
+            } else {
+                format!("frame {frame}: the whole log · {}", joined.join(", "))
+            },
             include: topics.iter().map(|t| topic_entity(&t.name)).collect(),
             exclude: topics
                 .iter()

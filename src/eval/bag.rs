@@ -23,7 +23,10 @@ use crate::interop::{RosReading, ros_cov_to_right};
 use crate::lie::{Se2, Se3, So2, So3};
 use serde::Serialize;
 
-use crate::plan::bag::{AxisStats, Issue, LogSummary, SeriesPoint, TopicPlan};
+use super::frames::{
+    FrameFindings, FrameJoin, FrameProblem, FrameProblemKind, join_plan, move_topic,
+};
+use crate::plan::bag::{AxisStats, DrawnMessage, Issue, LogSummary, SeriesPoint, TopicPlan};
 use crate::sample::{Sampler, chunk_rng};
 use crate::uncertain::{Side, UncertainPose};
 
@@ -109,7 +112,8 @@ pub struct PoseEvaluation {
     /// RViz's numbers (`None` when the covariance is not finite).
     pub rviz: Option<RvizNumbers>,
     /// σ = √Σᵢᵢ per ROS axis (x, y, z in the parent's axes, m; roll, pitch, yaw, rad) where
-    /// the axis is estimated: finite, neither a placeholder (≥ 1e6) nor zero.
+    /// the axis is estimated: finite, neither a placeholder (≥ 1e6) nor zero. As published: in
+    /// the topic's own frame's axes, also when it is drawn joined to another frame.
     pub sigma: [Option<f64>; 6],
 }
 
@@ -202,6 +206,9 @@ pub struct TopicEvaluation {
     /// NEES against the reference (`--reference`), streamed over every message
     /// ([`crate::eval::nees`]); `None` without a reference, or for the reference topic itself.
     pub consistency: Option<crate::eval::nees::TopicConsistency>,
+    /// Drawn in another frame than its own, joined through the log's `/tf`
+    /// ([`crate::eval::frames`]): `frame_id` is then the common frame.
+    pub joined: Option<FrameJoin>,
 }
 
 /// A log's numbers.
@@ -211,6 +218,8 @@ pub struct BagEvaluation {
     pub topics: Vec<TopicEvaluation>,
     /// The ROS reading every covariance was read in.
     pub reading: RosReading,
+    /// What kept topics in different frames apart ([`crate::eval::frames`]).
+    pub frames: FrameFindings,
 }
 
 impl BagEvaluation {
@@ -232,14 +241,63 @@ impl BagEvaluation {
 ///
 /// See the [module docs](self) for an example.
 pub fn evaluate_bag(plan: &LogSummary, settings: &BagEvalSettings) -> BagEvaluation {
+    let named: Vec<(&str, &str, Option<i64>)> = plan
+        .topics
+        .iter()
+        .map(|t| {
+            (
+                t.name.as_str(),
+                t.frame_id.as_str(),
+                t.stamp_range.map(|r| r.0),
+            )
+        })
+        .collect();
+    let joins = join_plan(&plan.tf, &named);
+    let mut problems = joins.problems;
+    let topics = plan
+        .topics
+        .iter()
+        .zip(joins.chains)
+        .enumerate()
+        .map(|(k, (t, chain))| {
+            let moved = chain.map(|c| move_topic(&plan.tf, &c, t, settings.reading));
+            match moved {
+                Some(Ok((moved, join))) => {
+                    let mut e = evaluate_topic(k as u64, &moved, settings);
+                    // σ per axis as published, in the topic's own frame's axes (as its plots,
+                    // report and check give them).
+                    for p in &mut e.poses {
+                        if let Some(d) = t.drawn.iter().find(|d| d.index == p.index) {
+                            p.sigma = message_sigma(d);
+                        }
+                    }
+                    TopicEvaluation {
+                        joined: Some(join),
+                        ..e
+                    }
+                }
+                Some(Err(stamp)) => {
+                    problems.push(FrameProblem {
+                        kind: FrameProblemKind::TiltsPlane,
+                        frames: vec![t.frame_id.clone()],
+                        roots: Vec::new(),
+                        topics: vec![t.name.clone()],
+                        source: "/tf".to_owned(),
+                        stamp_ns: Some(stamp),
+                    });
+                    evaluate_topic(k as u64, t, settings)
+                }
+                None => evaluate_topic(k as u64, t, settings),
+            }
+        })
+        .collect();
     BagEvaluation {
-        topics: plan
-            .topics
-            .iter()
-            .enumerate()
-            .map(|(k, t)| evaluate_topic(k as u64, t, settings))
-            .collect(),
+        topics,
         reading: settings.reading,
+        frames: FrameFindings {
+            has_tf: !plan.tf.edges.is_empty(),
+            problems,
+        },
     }
 }
 
@@ -289,10 +347,7 @@ fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) ->
                     },
                 },
             };
-            let sigma = std::array::from_fn(|i| {
-                let v = m.covariance[i * 7];
-                (v.is_finite() && v >= 0.0 && !d.unestimated[i]).then(|| v.sqrt())
-            });
+            let sigma = message_sigma(d);
             PoseEvaluation {
                 index: d.index,
                 stamp_ns: m.stamp_ns,
@@ -317,7 +372,16 @@ fn evaluate_topic(family: u64, topic: &TopicPlan, settings: &BagEvalSettings) ->
             sigma_summary(topic.sigma_stats[axis], &topic.series, axis)
         }),
         consistency: None,
+        joined: None,
     }
+}
+
+/// σ = √Σᵢᵢ per ROS axis of a message where the axis is estimated.
+fn message_sigma(d: &DrawnMessage) -> [Option<f64>; 6] {
+    std::array::from_fn(|i| {
+        let v = d.message.covariance[i * 7];
+        (v.is_finite() && v >= 0.0 && !d.unestimated[i]).then(|| v.sqrt())
+    })
 }
 
 /// The right-form Gaussian of a usable message. Planar: the unestimated z / roll / pitch rows

@@ -42,6 +42,7 @@ mod blocked;
 pub mod consistency;
 mod engine;
 mod findings;
+pub mod frames;
 pub mod graph;
 pub mod groups;
 mod model;
@@ -49,6 +50,7 @@ pub mod nees;
 mod ops;
 mod propagations;
 mod reports;
+pub mod stamped;
 
 pub use consistency::{Anees, Consistency, CoverageSummary};
 pub use model::{

@@ -50,6 +50,7 @@ use super::bag::{PoseState, meaning};
 mod math;
 mod model;
 use super::consistency::{ANEES_BAND_PROBABILITY, Anees};
+use super::stamped::{Lookup, StampedPoses, pose_of_sample};
 use crate::interop::RosReading;
 use crate::lie::{LieGroup, Se2, Se3, So3};
 use crate::plan::bag::{
@@ -129,8 +130,8 @@ struct TopicState {
 /// See the [module docs](self) for an example.
 pub struct NeesObserver {
     settings: NeesSettings,
-    /// (stamp, parent_from_child), in stamp order.
-    reference: Vec<(i64, Se3)>,
+    /// parent_from_child at its stamps (the one home of a pose at a stamp).
+    reference: StampedPoses,
     reference_frame: Option<String>,
     complete: bool,
     topics: BTreeMap<String, TopicState>,
@@ -141,7 +142,7 @@ impl NeesObserver {
     pub fn new(settings: NeesSettings) -> Self {
         Self {
             settings,
-            reference: Vec::new(),
+            reference: StampedPoses::default(),
             reference_frame: None,
             complete: false,
             topics: BTreeMap::new(),
@@ -174,37 +175,18 @@ impl NeesObserver {
 
     /// The stamps the reference spans (ns), if any sample.
     pub fn reference_span(&self) -> Option<(i64, i64)> {
-        Some((self.reference.first()?.0, self.reference.last()?.0))
+        self.reference.span()
     }
 
     /// The truth at `stamp_ns`: interpolated between the bracketing samples, never
     /// extrapolated.
     fn truth(&self, stamp_ns: i64) -> Truth {
-        let (Some(first), Some(last)) = (self.reference.first(), self.reference.last()) else {
-            return if self.complete {
-                Truth::After
-            } else {
-                Truth::Pending
-            };
-        };
-        if stamp_ns < first.0 {
-            return Truth::Before;
+        match self.reference.at(stamp_ns) {
+            Lookup::At(x) => Truth::At(x),
+            Lookup::Before if !self.reference.is_empty() => Truth::Before,
+            _ if self.complete => Truth::After,
+            _ => Truth::Pending,
         }
-        if stamp_ns > last.0 {
-            return if self.complete {
-                Truth::After
-            } else {
-                Truth::Pending
-            };
-        }
-        let i = self.reference.partition_point(|(t, _)| *t < stamp_ns);
-        let (tb, xb) = self.reference[i];
-        if tb == stamp_ns || i == 0 {
-            return Truth::At(xb);
-        }
-        let (ta, xa) = self.reference[i - 1];
-        let s = (stamp_ns - ta) as f64 / (tb - ta) as f64;
-        Truth::At(xa.interpolate(&xb, s))
     }
 
     /// Ends the stream: waiting estimates are after the reference; with `se3` alignment the
@@ -318,12 +300,9 @@ impl NeesObserver {
 
 impl LogObserver for NeesObserver {
     fn reference(&mut self, frame_id: &str, sample: ReferenceSample) {
-        let Ok(rotation) = So3::try_from_quaternion_xyzw(sample.orientation_xyzw) else {
+        let Some(x) = pose_of_sample(&sample) else {
             return;
         };
-        if sample.position.iter().any(|v| !v.is_finite()) {
-            return;
-        }
         let frame = frame_id.trim_start_matches('/');
         match &self.reference_frame {
             None => self.reference_frame = Some(frame.to_owned()),
@@ -331,20 +310,7 @@ impl LogObserver for NeesObserver {
             Some(f) if self.settings.tf_parent_required && f != frame => return,
             Some(_) => {}
         }
-        let x = Se3::from_parts(sample.position.into(), rotation);
-        let t = sample.stamp_ns;
-        match self.reference.last() {
-            Some((last, _)) if *last < t => self.reference.push((t, x)),
-            None => self.reference.push((t, x)),
-            _ => {
-                let i = self.reference.partition_point(|(s, _)| *s < t);
-                if self.reference.get(i).is_some_and(|(s, _)| *s == t) {
-                    self.reference[i] = (t, x);
-                } else {
-                    self.reference.insert(i, (t, x));
-                }
-            }
-        }
+        self.reference.insert(sample.stamp_ns, x);
         self.flush();
     }
 

@@ -153,6 +153,33 @@ pub fn ros_cov_from_right(
     b * cov_right * b.transpose()
 }
 
+/// A ROS covariance moved with its pose by a known transform T = parent_from_child (frames
+/// joined through `/tf`, [CONVENTIONS §6]): the message's pose X becomes T · X, and its error
+/// [δp; δφ] becomes B_T [δp; δφ] with B_T = [`ros_error_jacobian`] of T's rotation R_T, so
+/// **Σ' = B_T Σ B_T^T** — blkdiag(R_T, R_T) in tf2's reading (both blocks in the parent's axes:
+/// T · (Exp(δφ) R, p + δp) = (Exp(R_T δφ) R_T R, R_T p + t + R_T δp), exactly), blkdiag(R_T, I₃)
+/// in the body reading (the rotation error is local and does not move). This is what
+/// `tf2_geometry_msgs`' `doTransform` applies to a `PoseWithCovarianceStamped`. In posecov's
+/// right form nothing changes: T · X̂ · Exp(ξ) = (T X̂) · Exp(ξ), and B of R_T R is B_T B.
+///
+/// ```
+/// use posecov::{interop::{RosReading, ros_cov_moved, ros_cov_to_right}, lie::{LieGroup, So3}};
+/// use nalgebra::{Matrix6, Vector6};
+/// let r = So3::from_rpy(0.0, 0.0, 0.4); // the pose's rotation
+/// let r_t = So3::from_rpy(0.1, 0.0, 1.2); // map_from_odom's rotation
+/// let ros = Matrix6::from_diagonal(&Vector6::new(0.04, 0.01, 0.02, 0.003, 0.002, 0.001));
+/// let moved = ros_cov_moved(&ros, &r_t, RosReading::Tf2);
+/// let before = ros_cov_to_right(&ros, &r, RosReading::Tf2);
+/// let after = ros_cov_to_right(&moved, &r_t.compose(&r), RosReading::Tf2);
+/// assert!((before - after).norm() < 1e-15); // the right form does not move
+/// ```
+///
+/// [CONVENTIONS §6]: crate::conventions#6-ros-posewithcovariance
+pub fn ros_cov_moved(cov_ros: &Matrix6<f64>, rotation: &So3, reading: RosReading) -> Matrix6<f64> {
+    // The same map as a right-form covariance at R_T read out: B_T Σ B_Tᵀ.
+    ros_cov_from_right(cov_ros, rotation, reading)
+}
+
 impl RosPoseWithCovariance {
     /// The message as a right-form uncertain pose in `reading`: Σ_right = B⁻¹ Σ_ros B⁻ᵀ with
     /// B = [`ros_error_jacobian`] (first order: the ROS position error is additive, posecov's

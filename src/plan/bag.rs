@@ -23,6 +23,8 @@ pub use decimate::Decimator;
 pub use reference::{EstimateMessage, LogObserver, ReferenceInLog, ReferenceRead, ReferenceSample};
 mod cut;
 pub use cut::LogCut;
+mod tf;
+pub use tf::{MAX_TF_EDGES, MAX_TF_SAMPLES, TfEdge, TfTree};
 
 /// A variance at or above this is a placeholder ("not estimated"), not a measurement.
 pub const PLACEHOLDER: f64 = 1e6;
@@ -538,4 +540,7 @@ pub struct LogSummary {
     /// The read stopped at a cut or a damage before the file's end: everything before was
     /// read.
     pub cut: Option<LogCut>,
+    /// The log's `/tf` and `/tf_static` transforms, bounded ([`TfTree`]): what joins topics
+    /// in different frames (`eval::frames`).
+    pub tf: TfTree,
 }

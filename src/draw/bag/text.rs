@@ -171,14 +171,20 @@ pub fn description(
                 }
             })
             .collect();
+        let why = if e.frames.has_tf {
+            "the log's /tf does not join them, see below"
+        } else {
+            "the log has no /tf or /tf_static to join them"
+        };
         let _ = writeln!(
             s,
             "\n**{} frames** ({}): one whole-log view each — topics in different frames are \
-             never overlaid as if they were one (no `/tf` transform is applied).",
+             never overlaid as if they were one ({why}).",
             frames.len(),
             names.join(", ")
         );
     }
+    s.push_str(&super::frames::frames_paragraph(e));
     if plan.cancelled {
         let _ = writeln!(
             s,
@@ -199,7 +205,13 @@ pub fn description(
     if !plan.skipped.is_empty() {
         let _ = writeln!(s, "\n---\n\n**Skipped** (other message types):\n");
         for k in &plan.skipped {
-            let _ = writeln!(s, "- `{}`: {} × {}", k.name, k.count, k.message_type);
+            let joined = e.topics.iter().any(|t| t.joined.is_some());
+            let tf = if joined && ["/tf", "/tf_static"].contains(&k.name.as_str()) {
+                " (its transforms read to join frames, above)"
+            } else {
+                ""
+            };
+            let _ = writeln!(s, "- `{}`: {} × {}{tf}", k.name, k.count, k.message_type);
         }
     }
     if !plan.not_selected.is_empty() {

@@ -4,9 +4,9 @@
 //! [`LogSummary`] — every message's health is counted, a decimated set of messages is kept for
 //! drawing, and time series are kept at a bounded length (halving their density when full).
 //!
-//! Messages read: `nav_msgs/Odometry`, `geometry_msgs/PoseWithCovarianceStamped` and
-//! `geometry_msgs/PoseWithCovariance`; other types are listed as skipped. Stamps are the
-//! header stamp, or the log time when the header's is zero or missing (counted and said).
+//! Messages read: `nav_msgs/Odometry`, `geometry_msgs/PoseWithCovarianceStamped`,
+//! `geometry_msgs/PoseWithCovariance`, and `/tf` + `/tf_static` kept per edge (`tf.rs`); other
+//! types are listed as skipped. Stamps are the header stamp, or the log time when it is zero.
 //!
 //! ```
 //! use posecov::input::bag::{BagOptions, read_bag};
@@ -37,6 +37,7 @@ mod mcap_records;
 pub mod reference;
 mod ros1;
 mod ros1_linear;
+mod tf;
 mod topic;
 
 use decode::{DecodeError, Decoded};
@@ -240,6 +241,7 @@ struct Collector<'a, 'o> {
     reference: Option<ReferenceRead>,
     /// Where a read without an index stopped before the file's end.
     cut: Option<LogCut>,
+    tf: tf::TfCollector,
 }
 
 impl<'a, 'o> Collector<'a, 'o> {
@@ -259,6 +261,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             observer,
             reference: options.reference.as_ref().map(|_| ReferenceRead::default()),
             cut: None,
+            tf: tf::TfCollector::default(),
         }
     }
 
@@ -361,9 +364,7 @@ impl<'a, 'o> Collector<'a, 'o> {
                     self.topics.insert(topic.to_owned(), state);
                 }
             }
-            Some(Ok(_)) => {
-                self.not_selected.insert(topic.to_owned(), ());
-            }
+            Some(Ok(_)) => _ = self.not_selected.insert(topic.to_owned(), ()),
             other => {
                 if !self.skipped.contains_key(topic) {
                     let label = match other {
@@ -400,6 +401,7 @@ impl<'a, 'o> Collector<'a, 'o> {
         if self.is_reference(&stream.topic) {
             self.reference_message(stream, log_ns, bytes, codec);
         }
+        self.tf.message(stream, log_ns, bytes, codec);
         let kind = stream.kind.as_ref();
         self.message(&stream.topic, &stream.type_name, kind, log_ns, bytes, codec);
         Ok(())
@@ -438,9 +440,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             }
         };
         if !self.selected(topic) {
-            if !self.not_selected.contains_key(topic) {
-                self.not_selected.insert(topic.to_owned(), ());
-            }
+            self.not_selected.insert(topic.to_owned(), ());
             return;
         }
         let every = self.options.every;
@@ -531,6 +531,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             cancelled: self.cancelled,
             reference: self.reference,
             cut: self.cut,
+            tf: self.tf.finish(),
         })
     }
 }
