@@ -270,10 +270,7 @@ fn amcl_map_to_odom_joins_the_odometry_to_the_map() {
         .map(|v| v.name.as_str())
         .filter(|n| n.starts_with("frame "))
         .collect();
-    assert_eq!(
-        whole,
-        ["frame map: the whole log · /odom joined from odom by /tf"]
-    );
+    assert_eq!(whole, ["frame map (+ /tf: /odom from odom): the whole log"]);
     let text = &run.scene.description_markdown;
     assert!(
         text.contains(

@@ -199,14 +199,17 @@ fn log_views(scene: &Scene, e: &BagEvaluation, planar: bool) -> Vec<View3d> {
             .iter()
             .filter_map(|t| {
                 let j = t.joined.as_ref()?;
-                Some(format!("{} joined from {} by /tf", t.name, j.from))
+                Some(format!("{} from {}", t.name, j.from))
             })
             .collect();
         let mut view = View3d {
             name: if joined.is_empty() {
                 format!("frame {frame}: the whole log")
             } else {
-                format!("frame {frame}: the whole log · {}", joined.join(", "))
+                format!(
+                    "frame {frame} (+ /tf: {}): the whole log",
+                    joined.join(", ")
+                )
             },
             include: topics.iter().map(|t| topic_entity(&t.name)).collect(),
             exclude: topics
