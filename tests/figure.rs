@@ -103,7 +103,7 @@ fn camera_on_robot_has_its_legend_scale_and_regions() {
         "g.scale-bar",
         "path.ellipse",
         "g.region",
-        "circle.cloud",
+        "path.cloud",
         "text: Monte Carlo samples (500)",
         "text: given (input): Exp-mapped 95 % region",
         "text: vector space (SSC): 95 % ellipse",

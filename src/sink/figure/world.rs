@@ -1,7 +1,8 @@
 //! The world panel: a scene's 3-D items projected orthographically on a coordinate plane,
 //! with equal scales on both axes so lengths and shapes read true.
 //!
-//! - Point clouds: one dot per sample (at most [`MAX_DOTS`], evenly strided).
+//! - Point clouds: one dot per sample (at most [`MAX_DOTS`], evenly strided), each cloud one
+//!   path of circles.
 //! - Ellipsoids: their exact shadow on the plane, the ellipse of the projected shape matrix
 //!   P R diag(h)² Rᵀ Pᵀ (P the plane's two rows), dashed.
 //! - Surfaces (Exp-mapped bananas): the union of their projected triangles, filled, with a
@@ -230,11 +231,15 @@ pub fn draw_clouds(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mappin
         let radius = (cloud.radius * m.scale).clamp(0.6 * pen.unit, 1.6 * pen.unit);
         let alpha = (f64::from(cloud.color.0[3]) / 255.0).min(0.7);
         let color = on_white(darker(cloud.color, 0.25), alpha);
-        svg.open(&format!("class=\"cloud\" fill=\"{}\"", rgb(color)));
-        for p in cloud.positions.iter().step_by(stride) {
-            svg.circle(m.px(plane.project(*p)), radius);
-        }
-        svg.close();
+        svg.dots(
+            cloud
+                .positions
+                .iter()
+                .step_by(stride)
+                .map(|p| m.px(plane.project(*p))),
+            radius,
+            &format!("class=\"cloud\" fill=\"{}\"", rgb(color)),
+        );
     }
 }
 
