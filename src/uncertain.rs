@@ -306,8 +306,13 @@ pub fn try_inverse_covariance<const N: usize>(
     what: &'static str,
     cov: &TangentMatrix<N>,
 ) -> Result<TangentMatrix<N>> {
-    let sym = validate_covariance(what, cov)?;
-    let eigen = SymmetricEigen::new(DMatrix::from_iterator(N, N, sym.iter().copied()));
+    // The decomposition that validated ½(Σ + Σᵀ) is the one inverted (one, not two).
+    let (sym, eigen) = validate::validated_eigen(
+        what,
+        &DMatrix::from_iterator(N, N, cov.iter().copied()),
+        true,
+    )?;
+    let eigen = eigen.unwrap_or_else(|| SymmetricEigen::new(sym));
     let (min_eigenvalue, max_eigenvalue) = (eigen.eigenvalues.min(), eigen.eigenvalues.max());
     if max_eigenvalue <= 0.0 || min_eigenvalue <= SINGULAR_TOLERANCE * max_eigenvalue {
         return Err(Error::SingularCovariance {

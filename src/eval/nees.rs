@@ -121,6 +121,9 @@ struct TopicState {
     sums: Sums,
     skipped: Skipped,
     series: Decimator<(u64, i64, f64)>,
+    /// χ²_d(0.95) for the topic's d, computed once (an inverse CDF per message was a tenth
+    /// of a long log's NEES time).
+    bound: Option<(usize, f64)>,
 }
 
 /// The streamed NEES of a log's estimate topics against a reference: give it to the log's
@@ -265,6 +268,9 @@ impl NeesObserver {
 
     /// Estimates of every topic that the reference now covers.
     fn flush(&mut self) {
+        if self.topics.values().all(|t| t.pending.is_empty()) {
+            return;
+        }
         let waiting: Vec<String> = self
             .topics
             .iter()
@@ -334,6 +340,7 @@ impl LogObserver for NeesObserver {
                     Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
                     None => Decimator::new(1, DEFAULT_MAX_DRAWN),
                 },
+                bound: None,
             });
         let Some(gaussian) = gaussian_of(m, self.settings.reading) else {
             state.skipped.unusable += 1;
@@ -409,7 +416,14 @@ fn add_nees(state: &mut TopicState, w: &Waiting, truth: &Se3) {
         return;
     };
     let d = w.gaussian.dof();
-    let bound = chi2_radius(MESSAGE_BOUND_PROBABILITY, d).map_or(f64::INFINITY, |r| r * r);
+    let bound = match state.bound {
+        Some((dof, bound)) if dof == d => bound,
+        _ => {
+            let bound = chi2_radius(MESSAGE_BOUND_PROBABILITY, d).map_or(f64::INFINITY, |r| r * r);
+            state.bound = Some((d, bound));
+            bound
+        }
+    };
     let s = &mut state.sums;
     s.messages += 1;
     s.joint += joint;

@@ -1,7 +1,7 @@
 //! Validation of covariances: finite, symmetric and positive semi-definite within the one
 //! pair of tolerances every stage uses (files, evaluation, the health of robot logs).
 
-use nalgebra::{DMatrix, SymmetricEigen};
+use nalgebra::{DMatrix, Dyn, SymmetricEigen};
 
 use crate::error::{Error, Result, check_finite};
 use crate::lie::TangentMatrix;
@@ -71,6 +71,23 @@ pub fn validate_covariance<const N: usize>(
 /// assert!(validate_covariance_dyn("joint", &DMatrix::<f64>::identity(4, 3)).is_err()); // not square
 /// ```
 pub fn validate_covariance_dyn(what: &'static str, cov: &DMatrix<f64>) -> Result<DMatrix<f64>> {
+    validated_eigen(what, cov, false).map(|(sym, _)| sym)
+}
+
+/// ½(Σ + Σᵀ) and, when asked for, its eigen-decomposition.
+pub(super) type Validated = (DMatrix<f64>, Option<SymmetricEigen<f64, Dyn>>);
+
+/// [`validate_covariance_dyn`]; with `vectors`, also handing back the eigen-decomposition of
+/// ½(Σ + Σᵀ) that decided positive semi-definiteness (`None` for a 0 × 0 matrix, or without
+/// `vectors`), so that [`try_inverse_covariance`](super::try_inverse_covariance) inverts
+/// through it instead of decomposing the same matrix again. Without `vectors` only the
+/// eigenvalues are computed (the same values: nalgebra's QR sweeps do not depend on the
+/// eigenvectors they accumulate).
+pub(super) fn validated_eigen(
+    what: &'static str,
+    cov: &DMatrix<f64>,
+    vectors: bool,
+) -> Result<Validated> {
     let (n, cols) = cov.shape();
     if n != cols {
         return Err(Error::WrongShape {
@@ -106,9 +123,14 @@ pub fn validate_covariance_dyn(what: &'static str, cov: &DMatrix<f64>) -> Result
     }
     let sym = (cov + cov.transpose()) * 0.5;
     if n == 0 {
-        return Ok(sym);
+        return Ok((sym, None));
     }
-    let eigenvalues = SymmetricEigen::new(sym.clone()).eigenvalues;
+    let (eigenvalues, eigen) = if vectors {
+        let eigen = SymmetricEigen::new(sym.clone());
+        (eigen.eigenvalues.clone(), Some(eigen))
+    } else {
+        (sym.symmetric_eigenvalues(), None)
+    };
     let min_eigenvalue = eigenvalues.min();
     let tolerance = psd_tolerance(eigenvalues.max());
     if min_eigenvalue < -tolerance {
@@ -118,5 +140,5 @@ pub fn validate_covariance_dyn(what: &'static str, cov: &DMatrix<f64>) -> Result
             tolerance,
         });
     }
-    Ok(sym)
+    Ok((sym, eigen))
 }

@@ -50,6 +50,9 @@ pub(super) fn read(
             .with_emit_chunks(true),
     );
     let mut streams = Streams::default();
+    // One buffer for every chunk's records, decompressed (its capacity kept from chunk to
+    // chunk: no allocation, copy or fresh pages per chunk).
+    let mut chunk = Vec::new();
     let mut done = 0u64;
     let mut last_report = 0u64;
     while let Some(event) = reader.next_event() {
@@ -70,8 +73,8 @@ pub(super) fn read(
                 let at = |e: String| fail(format!("record 0x{opcode:02x} near byte {done}: {e}"));
                 let flow = match parse(opcode, data).map_err(at)? {
                     McapRecord::Chunk { header, records } => {
-                        let records = decompress(&header, records).map_err(at)?;
-                        chunk_records(&records, |opcode, body| {
+                        let records = decompress(&header, records, &mut chunk).map_err(at)?;
+                        chunk_records(records, |opcode, body| {
                             let inner = parse(opcode, body)
                                 .map_err(|e| format!("record 0x{opcode:02x} in this chunk: {e}"))?;
                             streams.take(inner, collector)
@@ -190,9 +193,14 @@ impl Streams {
     }
 }
 
-/// A chunk's records, decompressed: exactly the `uncompressed_size` its header gives (at most
+/// A chunk's records, decompressed into `out` (its contents replaced; an uncompressed chunk is
+/// its own records, not copied): exactly the `uncompressed_size` its header gives (at most
 /// [`RECORD_LIMIT`]), read through a limit of that size, so a falsified header ends here.
-fn decompress(header: &ChunkHeader, compressed: &[u8]) -> Result<Vec<u8>, String> {
+fn decompress<'a>(
+    header: &ChunkHeader,
+    compressed: &'a [u8],
+    out: &'a mut Vec<u8>,
+) -> Result<&'a [u8], String> {
     let size = usize::try_from(header.uncompressed_size)
         .ok()
         .filter(|&s| s <= RECORD_LIMIT)
@@ -205,15 +213,12 @@ fn decompress(header: &ChunkHeader, compressed: &[u8]) -> Result<Vec<u8>, String
         })?;
     // One byte more than expected is read, to tell "too long" from "exactly right".
     let bound = header.uncompressed_size.saturating_add(1);
-    let mut out = Vec::new();
+    out.clear();
     let read = match header.compression.as_str() {
-        "" => {
-            out.extend_from_slice(compressed);
-            Ok(compressed.len())
-        }
+        "" => Ok(0),
         "zstd" => zstd::stream::read::Decoder::new(compressed)
-            .and_then(|d| d.take(bound).read_to_end(&mut out)),
-        "lz4" => lz4::Decoder::new(compressed).and_then(|d| d.take(bound).read_to_end(&mut out)),
+            .and_then(|d| d.take(bound).read_to_end(out)),
+        "lz4" => lz4::Decoder::new(compressed).and_then(|d| d.take(bound).read_to_end(out)),
         other => {
             return Err(format!(
                 "chunk compression {other:?}: posecov reads zstd, lz4 or none"
@@ -221,14 +226,19 @@ fn decompress(header: &ChunkHeader, compressed: &[u8]) -> Result<Vec<u8>, String
         }
     };
     read.map_err(|e| format!("the {} chunk does not decompress: {e}", header.compression))?;
-    if out.len() != size {
+    let records: &[u8] = if header.compression.is_empty() {
+        compressed
+    } else {
+        out
+    };
+    if records.len() != size {
         return Err(format!(
             "the chunk decompresses to {}{} bytes, its header says {size}",
-            out.len().min(size.saturating_add(1)),
-            if out.len() > size { " or more" } else { "" },
+            records.len().min(size.saturating_add(1)),
+            if records.len() > size { " or more" } else { "" },
         ));
     }
-    Ok(out)
+    Ok(records)
 }
 
 /// Calls `take` with each record (opcode, body) of a decompressed chunk, in order; every
@@ -279,16 +289,22 @@ mod tests {
     fn a_falsified_uncompressed_size_is_refused_at_once() {
         let records = [0x0f, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0];
         let zstd = zstd::bulk::compress(&records, 3).unwrap();
-        let good = decompress(&header("zstd", zstd.len(), records.len() as u64), &zstd).unwrap();
+        let mut out = Vec::new();
+        let good = decompress(
+            &header("zstd", zstd.len(), records.len() as u64),
+            &zstd,
+            &mut out,
+        )
+        .unwrap();
         assert_eq!(good, records);
         for wrong in [0, 5, records.len() as u64 + 1, 1 << 29, u64::MAX] {
-            let e = decompress(&header("zstd", zstd.len(), wrong), &zstd).unwrap_err();
+            let e = decompress(&header("zstd", zstd.len(), wrong), &zstd, &mut out).unwrap_err();
             assert!(
                 e.contains("header says") || e.contains("larger than"),
                 "{wrong}: {e}"
             );
         }
-        let e = decompress(&header("bz2", 3, 3), b"abc").unwrap_err();
+        let e = decompress(&header("bz2", 3, 3), b"abc", &mut out).unwrap_err();
         assert!(e.contains("\"bz2\""), "{e}");
     }
 
