@@ -8,6 +8,9 @@ use super::decode::Decoded;
 use crate::plan::bag::{AxisStats, COV_LEN, Health, Issue, Stretch};
 use crate::uncertain::{psd_tolerance, symmetry_tolerance};
 
+mod issues;
+pub use issues::Issues;
+
 pub use crate::plan::bag::PLACEHOLDER;
 /// A drop: the position trace divided by at least this from one usable message to the next.
 pub const DROP_FACTOR: f64 = 5.0;
@@ -24,7 +27,7 @@ const PLANAR_AXES: [usize; 3] = [0, 1, 5];
 #[derive(Debug, Clone, PartialEq)]
 pub struct MessageHealth {
     /// The issues of this message alone (drops and growth come from [`Trend`]).
-    pub issues: Vec<Issue>,
+    pub issues: Issues,
     /// Axes whose variance is ≥ [`PLACEHOLDER`] or exactly 0, per ROS axis.
     pub unestimated: [bool; 6],
     /// Smallest eigenvalue of the estimated block, computed when it is finite, symmetric and
@@ -81,11 +84,44 @@ fn positive_definite(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
 /// assert_eq!(h.unestimated, [false, false, true, true, true, false]);
 /// ```
 pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHealth {
-    let mut issues = Vec::new();
+    with_orientation(orientation_xyzw, classify_covariance(cov), cov)
+}
+
+/// The message's health from its orientation and its covariance's classification
+/// ([`classify_covariance`]): a bad orientation first, then the covariance's issues, and the
+/// position trace if the message is usable.
+fn with_orientation(
+    orientation_xyzw: [f64; 4],
+    covariance: MessageHealth,
+    cov: &[f64; COV_LEN],
+) -> MessageHealth {
+    let mut issues = Issues::default();
     let norm = orientation_xyzw.iter().map(|q| q * q).sum::<f64>().sqrt();
     if !norm.is_finite() || (norm - 1.0).abs() > 1e-3 {
         issues.push(Issue::BadOrientation);
     }
+    issues.extend(covariance.issues.iter().copied());
+    let health = MessageHealth {
+        issues,
+        ..covariance
+    };
+    let unestimated = health.unestimated;
+    let position_trace = health.usable().then(|| {
+        (0..3)
+            .filter(|&i| !unestimated[i])
+            .map(|i| cov[i * 7])
+            .sum::<f64>()
+    });
+    MessageHealth {
+        position_trace,
+        ..health
+    }
+}
+
+/// What the covariance alone says (no orientation, no position trace): a function of its 36
+/// entries, so a topic whose covariance repeats classifies it once ([`TopicHealth::add`]).
+fn classify_covariance(cov: &[f64; COV_LEN]) -> MessageHealth {
+    let mut issues = Issues::default();
     let diag: [f64; 6] = std::array::from_fn(|i| cov[i * 7]);
     let mut unestimated = diag.map(|v| v == 0.0 || v >= PLACEHOLDER);
     if cov.iter().any(|v| !v.is_finite()) {
@@ -126,8 +162,10 @@ pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHeal
     // The symmetry and PSD rules are evaluation's (`uncertain`): what health calls PSD,
     // evaluation accepts.
     let tol = symmetry_tolerance(scale);
-    let asymmetric = kept.iter().any(|&i| {
-        kept.iter()
+    // Each pair once (|Σᵢⱼ − Σⱼᵢ| is the same from either side; every entry is finite here).
+    let asymmetric = kept.iter().enumerate().any(|(a, &i)| {
+        kept[a + 1..]
+            .iter()
             .any(|&j| (cov[i * 6 + j] - cov[j * 6 + i]).abs() > tol)
     });
     let mut min_eigenvalue = None;
@@ -155,21 +193,11 @@ pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHeal
             issues.push(Issue::NotPsd);
         }
     }
-    let health = MessageHealth {
+    MessageHealth {
         issues,
         unestimated,
         min_eigenvalue,
         position_trace: None,
-    };
-    let position_trace = health.usable().then(|| {
-        (0..3)
-            .filter(|&i| !unestimated[i])
-            .map(|i| diag[i])
-            .sum::<f64>()
-    });
-    MessageHealth {
-        position_trace,
-        ..health
     }
 }
 
@@ -193,8 +221,8 @@ impl Trend {
     /// assert!(t.next(5.0).is_empty());
     /// assert_eq!(t.next(10.0), vec![Issue::Growth]);
     /// ```
-    pub fn next(&mut self, trace: f64) -> Vec<Issue> {
-        let mut out = Vec::new();
+    pub fn next(&mut self, trace: f64) -> Issues {
+        let mut out = Issues::default();
         if trace <= 0.0 {
             return out;
         }
@@ -252,9 +280,16 @@ impl Constancy {
             .map(|i| cov[i * 7])
             .filter(|v| *v < PLACEHOLDER)
             .sum();
-        let continues = self
+        // `==` on every entry (as arrays compare), without an early exit: in vectors.
+        let same = self
             .previous
-            .is_some_and(|(c, t, _)| c == *cov || (dead_reckoned && trace <= t));
+            .as_ref()
+            .is_some_and(|(c, ..)| c.iter().zip(cov).fold(true, |same, (x, y)| same & (x == y)));
+        let continues = same
+            || self
+                .previous
+                .as_ref()
+                .is_some_and(|(_, t, _)| dead_reckoned && trace <= *t);
         let step = match self.previous {
             Some((_, _, p)) => {
                 let d = (0..3)
@@ -282,7 +317,14 @@ impl Constancy {
                 });
             }
         }
-        self.previous = Some((*cov, trace, position));
+        match &mut self.previous {
+            // The same entries: only the trace and position move on (no 36-entry copy).
+            Some((_, t, p)) if same => {
+                *t = trace;
+                *p = position;
+            }
+            _ => self.previous = Some((*cov, trace, position)),
+        }
     }
 
     fn close(&mut self) {
@@ -328,6 +370,8 @@ pub struct TopicHealth {
     pub health: Health,
     pub(super) trend: Trend,
     pub(super) constancy: Constancy,
+    /// The last message's covariance and its classification ([`classify_covariance`]).
+    previous: Option<([f64; COV_LEN], MessageHealth)>,
     /// Usable messages (drawable as a Gaussian).
     pub usable: u64,
     /// Every usable message so far has placeholders on z, roll and pitch.
@@ -342,11 +386,21 @@ impl Default for TopicHealth {
             health: Health::default(),
             trend: Trend::default(),
             constancy: Constancy::default(),
+            previous: None,
             usable: 0,
             planar: true,
             sigma_stats: [None; 6],
         }
     }
+}
+
+/// Whether two covariances have the same bits in every entry (then every check gives the same
+/// answer, NaN and −0 included).
+fn same_bits(a: &[f64; COV_LEN], b: &[f64; COV_LEN]) -> bool {
+    // Every entry compared, without an early exit: the compiler compares them in vectors.
+    a.iter()
+        .zip(b)
+        .fold(true, |same, (x, y)| same & (x.to_bits() == y.to_bits()))
 }
 
 impl TopicHealth {
@@ -359,9 +413,18 @@ impl TopicHealth {
         d: &Decoded,
         dead_reckoned: bool,
     ) -> (MessageHealth, [Option<f64>; 6]) {
-        let mut h = classify(&d.covariance, d.orientation_xyzw);
+        let covariance = match &self.previous {
+            // The same 36 entries as the message before: the same classification.
+            Some((cov, h)) if same_bits(cov, &d.covariance) => h.clone(),
+            _ => {
+                let h = classify_covariance(&d.covariance);
+                self.previous = Some((d.covariance, h.clone()));
+                h
+            }
+        };
+        let mut h = with_orientation(d.orientation_xyzw, covariance, &d.covariance);
         if let Some(trace) = h.position_trace {
-            h.issues.extend(self.trend.next(trace));
+            h.issues.extend(self.trend.next(trace).iter().copied());
         }
         for issue in &h.issues {
             self.health.note(*issue, stamp_ns, index);
