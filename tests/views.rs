@@ -199,3 +199,23 @@ fn the_blueprint_carries_each_camera_and_each_hidden_entity() {
     b.sort();
     assert_eq!(a, b);
 }
+
+/// Every bundled scenario's legend tiles fit their view at 1024 × 640 unscaled: a legend
+/// taller than its view is scaled down, its words keep their size and overlap.
+#[test]
+fn legends_fit_their_view() {
+    use posecov::scene::layout::{VIEW_CHROME, has_legend_view, legend_share, tiles};
+    for bundled in BUNDLED {
+        let scene = scene_of(bundled.name);
+        if !has_legend_view(&scene) {
+            continue;
+        }
+        let height = tiles(&scene.legend).height;
+        assert!(
+            height + VIEW_CHROME <= legend_share(height),
+            "{}: the legend needs {height:.0} points, its view has {:.0}",
+            bundled.name,
+            legend_share(height) - VIEW_CHROME
+        );
+    }
+}

@@ -45,21 +45,25 @@ const ROW_GAP: f64 = 8.0;
 /// Space between tiles, and the words' inner padding.
 const PAD: f64 = 8.0;
 
+/// The most of the left column the legend view takes: the 3-D views keep the rest.
+pub const LEGEND_MOST: f64 = 0.6;
+
 /// The legend view's height in the left column, tab included, for tiles `height` high
-/// ([`Tiles::height`]); 0 without tiles. At most half the column, so the 3-D views keep the
-/// other half.
+/// ([`Tiles::height`]); 0 without tiles. At most [`LEGEND_MOST`] of the column, so the 3-D
+/// views keep the rest; tiles taller than that are scaled down to fit and their words
+/// (which keep their size) can overlap, which no bundled scenario's legend needs.
 ///
 /// ```
-/// use posecov::scene::layout::{DESIGN_HEIGHT, legend_share};
+/// use posecov::scene::layout::{DESIGN_HEIGHT, LEGEND_MOST, legend_share};
 /// assert_eq!(legend_share(0.0), 0.0);
 /// assert_eq!(legend_share(100.0), 130.0);
-/// assert_eq!(legend_share(1000.0), DESIGN_HEIGHT / 2.0);
+/// assert_eq!(legend_share(1000.0), LEGEND_MOST * DESIGN_HEIGHT);
 /// ```
 pub fn legend_share(height: f64) -> f64 {
     if height <= 0.0 {
         0.0
     } else {
-        (height + VIEW_CHROME).min(0.5 * DESIGN_HEIGHT)
+        (height + VIEW_CHROME).min(LEGEND_MOST * DESIGN_HEIGHT)
     }
 }
 
@@ -85,10 +89,13 @@ pub fn views_aspect(scene: &Scene, count: usize) -> f64 {
     DESIGN_WIDTH / columns as f64 / view_height
 }
 
-/// One legend tile: where its bar runs, and its entry.
+/// One legend tile: where its bar runs, its entry and its words.
 pub struct Tile<'a> {
-    /// The entry it shows.
+    /// The entry it shows (its colour and mark; the first of those it stands for).
     pub entry: &'a LegendEntry,
+    /// Its words: [`tile_words`] of the entry, with the methods of the entries it stands for
+    /// joined ("given (input), first order, exact: Exp-mapped 95 % region — sky blue").
+    pub words: String,
     /// The bar's left and right ends.
     pub x: [f64; 2],
     /// The bar's height in the view (down from the top).
@@ -140,48 +147,91 @@ fn lines(text: &str, width: f64) -> usize {
     lines
 }
 
-/// Lays the entries out in the number of columns (1–4) that takes the least height.
+/// The entries as tiles' words: an entry whose words, mark and colour equal an earlier one's
+/// is left out (entries that differ only in their detail, the share of samples held by each
+/// of two outputs, read the same here), and entries that differ only in the method before
+/// their label's first ": " share one tile naming the methods (each view's title names the
+/// method it draws). Axes entries, whose labels name what carries the axes, are never joined.
+fn grouped(entries: &[LegendEntry]) -> Vec<(&LegendEntry, String)> {
+    // (first entry, its methods, the label after the methods or the whole words)
+    let mut groups: Vec<(&LegendEntry, Vec<&str>, &str)> = Vec::new();
+    for e in entries {
+        let split = match e.swatch {
+            Swatch::Axes => None,
+            _ => e.label.split_once(": "),
+        };
+        let (method, rest) = split.unwrap_or(("", e.label.as_str()));
+        let same = |g: &&mut (&LegendEntry, Vec<&str>, &str)| {
+            g.2 == rest
+                && g.0.swatch == e.swatch
+                && g.0.color == e.color
+                && g.1.is_empty() == method.is_empty()
+        };
+        match groups.iter_mut().find(same) {
+            Some(g) => {
+                if !g.1.contains(&method) {
+                    g.1.push(method);
+                }
+            }
+            None => groups.push((
+                e,
+                if method.is_empty() {
+                    Vec::new()
+                } else {
+                    vec![method]
+                },
+                rest,
+            )),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(e, methods, rest)| {
+            let label = if methods.is_empty() {
+                rest.to_string()
+            } else {
+                format!("{}: {rest}", methods.join(", "))
+            };
+            let joined = LegendEntry { label, ..e.clone() };
+            (e, tile_words(&joined))
+        })
+        .collect()
+}
+
+/// Lays the entries out in the number of columns (1–4) that takes the least height, one tile
+/// per distinct words: entries that differ only in the method before their label's first
+/// ": " share a tile naming the methods.
 ///
 /// ```
 /// use posecov::scene::{Color, LegendEntry, Swatch};
 /// use posecov::scene::layout::tiles;
 /// let e = |label: &str| LegendEntry { label: label.into(), detail: String::new(),
 ///     color: Color::rgb(175, 175, 175), swatch: Swatch::Dots };
-/// let entries = [e("Monte Carlo samples (4000)"), e("nominal path"), e("links")];
+/// let entries = [e("Monte Carlo samples (4000)"), e("nominal path"), e("links"),
+///     e("first order: region"), e("exact: region")];
 /// let t = tiles(&entries);
-/// assert!(t.height > 0.0 && t.height < 60.0, "{}", t.height);
+/// assert!(t.height > 0.0 && t.height < 100.0, "{}", t.height);
+/// assert_eq!(t.tiles.len(), 4);
+/// assert_eq!(t.tiles[3].words, "first order, exact: region — grey");
 /// assert_eq!(tiles(&[]).height, 0.0);
 /// ```
 pub fn tiles(entries: &[LegendEntry]) -> Tiles<'_> {
-    // One tile per words and mark: entries that differ only in their detail (the share of
-    // samples held by each of two outputs) read the same here.
-    let mut seen: Vec<(String, Swatch)> = Vec::new();
-    let entries: Vec<&LegendEntry> = entries
-        .iter()
-        .filter(|e| {
-            let key = (tile_words(e), e.swatch);
-            let new = !seen.contains(&key);
-            if new {
-                seen.push(key);
-            }
-            new
-        })
-        .collect();
-    let texts: Vec<String> = entries.iter().map(|e| tile_words(e)).collect();
+    let grouped = grouped(entries);
     let lay = |columns: usize| {
         let width = DESIGN_WIDTH / columns as f64;
         let mut tiles = Vec::new();
         let mut y = 0.0;
-        for (row, chunk) in entries.chunks(columns).enumerate() {
-            let first = row * columns;
-            let most = (0..chunk.len())
-                .map(|i| lines(&texts[first + i], width))
+        for chunk in grouped.chunks(columns) {
+            let most = chunk
+                .iter()
+                .map(|(_, words)| lines(words, width))
                 .max()
                 .unwrap_or(1);
-            for (i, &entry) in chunk.iter().enumerate() {
+            for (i, (entry, words)) in chunk.iter().enumerate() {
                 let x0 = i as f64 * width + PAD;
                 tiles.push(Tile {
                     entry,
+                    words: words.clone(),
                     x: [x0, x0 + width - 2.0 * PAD],
                     y: y + 4.0,
                 });

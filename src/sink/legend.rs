@@ -1,7 +1,7 @@
 //! The viewer's legend: a small 2-D view under the 3-D views with one tile per
-//! [`LegendEntry`] of the scene — a bar in the entry's colour (thick for a region, thin for a
-//! line, with dots for a cloud, red, green and blue strokes for axes) and under it the words in
-//! that colour, wrapped to the tile, the colour named ("first order: Exp-mapped 95 % region —
+//! [`LegendEntry`] of the scene (entries that differ only in their method share one tile) — a
+//! bar in the entry's colour (thick for a region, thin for a line, with dots for a cloud, red,
+//! green and blue strokes for axes) and under it the words in that colour, wrapped to the tile, the colour named ("first order: Exp-mapped 95 % region —
 //! sky blue"). What the run measured about an entry ([`LegendEntry::detail`]) stays in the text
 //! panel's table: the tiles must fit at 1024 × 640.
 //!
@@ -15,7 +15,7 @@ use ::rerun as rr;
 
 use super::SinkError;
 use super::rerun::send;
-use crate::scene::layout::{AXES_WORDS, tile_words, tiles};
+use crate::scene::layout::{AXES_WORDS, tiles};
 use crate::scene::{AXIS_COLORS, Color, LegendEntry, Swatch};
 
 /// Entity of the legend's tiles (static; shown by the legend view only).
@@ -45,7 +45,7 @@ pub fn log_legend(rec: &rr::RecordingStream, entries: &[LegendEntry]) -> Result<
         bars.1.push([x1 - x0, height]);
         bars.2.push(rerun_color(color));
         bars.3.push(radius);
-        bars.4.push(tile_words(e));
+        bars.4.push(tile.words.clone());
         match e.swatch {
             Swatch::Dots => {
                 for k in 0..5 {
