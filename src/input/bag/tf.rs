@@ -16,7 +16,9 @@ pub(super) const TF_TOPICS: [&str; 2] = ["/tf", "/tf_static"];
 pub(super) struct TfCollector {
     /// Per edge: the edge, its kept `/tf` samples and its `/tf` transforms read.
     edges: Vec<(TfEdge, Decimator<ReferenceSample>, u64)>,
-    by_name: HashMap<(String, String), usize>,
+    /// Parent → child → index in `edges`: looked up by `&str`, so a transform of a known edge
+    /// (every `/tf` message after the first) allocates nothing.
+    by_name: HashMap<String, HashMap<String, usize>>,
     undecodable: Vec<(String, u64, i64)>,
 }
 
@@ -52,15 +54,21 @@ impl TfCollector {
             let parent = pose.frame_id.trim_start_matches('/');
             let child = pose.child_frame_id.trim_start_matches('/');
             let sample = pose.sample(log_time_ns);
-            let key = (parent.to_owned(), child.to_owned());
-            let at = match self.by_name.get(&key) {
+            let at = match self
+                .by_name
+                .get(parent)
+                .and_then(|children| children.get(child))
+            {
                 Some(at) => *at,
                 None => {
                     let mut edge = TfEdge::new(parent, child, topic, sample.stamp_ns);
                     edge.dropped = self.edges.len() >= MAX_TF_EDGES;
                     self.edges
                         .push((edge, Decimator::new(1, MAX_TF_SAMPLES), 0));
-                    self.by_name.insert(key, self.edges.len() - 1);
+                    self.by_name
+                        .entry(parent.to_owned())
+                        .or_default()
+                        .insert(child.to_owned(), self.edges.len() - 1);
                     self.edges.len() - 1
                 }
             };
