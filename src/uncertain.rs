@@ -4,7 +4,7 @@
 //! Right / body (default): X = μ · Exp(ε); left / world: X = Exp(ε) · μ; ε ~ N(0, Σ).
 //! Σ_left = Ad_μ Σ_right Ad_μᵀ. See the [crate conventions](crate#conventions).
 
-use nalgebra::{DMatrix, Matrix2, Matrix3, SMatrix, SymmetricEigen, Vector2, Vector3};
+use nalgebra::{Matrix2, Matrix3, SMatrix, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result, check_finite};
@@ -307,23 +307,20 @@ pub fn try_inverse_covariance<const N: usize>(
     cov: &TangentMatrix<N>,
 ) -> Result<TangentMatrix<N>> {
     // The decomposition that validated ½(Σ + Σᵀ) is the one inverted (one, not two).
-    let (sym, eigen) = validate::validated_eigen(
+    let (_, eigen) = validate::validated_eigen(what, cov, true)?;
+    let singular = |min_eigenvalue| Error::SingularCovariance {
         what,
-        &DMatrix::from_iterator(N, N, cov.iter().copied()),
-        true,
-    )?;
-    let eigen = eigen.unwrap_or_else(|| SymmetricEigen::new(sym));
-    let (min_eigenvalue, max_eigenvalue) = (eigen.eigenvalues.min(), eigen.eigenvalues.max());
+        min_eigenvalue,
+    };
+    // Only a 0 × 0 Σ has no decomposition: nothing to invert.
+    let eigen = eigen.ok_or_else(|| singular(0.0))?;
+    let (min_eigenvalue, max_eigenvalue) = (eigen.values.min(), eigen.values.max());
     if max_eigenvalue <= 0.0 || min_eigenvalue <= SINGULAR_TOLERANCE * max_eigenvalue {
-        return Err(Error::SingularCovariance {
-            what,
-            min_eigenvalue,
-        });
+        return Err(singular(min_eigenvalue));
     }
-    let v = &eigen.eigenvectors;
-    let inverse_values = eigen.eigenvalues.map(|l| 1.0 / l);
-    let info = v * DMatrix::from_diagonal(&inverse_values) * v.transpose();
-    let info = TangentMatrix::<N>::from_iterator(info.iter().copied());
+    let v = &eigen.vectors;
+    let inverse_values = eigen.values.map(|l| 1.0 / l);
+    let info = v * TangentMatrix::<N>::from_diagonal(&inverse_values) * v.transpose();
     Ok((info + info.transpose()) * 0.5)
 }
 

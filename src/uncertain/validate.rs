@@ -1,7 +1,10 @@
 //! Validation of covariances: finite, symmetric and positive semi-definite within the one
 //! pair of tolerances every stage uses (files, evaluation, the health of robot logs).
 
-use nalgebra::{DMatrix, Dyn, SymmetricEigen};
+use nalgebra::allocator::Allocator;
+use nalgebra::{
+    Const, DMatrix, DefaultAllocator, DimDiff, DimSub, Dyn, OMatrix, SVector, SymmetricEigen, U1,
+};
 
 use crate::error::{Error, Result, check_finite};
 use crate::lie::TangentMatrix;
@@ -56,8 +59,7 @@ pub fn validate_covariance<const N: usize>(
     what: &'static str,
     cov: &TangentMatrix<N>,
 ) -> Result<TangentMatrix<N>> {
-    let sym = validate_covariance_dyn(what, &DMatrix::from_iterator(N, N, cov.iter().copied()))?;
-    Ok(TangentMatrix::<N>::from_iterator(sym.iter().copied()))
+    validated_eigen(what, cov, false).map(|(sym, _)| sym)
 }
 
 /// [`validate_covariance`] for a matrix whose size is known only at run time (a joint
@@ -71,23 +73,80 @@ pub fn validate_covariance<const N: usize>(
 /// assert!(validate_covariance_dyn("joint", &DMatrix::<f64>::identity(4, 3)).is_err()); // not square
 /// ```
 pub fn validate_covariance_dyn(what: &'static str, cov: &DMatrix<f64>) -> Result<DMatrix<f64>> {
-    validated_eigen(what, cov, false).map(|(sym, _)| sym)
+    decomposed(what, cov, false).map(|(sym, _)| sym)
+}
+
+/// The eigen-decomposition ½(Σ + Σᵀ) = V diag(λ) Vᵀ of a validated N × N covariance.
+pub(super) struct Eigen<const N: usize> {
+    /// λ, in nalgebra's order.
+    pub(super) values: SVector<f64, N>,
+    /// V, one eigenvector per column.
+    pub(super) vectors: TangentMatrix<N>,
 }
 
 /// ½(Σ + Σᵀ) and, when asked for, its eigen-decomposition.
-pub(super) type Validated = (DMatrix<f64>, Option<SymmetricEigen<f64, Dyn>>);
+pub(super) type Validated<const N: usize> = (TangentMatrix<N>, Option<Eigen<N>>);
 
-/// [`validate_covariance_dyn`]; with `vectors`, also handing back the eigen-decomposition of
+/// [`validate_covariance`]; with `vectors`, also handing back the eigen-decomposition of
 /// ½(Σ + Σᵀ) that decided positive semi-definiteness (`None` for a 0 × 0 matrix, or without
 /// `vectors`), so that [`try_inverse_covariance`](super::try_inverse_covariance) inverts
 /// through it instead of decomposing the same matrix again. Without `vectors` only the
 /// eigenvalues are computed (the same values: nalgebra's QR sweeps do not depend on the
 /// eigenvectors they accumulate).
-pub(super) fn validated_eigen(
+///
+/// nalgebra's decompositions take their size as a type: the sizes of the groups (1, 2, 3, 6)
+/// run as that fixed size, on the stack (the same operations in the same order as at run-time
+/// size, so the same bits, without a heap matrix per call); any other N at run-time size.
+pub(super) fn validated_eigen<const N: usize>(
     what: &'static str,
-    cov: &DMatrix<f64>,
+    cov: &TangentMatrix<N>,
     vectors: bool,
-) -> Result<Validated> {
+) -> Result<Validated<N>> {
+    match N {
+        1 => in_size(what, cov, vectors, Const::<1>),
+        2 => in_size(what, cov, vectors, Const::<2>),
+        3 => in_size(what, cov, vectors, Const::<3>),
+        6 => in_size(what, cov, vectors, Const::<6>),
+        _ => in_size(what, cov, vectors, Dyn(N)),
+    }
+}
+
+/// [`validated_eigen`] run in the size `dim` (= N).
+fn in_size<D, const N: usize>(
+    what: &'static str,
+    cov: &TangentMatrix<N>,
+    vectors: bool,
+    dim: D,
+) -> Result<Validated<N>>
+where
+    D: DimSub<U1>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D> + Allocator<DimDiff<D, U1>>,
+{
+    let m = OMatrix::<f64, D, D>::from_iterator_generic(dim, dim, cov.iter().copied());
+    let (sym, eigen) = decomposed(what, &m, vectors)?;
+    Ok((
+        TangentMatrix::<N>::from_iterator(sym.iter().copied()),
+        eigen.map(|e| Eigen {
+            values: SVector::from_iterator(e.eigenvalues.iter().copied()),
+            vectors: TangentMatrix::<N>::from_iterator(e.eigenvectors.iter().copied()),
+        }),
+    ))
+}
+
+/// ½(Σ + Σᵀ) and, when asked for, its eigen-decomposition, in any size.
+type Decomposed<D> = (OMatrix<f64, D, D>, Option<SymmetricEigen<f64, D>>);
+
+/// The one validation: square, finite, symmetric within [`SYMMETRY_TOLERANCE`], positive
+/// semi-definite within [`PSD_TOLERANCE`] (see [`validated_eigen`] for `vectors`).
+fn decomposed<D>(
+    what: &'static str,
+    cov: &OMatrix<f64, D, D>,
+    vectors: bool,
+) -> Result<Decomposed<D>>
+where
+    D: DimSub<U1>,
+    DefaultAllocator: Allocator<D, D> + Allocator<D> + Allocator<DimDiff<D, U1>>,
+{
     let (n, cols) = cov.shape();
     if n != cols {
         return Err(Error::WrongShape {
