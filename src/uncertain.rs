@@ -96,6 +96,31 @@ impl<G: LieGroup<N>, const N: usize> UncertainPose<G, N> {
         Ok(Self { mean, cov, side })
     }
 
+    /// [`try_new`](Self::try_new) and the information matrix Σ⁻¹
+    /// ([`try_inverse_covariance`]'s, `Err` when Σ is singular) from the one
+    /// eigen-decomposition that validates Σ: what a consumer of every message of a log (the
+    /// NEES) needs, without decomposing Σ twice.
+    ///
+    /// ```
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// use nalgebra::Matrix3;
+    /// let (pose, info) = UncertainPose::try_new_with_information(Se2::identity(), Matrix3::identity() * 4.0, Side::Right).unwrap();
+    /// assert_eq!(pose.cov()[(2, 2)], 4.0);
+    /// assert!((info.unwrap() - Matrix3::identity() * 0.25).norm() < 1e-15);
+    /// let (_, info) = UncertainPose::try_new_with_information(Se2::identity(), Matrix3::zeros(), Side::Right).unwrap();
+    /// assert!(info.is_err()); // valid (PSD) but singular
+    /// ```
+    pub fn try_new_with_information(
+        mean: G,
+        cov: TangentMatrix<N>,
+        side: Side,
+    ) -> Result<(Self, Result<TangentMatrix<N>>)> {
+        let what = "covariance";
+        let (cov, eigen) = validate::validated_eigen(what, &cov, true)?;
+        Ok((Self { mean, cov, side }, information(what, eigen)))
+    }
+
     /// Wraps an already-valid (symmetric PSD) covariance without checking it; for results
     /// the library computes itself, e.g. Ad Σ Adᵀ of a valid Σ. The result is symmetrised.
     ///
@@ -308,6 +333,15 @@ pub fn try_inverse_covariance<const N: usize>(
 ) -> Result<TangentMatrix<N>> {
     // The decomposition that validated ½(Σ + Σᵀ) is the one inverted (one, not two).
     let (_, eigen) = validate::validated_eigen(what, cov, true)?;
+    information(what, eigen)
+}
+
+/// Σ⁻¹ = V diag(1/λ) Vᵀ from the decomposition that validated Σ (`None`: a 0 × 0 Σ), or
+/// [`Error::SingularCovariance`].
+fn information<const N: usize>(
+    what: &'static str,
+    eigen: Option<validate::Eigen<N>>,
+) -> Result<TangentMatrix<N>> {
     let singular = |min_eigenvalue| Error::SingularCovariance {
         what,
         min_eigenvalue,

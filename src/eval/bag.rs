@@ -398,6 +398,41 @@ pub(super) fn meaning(
     reading: RosReading,
 ) -> Result<PoseState, Vec<Issue>> {
     let invalid = |_| vec![Issue::NotPsd];
+    match right_form(mean, cov_ros, unestimated, planar, reading)? {
+        RightForm::Planar(mean, cov) => UncertainPose::try_new(mean, cov, Side::Right)
+            .map(|pose| PoseState::Planar {
+                pose,
+                cloud: Vec::new(),
+            })
+            .map_err(invalid),
+        RightForm::Spatial(mean, cov) => UncertainPose::try_new(mean, cov, Side::Right)
+            .map(|pose| PoseState::Spatial {
+                pose: Box::new(pose),
+                cloud: Vec::new(),
+            })
+            .map_err(invalid),
+    }
+}
+
+/// A message's mean and right-form covariance, not validated yet.
+// Handed straight to its validation: boxing the 6 × 6 would allocate once per message.
+#[allow(clippy::large_enum_variant)]
+pub(super) enum RightForm {
+    /// (x, y, yaw).
+    Planar(Se2, Matrix3<f64>),
+    /// SE(3).
+    Spatial(Se3, Matrix6<f64>),
+}
+
+/// The conversion of [`meaning`], before Σ is validated (which the NEES does with the
+/// decomposition that also inverts it).
+pub(super) fn right_form(
+    mean: &Se3,
+    cov_ros: &Matrix6<f64>,
+    unestimated: &[bool; 6],
+    planar: bool,
+    reading: RosReading,
+) -> Result<RightForm, Vec<Issue>> {
     let used: &[usize] = if planar {
         &[0, 1, 5]
     } else {
@@ -409,33 +444,22 @@ pub(super) fn meaning(
     {
         return Err(vec![Issue::PlaceholderUsedAxis]);
     }
-    if planar {
-        let yaw = mean.rotation().to_rpy()[2];
-        let mut cov = *cov_ros;
-        for i in [2, 3, 4] {
-            cov.row_mut(i).fill(0.0);
-            cov.column_mut(i).fill(0.0);
-        }
-        let right = ros_cov_to_right(&cov, &So3::from_rpy(0.0, 0.0, yaw), reading);
-        let keep = [0, 1, 5];
-        let cov2 = Matrix3::from_fn(|r, c| right[(keep[r], keep[c])]);
-        let t = mean.translation();
-        let mean2 = Se2::from_parts(Vector2::new(t.x, t.y), So2::from_angle(yaw));
-        UncertainPose::try_new(mean2, cov2, Side::Right)
-            .map(|pose| PoseState::Planar {
-                pose,
-                cloud: Vec::new(),
-            })
-            .map_err(invalid)
-    } else {
+    if !planar {
         let right = ros_cov_to_right(cov_ros, mean.rotation(), reading);
-        UncertainPose::try_new(*mean, right, Side::Right)
-            .map(|pose| PoseState::Spatial {
-                pose: Box::new(pose),
-                cloud: Vec::new(),
-            })
-            .map_err(invalid)
+        return Ok(RightForm::Spatial(*mean, right));
     }
+    let yaw = mean.rotation().to_rpy()[2];
+    let mut cov = *cov_ros;
+    for i in [2, 3, 4] {
+        cov.row_mut(i).fill(0.0);
+        cov.column_mut(i).fill(0.0);
+    }
+    let right = ros_cov_to_right(&cov, &So3::from_rpy(0.0, 0.0, yaw), reading);
+    let keep = [0, 1, 5];
+    let cov2 = Matrix3::from_fn(|r, c| right[(keep[r], keep[c])]);
+    let t = mean.translation();
+    let mean2 = Se2::from_parts(Vector2::new(t.x, t.y), So2::from_angle(yaw));
+    Ok(RightForm::Planar(mean2, cov2))
 }
 
 /// ‖Σ_tf2 − Σ_body‖_F / ‖Σ_tf2‖_F of one message's right-form covariances (0 for Σ = 0).

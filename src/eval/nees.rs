@@ -45,7 +45,7 @@ use std::collections::{BTreeMap, VecDeque};
 
 use nalgebra::{Matrix6, SMatrix, Vector3};
 
-use super::bag::{PoseState, meaning};
+use super::bag::{RightForm, right_form};
 
 mod math;
 mod model;
@@ -57,7 +57,7 @@ use crate::plan::bag::{
     DEFAULT_MAX_DRAWN, Decimator, EstimateMessage, LogObserver, MAX_DRAWN_LIMIT, ReferenceSample,
 };
 use crate::plan::limits::MAX_COORDINATE;
-use crate::uncertain::{anees_band, chi2_radius};
+use crate::uncertain::{Side, UncertainPose, anees_band, chi2_radius};
 pub use math::{nees_se2, nees_se3, umeyama};
 pub use model::{
     Align, MAX_PENDING, MESSAGE_BOUND_PROBABILITY, NeesSettings, Skipped, TopicConsistency, Verdict,
@@ -71,11 +71,11 @@ enum Truth {
     Pending,
 }
 
-/// An estimate's Gaussian in the right form.
+/// An estimate's Gaussian in the right form, with Σ⁻¹ (`None`: Σ is singular).
 #[derive(Clone)]
 enum Gaussian {
-    Planar(Se2, SMatrix<f64, 3, 3>),
-    Spatial(Se3, Box<Matrix6<f64>>),
+    Planar(Se2, SMatrix<f64, 3, 3>, Option<SMatrix<f64, 3, 3>>),
+    Spatial(Se3, Box<(Matrix6<f64>, Option<Matrix6<f64>>)>),
 }
 
 impl Gaussian {
@@ -87,7 +87,7 @@ impl Gaussian {
     }
     fn position(&self) -> Vector3<f64> {
         match self {
-            Gaussian::Planar(x, _) => Vector3::new(x.translation().x, x.translation().y, 0.0),
+            Gaussian::Planar(x, ..) => Vector3::new(x.translation().x, x.translation().y, 0.0),
             Gaussian::Spatial(x, _) => *x.translation(),
         }
     }
@@ -253,7 +253,7 @@ impl NeesObserver {
                 let t = *state.alignment.get_or_insert_with(|| {
                     let estimate = match &w.gaussian {
                         Gaussian::Spatial(x, _) => *x,
-                        Gaussian::Planar(x, _) => x.to_se3(),
+                        Gaussian::Planar(x, ..) => x.to_se3(),
                     };
                     estimate.compose(&truth.inverse())
                 });
@@ -382,8 +382,8 @@ impl LogObserver for NeesObserver {
     }
 }
 
-/// The right-form Gaussian of a usable message (the log drawing's conversion), `None` when it
-/// has none.
+/// The right-form Gaussian of a usable message (the log drawing's conversion) with Σ⁻¹ from
+/// the decomposition that validates Σ, `None` when it has none.
 fn gaussian_of(m: &EstimateMessage<'_>, reading: RosReading) -> Option<Gaussian> {
     if !m.usable
         || m.position
@@ -396,19 +396,31 @@ fn gaussian_of(m: &EstimateMessage<'_>, reading: RosReading) -> Option<Gaussian>
     let mean = Se3::from_parts(m.position.into(), rotation);
     let planar = m.unestimated[2] && m.unestimated[3] && m.unestimated[4];
     let cov = Matrix6::from_row_slice(m.covariance);
-    match meaning(&mean, &cov, &m.unestimated, planar, reading).ok()? {
-        PoseState::Planar { pose, .. } => Some(Gaussian::Planar(*pose.mean(), *pose.cov())),
-        PoseState::Spatial { pose, .. } => {
-            Some(Gaussian::Spatial(*pose.mean(), Box::new(*pose.cov())))
-        }
-        PoseState::Invalid { .. } => None,
-    }
+    Some(
+        match right_form(&mean, &cov, &m.unestimated, planar, reading).ok()? {
+            RightForm::Planar(mean, cov) => {
+                let (pose, info) =
+                    UncertainPose::try_new_with_information(mean, cov, Side::Right).ok()?;
+                Gaussian::Planar(*pose.mean(), *pose.cov(), info.ok())
+            }
+            RightForm::Spatial(mean, cov) => {
+                let (pose, info) =
+                    UncertainPose::try_new_with_information(mean, cov, Side::Right).ok()?;
+                Gaussian::Spatial(*pose.mean(), Box::new((*pose.cov(), info.ok())))
+            }
+        },
+    )
 }
 
 fn add_nees(state: &mut TopicState, w: &Waiting, truth: &Se3) {
     let parts = match &w.gaussian {
-        Gaussian::Planar(x, cov) => nees_se2(x, cov, truth),
-        Gaussian::Spatial(x, cov) => nees_se3(x, cov, truth),
+        Gaussian::Planar(x, cov, info) => info
+            .as_ref()
+            .and_then(|info| math::nees_se2_informed(x, cov, info, truth)),
+        Gaussian::Spatial(x, cov_info) => cov_info
+            .1
+            .as_ref()
+            .and_then(|info| math::nees_se3_informed(x, &cov_info.0, info, truth)),
     };
     let Some([joint, position, orientation]) = parts.filter(|p| p.iter().all(|v| v.is_finite()))
     else {

@@ -18,8 +18,18 @@ use crate::uncertain::try_inverse_covariance;
 /// assert!((joint - 4.0).abs() < 1e-12 && (position - 4.0).abs() < 1e-12 && orientation.abs() < 1e-12);
 /// ```
 pub fn nees_se3(estimate: &Se3, cov: &Matrix6<f64>, truth: &Se3) -> Option<[f64; 3]> {
-    let e = truth.rminus(estimate);
     let info = try_inverse_covariance("Σ", cov).ok()?;
+    nees_se3_informed(estimate, cov, &info, truth)
+}
+
+/// [`nees_se3`] with Σ⁻¹ known (from the decomposition that validated Σ).
+pub(super) fn nees_se3_informed(
+    estimate: &Se3,
+    cov: &Matrix6<f64>,
+    info: &Matrix6<f64>,
+    truth: &Se3,
+) -> Option<[f64; 3]> {
+    let e = truth.rminus(estimate);
     let joint = (e.transpose() * info * e)[0];
     let r = estimate.rotation().to_matrix();
     let dp = r.transpose() * (truth.translation() - estimate.translation());
@@ -47,11 +57,21 @@ pub fn nees_se3(estimate: &Se3, cov: &Matrix6<f64>, truth: &Se3) -> Option<[f64;
 /// assert!((joint - 1.0).abs() < 1e-12 && (orientation - 1.0).abs() < 1e-12);
 /// ```
 pub fn nees_se2(estimate: &Se2, cov: &Matrix3<f64>, truth: &Se3) -> Option<[f64; 3]> {
+    let info = try_inverse_covariance("Σ", cov).ok()?;
+    nees_se2_informed(estimate, cov, &info, truth)
+}
+
+/// [`nees_se2`] with Σ⁻¹ known (from the decomposition that validated Σ).
+pub(super) fn nees_se2_informed(
+    estimate: &Se2,
+    cov: &Matrix3<f64>,
+    info: &Matrix3<f64>,
+    truth: &Se3,
+) -> Option<[f64; 3]> {
     let t = truth.translation();
     let yaw = truth.rotation().to_rpy()[2];
     let truth = Se2::from_parts(Vector2::new(t.x, t.y), So2::from_angle(yaw));
     let e = truth.rminus(estimate);
-    let info = try_inverse_covariance("Σ", cov).ok()?;
     let joint = (e.transpose() * info * e)[0];
     let r = estimate.rotation().to_matrix();
     let dp: SVector<f64, 2> = r.transpose() * (truth.translation() - estimate.translation());
