@@ -90,7 +90,7 @@ pub(super) fn report_as(
     let loaded = match open(scenario)? {
         Opened::Plan(loaded) => *loaded,
         Opened::Log(located) => {
-            let run = bag::run_with(&located, &resolve_log(overrides)?, None, bar)?;
+            let run = bag::run_with(&located, &resolve_log(overrides)?, None, bar, false)?;
             return Ok(match style {
                 ReportStyle::Text => bag::report_text(scenario, &run),
                 _ => printed(bag::report_json(scenario, &run)),
@@ -216,7 +216,7 @@ pub(super) fn check_as(
     let loaded = match open(scenario)? {
         Opened::Plan(loaded) => *loaded,
         Opened::Log(located) => {
-            let run = bag::run_with(&located, &resolve_log(overrides)?, None, bar)?;
+            let run = bag::run_with(&located, &resolve_log(overrides)?, None, bar, true)?;
             return Ok(bag::check(&run, scenario, allow));
         }
     };
