@@ -216,8 +216,14 @@ fn decompress<'a>(
     out.clear();
     let read = match header.compression.as_str() {
         "" => Ok(0),
-        "zstd" => zstd::stream::read::Decoder::new(compressed)
-            .and_then(|d| d.take(bound).read_to_end(out)),
+        // In one call straight into `out` (room for one byte more than expected); a chunk
+        // that does not fit or does not decode is read again through the limit below, which
+        // says how it is wrong.
+        "zstd" => zstd_in_one(compressed, bound, out).or_else(|_| {
+            out.clear();
+            zstd::stream::read::Decoder::new(compressed)
+                .and_then(|d| d.take(bound).read_to_end(out))
+        }),
         "lz4" => lz4::Decoder::new(compressed).and_then(|d| d.take(bound).read_to_end(out)),
         other => {
             return Err(format!(
@@ -240,6 +246,23 @@ fn decompress<'a>(
     }
     Ok(records)
 }
+
+/// A zstd chunk decompressed in one call into `out`'s room for `bound` bytes (the streaming
+/// decoder copied each block through its window and zeroed `out` first: a tenth of a long
+/// log's read).
+/// Only up to [`ONE_CALL_LIMIT`] bytes: the room is taken before a byte is read, and a
+/// falsified header must not take a gigabyte.
+fn zstd_in_one(compressed: &[u8], bound: u64, out: &mut Vec<u8>) -> std::io::Result<usize> {
+    let room = usize::try_from(bound)
+        .ok()
+        .filter(|&b| b <= ONE_CALL_LIMIT)
+        .ok_or_else(|| std::io::Error::other("a chunk this large is streamed"))?;
+    out.reserve_exact(room);
+    zstd::bulk::Decompressor::new()?.decompress_to_buffer(compressed, out)
+}
+
+/// The largest chunk [`zstd_in_one`] decompresses (MCAP writers' chunks are a few MiB).
+const ONE_CALL_LIMIT: usize = 64 << 20;
 
 /// Calls `take` with each record (opcode, body) of a decompressed chunk, in order; every
 /// record moves on by its opcode and length, and a length past the chunk's end is refused.
