@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # posecov's bag reader vs the Python `rosbags` package on the same bags, side by side in one
 # run: robot_localization's test2.bag as shipped (bz2) and rewritten ten times over (30 600
-# Odometry messages) with no, lz4 and bz2 chunk compression; the criterion bench
+# Odometry messages) with no, lz4 and bz2 chunk compression, and ten times over with a new
+# pose covariance in every message, as an EKF publishes it (`--ekf`: the bags as shipped
+# publish one covariance throughout), uncompressed and lz4; the criterion bench
 # benches/bag_read.rs, then benches/bag_rosbags.py in its own virtualenv, then the ratios of
 # messages per second. Then, from the same criterion run: posecov's read of each bz2 bag
 # against libbz2 alone decompressing its chunks on the same threads (bag_libbz2/*; the rule:
@@ -29,6 +31,10 @@ for c in none lz4 bz2; do
     "$venv/bin/python" "$here/bag_rosbags.py" "$bag" --rewrite "$work/jackal10_$c.bag" --compression "$c" --copies 10
     bags+=("$work/jackal10_$c.bag")
 done
+for c in none lz4; do
+    "$venv/bin/python" "$here/bag_rosbags.py" "$bag" --rewrite "$work/ekf10_$c.bag" --compression "$c" --copies 10 --ekf
+    bags+=("$work/ekf10_$c.bag")
+done
 if [ -n "${POSECOV_BIN:-}" ]; then
     "$venv/bin/python" "$here/bag_rosbags.py" "$bag" --rewrite "$work/jackal100_bz2.bag" --compression bz2 --copies 100
 fi
@@ -39,7 +45,7 @@ cd "$root"
 cargo bench --no-default-features --bench bag_read --no-run >/dev/null 2>&1
 out=""
 declare -A rosbags
-for name in test2 jackal10_none jackal10_lz4 jackal10_bz2; do
+for name in test2 jackal10_none jackal10_lz4 jackal10_bz2 ekf10_none ekf10_lz4; do
     if [ "$name" = test2 ]; then file="$bag"; bench=ros1_test2_bz2; else file="$work/$name.bag"; bench="$name"; fi
     out+="$(POSECOV_BENCH_BAGS="$(IFS=:; echo "${bags[*]}")" \
         cargo bench --no-default-features --bench bag_read -- --warm-up-time 1 --measurement-time 3 "/$bench\$" 2>&1)"$'\n'
@@ -52,7 +58,7 @@ rate() { # criterion's median throughput of bench $1 (group/name), in messages/s
         awk '{ m = ($2 == "K") ? 1e3 : (($2 == "M") ? 1e6 : 1); printf "%.0f", $1 * m }'
 }
 printf "%-16s %14s %14s %8s\n" "bag" "posecov msg/s" "rosbags msg/s" "ratio"
-for name in test2 jackal10_none jackal10_lz4 jackal10_bz2; do
+for name in test2 jackal10_none jackal10_lz4 jackal10_bz2 ekf10_none ekf10_lz4; do
     if [ "$name" = test2 ]; then bench=ros1_test2_bz2; else bench="$name"; fi
     p="$(rate "bag_read/$bench")"
     r="${rosbags[$name]}"
@@ -68,7 +74,7 @@ for name in ros1_test2_bz2 jackal10_bz2; do
 done
 echo
 printf "%-16s %14s %16s %8s\n" "bag" "read msg/s" "health msg/s" "share"
-for name in ros1_test2_bz2 jackal10_none jackal10_lz4 jackal10_bz2; do
+for name in ros1_test2_bz2 jackal10_none jackal10_lz4 jackal10_bz2 ekf10_none ekf10_lz4; do
     p="$(rate "bag_read/$name")"
     h="$(rate "bag_health/$name")"
     printf "%-16s %14s %16s %7.1f%%\n" "$name" "$p" "$h" "$(python3 -c "print(100 * $p / $h)")"

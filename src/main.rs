@@ -71,7 +71,8 @@ enum Command {
         more: Vec<String>,
         /// Accept this defect class on purpose (repeatable): non_finite, asymmetric, not_psd,
         /// undecodable, bad_orientation, unknown_marker, all_zero, placeholder_used_axis,
-        /// constant, frozen_stamp, type_change. A log cut short is always reported (exit 1).
+        /// constant, frozen_stamp, type_change, tf_cycle, tf_several_parents (then named as
+        /// allowed). A log cut short is always reported (exit 1).
         #[arg(long = "allow", value_name = "NAME")]
         allow: Vec<String>,
     },

@@ -166,13 +166,22 @@ fn log_run(path: &Path) -> bag::LogRun {
 }
 
 fn check_code(path: &Path) -> (Option<i32>, String) {
-    let out = Command::new(BIN)
-        // The odometry's covariance is constant on purpose (a defect of its own): allowed.
-        .args(["check", path.to_str().unwrap(), "--allow", "constant"])
-        .output()
-        .unwrap();
+    let (code, _, stderr) = check_allowing(path, &[]);
+    (code, stderr)
+}
+
+/// `posecov check PATH --allow constant --allow NAME…`: the exit code, stdout and stderr.
+fn check_allowing(path: &Path, names: &[&str]) -> (Option<i32>, String, String) {
+    let mut command = Command::new(BIN);
+    // The odometry's covariance is constant on purpose (a defect of its own): allowed.
+    command.args(["check", path.to_str().unwrap(), "--allow", "constant"]);
+    for name in names {
+        command.args(["--allow", name]);
+    }
+    let out = command.output().unwrap();
     (
         out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
@@ -377,6 +386,24 @@ fn a_cycle_is_a_defect_said_and_nothing_is_joined() {
         stderr.contains("cycle.mcap: tf_cycle — /tf has a cycle"),
         "{stderr}"
     );
+    assert!(
+        stderr.contains("(`--allow tf_cycle` accepts it)"),
+        "{stderr}"
+    );
+    // Accepted on purpose: check passes, and says which defects it allowed.
+    let (code, stdout, stderr) = check_allowing(&path, &["tf_cycle"]);
+    assert_eq!(code, Some(0), "{stdout}{stderr}");
+    assert!(!stderr.contains("tf_cycle"), "{stderr}");
+    assert!(
+        stdout.contains(": ok (2 pose topic(s), ")
+            && stdout.contains(", defects allowed: constant, tf_cycle)"),
+        "{stdout}"
+    );
+    // The report still says it, as a defect.
+    assert_eq!(cycle["class"], "defect");
+    // Allowing another /tf defect does not accept this one.
+    let (code, _, stderr) = check_allowing(&path, &["tf_several_parents"]);
+    assert_eq!(code, Some(1), "{stderr}");
 }
 
 #[test]

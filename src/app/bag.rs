@@ -359,9 +359,11 @@ pub fn report_text(name: &str, run: &LogRun) -> String {
     )
 }
 
-/// What `check` says of a log: one line for stdout (topics, messages, drawn items, defects and
-/// notes) and, for each topic with a defect not in `allow`, its first defect on a line for
-/// stderr in the file's terms (file, topic, message, stamp), with its count and `--allow` name.
+/// What `check` says of a log: one line for stdout (topics, messages, drawn items, defects,
+/// notes and the defect kinds found but allowed) and, for each topic with a defect not in
+/// `allow`, its first defect on a line for stderr in the file's terms (file, topic, message,
+/// stamp), with its count and `--allow` name; a line for each defect of the log's `/tf` not in
+/// `allow` (`tf_cycle`, `tf_several_parents`) and for a log cut short (never allowed).
 ///
 /// ```
 /// use posecov::app::{Overrides, bag, run::{Run, open}};
@@ -371,13 +373,17 @@ pub fn report_text(name: &str, run: &LogRun) -> String {
 /// assert!(checked.line.starts_with("covariance_health: defects on 1 of 3 pose topic(s)"), "{}", checked.line);
 /// assert!(checked.defects[0].starts_with("health_cases.mcap (bundled): topic /amcl_pose, message 1 (stamp 101.000 s): all_zero"), "{:?}", checked.defects);
 /// let allow: Vec<Issue> = Issue::ALL.to_vec();
-/// assert!(bag::check(&run, "covariance_health", &allow).defects.is_empty());
+/// let checked = bag::check(&run, "covariance_health", &allow);
+/// assert!(checked.defects.is_empty());
+/// assert!(checked.line.contains(", defects allowed: "), "{}", checked.line);
 /// ```
 pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
     let plan = &run.plan;
     let file = run.located.origin();
     let mut defects = Vec::new();
     let mut notes = 0;
+    // The defect kinds found and accepted on purpose: said, so an allowed defect is not hidden.
+    let mut allowed = Vec::new();
     for t in &plan.topics {
         notes += t
             .health
@@ -385,6 +391,11 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
             .iter()
             .filter(|(i, _)| t.class(**i) == Class::Note)
             .count();
+        for (issue, _) in t.defects().filter(|(i, _)| allow.contains(i)) {
+            if !allowed.contains(&issue) {
+                allowed.push(issue);
+            }
+        }
         let mut found: Vec<_> = t.defects().filter(|(i, _)| !allow.contains(i)).collect();
         found.sort_by_key(|(_, c)| (c.first_index, c.first_stamp_ns));
         if let Some((issue, c)) = found.first() {
@@ -412,16 +423,28 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
             cut.reason, cut.chunks_read, cut.at_byte, cut.file_bytes
         ));
     }
-    let tf_defects = frames::tf_defects(&file, &run.evaluation);
+    let (tf_allowed, tf_defects) = frames::tf_defects(&file, &run.evaluation, allow);
+    allowed.extend(tf_allowed);
     let log_defects = usize::from(plan.cut.is_some()) + tf_defects.len();
     defects.extend(tf_defects);
     let facts = format!(
-        "{} messages, {} drawn items{}",
+        "{} messages, {} drawn items{}{}",
         plan.messages_total,
         run.scene.items.len(),
         match notes {
             0 => String::new(),
             n => format!(", {n} kind(s) of note (see `posecov report`)"),
+        },
+        match allowed.len() {
+            0 => String::new(),
+            _ => format!(
+                ", defects allowed: {}",
+                allowed
+                    .iter()
+                    .map(|i| i.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
         }
     );
     let line = if defects.is_empty() {

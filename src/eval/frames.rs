@@ -45,7 +45,7 @@ use serde::Serialize;
 use super::stamped::{Lookup, StampedPoses, pose_of_sample};
 use crate::interop::{RosReading, ros_cov_moved};
 use crate::lie::{LieGroup, Se3};
-use crate::plan::bag::{TfTree, TopicPlan};
+use crate::plan::bag::{Class, Issue, TfTree, TopicPlan};
 
 /// A transform keeps a planar topic's plane when its roll and pitch are below this (rad).
 pub const PLANE_TOLERANCE: f64 = 1e-6;
@@ -86,30 +86,32 @@ pub enum FrameProblemKind {
 }
 
 impl FrameProblemKind {
-    /// Its name in `report --json`.
+    /// Its finding in the one table of findings ([`Issue`]): the word (`tf_cycle`) in the
+    /// panel, `report --json` and `check --allow`, and its class (a broken tree is a defect,
+    /// `posecov check` fails on it; a frame the log does not join is a note).
     ///
     /// ```
     /// use posecov::eval::frames::FrameProblemKind;
-    /// assert_eq!(FrameProblemKind::MissingLink.name(), "missing_link");
-    /// assert!(FrameProblemKind::Cycle.is_defect() && !FrameProblemKind::NoTransform.is_defect());
+    /// use posecov::plan::bag::{Class, Issue};
+    /// assert_eq!(FrameProblemKind::MissingLink.issue().name(), "tf_missing_link");
+    /// assert_eq!(FrameProblemKind::Cycle.issue(), Issue::TfCycle);
+    /// assert_eq!(FrameProblemKind::Cycle.class(), Class::Defect);
+    /// assert_eq!(FrameProblemKind::NoTransform.class(), Class::Note);
     /// ```
-    pub fn name(self) -> &'static str {
+    pub fn issue(self) -> Issue {
         match self {
-            FrameProblemKind::Cycle => "cycle",
-            FrameProblemKind::SeveralParents => "several_parents",
-            FrameProblemKind::MissingLink => "missing_link",
-            FrameProblemKind::NoTransform => "no_transform",
-            FrameProblemKind::TiltsPlane => "tilts_plane",
+            FrameProblemKind::Cycle => Issue::TfCycle,
+            FrameProblemKind::SeveralParents => Issue::TfSeveralParents,
+            FrameProblemKind::MissingLink => Issue::TfMissingLink,
+            FrameProblemKind::NoTransform => Issue::TfNoTransform,
+            FrameProblemKind::TiltsPlane => Issue::TfTiltsPlane,
         }
     }
 
-    /// A broken `/tf` tree (cycle, several parents) is a defect (`posecov check` fails); a
-    /// frame the log does not join is a note. See [`name`](Self::name) for an example.
-    pub fn is_defect(self) -> bool {
-        matches!(
-            self,
-            FrameProblemKind::Cycle | FrameProblemKind::SeveralParents
-        )
+    /// Defect or note, by [`Issue::class`] (see [`issue`](Self::issue) for an example).
+    pub fn class(self) -> Class {
+        // Whether the topic is dead-reckoned matters only to `constant`.
+        self.issue().class(false)
     }
 }
 

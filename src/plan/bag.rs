@@ -123,8 +123,10 @@ pub enum Class {
     Note,
 }
 
-/// A covariance-health finding (a message can have several). Its `--allow` name and JSON key
-/// is [`Issue::name`]; its class [`Issue::class`].
+/// A health finding: of a topic's covariance and stamps (a message can have several), or of
+/// the log's `/tf` tree (the `Tf…` kinds, found when frames are joined:
+/// [`crate::eval::frames::FrameProblemKind`]). This is the one table of findings: its
+/// `--allow` name and JSON word is [`Issue::name`], its class [`Issue::class`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Issue {
@@ -152,6 +154,12 @@ pub enum Issue {
     /// Messages of another type on the topic (another publisher, a changed definition): not
     /// read; the types are [`Health::other_types`].
     TypeChange,
+    /// The log's `/tf` has a chain of parents that comes back to itself: nothing is joined
+    /// through it.
+    TfCycle,
+    /// The log's `/tf` gives a child frame several parents, where tf allows one: nothing is
+    /// joined through that frame.
+    TfSeveralParents,
     /// A variance ≥ 1e6 on an axis planar motion does not use (z, roll, pitch): "not
     /// estimated".
     Placeholder,
@@ -165,11 +173,17 @@ pub enum Issue {
     /// The position trace ≥ 100 × its smallest value since the last drop: dead reckoning
     /// without correction.
     Growth,
+    /// Topics' frames are in `/tf`, but in trees no transform joins: drawn apart.
+    TfMissingLink,
+    /// A topic's frame never gets a transform in `/tf` or `/tf_static`: drawn apart.
+    TfNoTransform,
+    /// A planar topic whose transform tilts its plane: drawn apart.
+    TfTiltsPlane,
 }
 
 impl Issue {
     /// Every finding, defects first.
-    pub const ALL: [Issue; 16] = [
+    pub const ALL: [Issue; 21] = [
         Issue::NonFinite,
         Issue::Asymmetric,
         Issue::NotPsd,
@@ -181,11 +195,16 @@ impl Issue {
         Issue::Constant,
         Issue::FrozenStamp,
         Issue::TypeChange,
+        Issue::TfCycle,
+        Issue::TfSeveralParents,
         Issue::Placeholder,
         Issue::StampFallback,
         Issue::StampOrder,
         Issue::Drop,
         Issue::Growth,
+        Issue::TfMissingLink,
+        Issue::TfNoTransform,
+        Issue::TfTiltsPlane,
     ];
 
     /// The `--allow` name and JSON key.
@@ -208,11 +227,16 @@ impl Issue {
             Issue::Constant => "constant",
             Issue::FrozenStamp => "frozen_stamp",
             Issue::TypeChange => "type_change",
+            Issue::TfCycle => "tf_cycle",
+            Issue::TfSeveralParents => "tf_several_parents",
             Issue::Placeholder => "placeholder",
             Issue::StampFallback => "stamp_fallback",
             Issue::StampOrder => "stamp_order",
             Issue::Drop => "drop",
             Issue::Growth => "growth",
+            Issue::TfMissingLink => "tf_missing_link",
+            Issue::TfNoTransform => "tf_no_transform",
+            Issue::TfTiltsPlane => "tf_tilts_plane",
         }
     }
 
@@ -229,6 +253,7 @@ impl Issue {
     /// assert_eq!(Issue::Constant.class(true), Class::Defect);
     /// assert_eq!(Issue::Constant.class(false), Class::Note);
     /// assert_eq!(Issue::Placeholder.class(true), Class::Note);
+    /// assert_eq!(Issue::TfCycle.class(false), Class::Defect);
     /// ```
     pub fn class(self, dead_reckoned: bool) -> Class {
         match self {
@@ -237,7 +262,10 @@ impl Issue {
             | Issue::StampFallback
             | Issue::StampOrder
             | Issue::Drop
-            | Issue::Growth => Class::Note,
+            | Issue::Growth
+            | Issue::TfMissingLink
+            | Issue::TfNoTransform
+            | Issue::TfTiltsPlane => Class::Note,
             _ => Class::Defect,
         }
     }

@@ -7,7 +7,7 @@ use serde_json::{Value, json};
 use super::stamp_seconds;
 use crate::draw::bag::frame_problem_sentence;
 use crate::eval::bag::{BagEvaluation, TopicEvaluation};
-use crate::plan::bag::TfTree;
+use crate::plan::bag::{Class, Issue, TfTree};
 
 /// `frames`: the `/tf` edges read (what was kept of them) and the problems.
 pub(super) fn frames_json(tf: &TfTree, e: &BagEvaluation) -> Value {
@@ -28,8 +28,8 @@ pub(super) fn frames_json(tf: &TfTree, e: &BagEvaluation) -> Value {
             "topic": topic, "count": count, "first_log_time_s": stamp_seconds(*first),
         })).collect::<Vec<_>>(),
         "problems": e.frames.problems.iter().map(|p| json!({
-            "kind": format!("tf_{}", p.kind.name()),
-            "class": if p.kind.is_defect() { "defect" } else { "note" },
+            "kind": p.kind.issue().name(),
+            "class": p.kind.class(),
             "frames": p.frames,
             "roots": p.roots,
             "topics": p.topics,
@@ -55,19 +55,32 @@ pub(super) fn join_json(t: &TopicEvaluation) -> Value {
     })
 }
 
-/// `check`'s lines for the defects of the log's `/tf` (a cycle, several parents), in the
+/// The defects of the log's `/tf` (a cycle, several parents): the kinds `allow` names that
+/// were found (accepted on purpose, each once), and `check`'s line for each other one, in the
 /// file's terms.
-pub(super) fn tf_defects(file: &str, e: &BagEvaluation) -> Vec<String> {
-    e.frames
-        .problems
-        .iter()
-        .filter(|p| p.kind.is_defect())
-        .map(|p| {
-            format!(
-                "{file}: tf_{} — {}",
-                p.kind.name(),
+pub(super) fn tf_defects(
+    file: &str,
+    e: &BagEvaluation,
+    allow: &[Issue],
+) -> (Vec<Issue>, Vec<String>) {
+    let mut allowed = Vec::new();
+    let mut lines = Vec::new();
+    for p in e.frames.problems.iter() {
+        let issue = p.kind.issue();
+        if p.kind.class() != Class::Defect {
+            continue;
+        }
+        if allow.contains(&issue) {
+            if !allowed.contains(&issue) {
+                allowed.push(issue);
+            }
+        } else {
+            let name = issue.name();
+            lines.push(format!(
+                "{file}: {name} — {} (`--allow {name}` accepts it)",
                 frame_problem_sentence(p)
-            )
-        })
-        .collect()
+            ));
+        }
+    }
+    (allowed, lines)
 }

@@ -7,6 +7,7 @@ use std::fmt::Write;
 use crate::eval::bag::BagEvaluation;
 use crate::eval::frames::{FrameProblem, FrameProblemKind};
 use crate::interop::RosReading;
+use crate::plan::bag::Class;
 
 /// A stamp in seconds, as the timeline shows it.
 fn secs(ns: i64) -> String {
@@ -122,15 +123,14 @@ pub(super) fn frames_paragraph(e: &BagEvaluation) -> String {
         );
     }
     for p in &e.frames.problems {
-        let class = if p.kind.is_defect() {
-            "**defect**"
-        } else {
-            "note"
+        let class = match p.kind.class() {
+            Class::Defect => "**defect**",
+            Class::Note => "note",
         };
         let _ = writeln!(
             s,
-            "\n{class} `tf_{}`: {}.",
-            p.kind.name(),
+            "\n{class} `{}`: {}.",
+            p.kind.issue().name(),
             frame_problem_sentence(p)
         );
     }

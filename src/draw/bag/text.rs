@@ -39,6 +39,11 @@ pub fn issue_word(issue: Issue) -> &'static str {
         Issue::StampOrder => "stamp out of order",
         Issue::Drop => "sudden drop (relocalisation?)",
         Issue::Growth => "unbounded growth",
+        Issue::TfCycle => "a cycle in /tf",
+        Issue::TfSeveralParents => "a frame with several parents in /tf",
+        Issue::TfMissingLink => "frames /tf does not join",
+        Issue::TfNoTransform => "a frame never in /tf",
+        Issue::TfTiltsPlane => "a transform that tilts the plane",
     }
 }
 
@@ -124,6 +129,27 @@ pub fn issue_sentence(issue: Issue, t: &TopicPlan) -> String {
         }
         Issue::Growth => {
             "the position trace reached ≥ 100 × its value since the last drop (dead reckoning)."
+                .to_owned()
+        }
+        // The log's /tf: said with its frames and stamp by `frame_problem_sentence`.
+        Issue::TfCycle => {
+            "the log's /tf has a cycle, where tf allows no loop: nothing is joined through it."
+                .to_owned()
+        }
+        Issue::TfSeveralParents => "the log's /tf gives a frame several parents, where tf allows \
+             one: nothing is joined through it."
+            .to_owned(),
+        Issue::TfMissingLink => {
+            "no chain of transforms in /tf joins the topics' frames: drawn apart.".to_owned()
+        }
+        Issue::TfNoTransform => {
+            format!(
+                "frame `{}` never gets a transform in /tf or /tf_static: drawn in its own view.",
+                t.frame_id
+            )
+        }
+        Issue::TfTiltsPlane => {
+            "the transform to the common frame tilts this planar topic's plane: drawn apart."
                 .to_owned()
         }
     }

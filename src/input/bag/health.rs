@@ -31,7 +31,8 @@ pub struct MessageHealth {
     /// Axes whose variance is ≥ [`PLACEHOLDER`] or exactly 0, per ROS axis.
     pub unestimated: [bool; 6],
     /// Smallest eigenvalue of the estimated block, computed when it is finite, symmetric and
-    /// not positive definite (`None` otherwise: a positive definite block is PSD).
+    /// not positive definite; exactly 0 when it is positive definite but for axes whose row
+    /// and column are zero (`None` otherwise: a positive definite block is PSD).
     pub min_eigenvalue: Option<f64>,
     /// Trace of the estimated position block, m² (usable messages only).
     pub position_trace: Option<f64>,
@@ -71,6 +72,43 @@ fn positive_definite(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
     true
 }
 
+/// Whether the block of `cov` on the `kept` axes is positive definite once the axes whose row
+/// and column are zero in it are left out (a variance of exactly 0 without correlation, "not
+/// estimated", as some drivers publish z, roll and pitch): each such axis adds an eigenvalue
+/// of exactly 0 and leaves the others to the rest, so the block is then PSD with smallest
+/// eigenvalue 0, without an eigen-decomposition.
+fn positive_definite_but_zero_axes(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
+    let mut rest = [0usize; 6];
+    let mut m = 0;
+    for &i in kept {
+        if kept
+            .iter()
+            .any(|&j| cov[i * 6 + j] != 0.0 || cov[j * 6 + i] != 0.0)
+        {
+            rest[m] = i;
+            m += 1;
+        }
+    }
+    m < kept.len() && positive_definite(cov, &rest[..m])
+}
+
+/// The smallest eigenvalue and the largest (at least 0) of the symmetrised block of `cov` on
+/// the `kept` axes, by nalgebra's symmetric eigen-decomposition: the numbers a covariance
+/// that is not positive definite reports.
+fn eigenvalue_range(cov: &[f64; COV_LEN], kept: &[usize]) -> (f64, f64) {
+    let block = DMatrix::from_fn(kept.len(), kept.len(), |r, c| {
+        0.5 * (cov[kept[r] * 6 + kept[c]] + cov[kept[c] * 6 + kept[r]])
+    });
+    let eig = SymmetricEigen::new(block);
+    let lo = eig
+        .eigenvalues
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let hi = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
+    (lo, hi)
+}
+
 /// Classifies one covariance (ROS layout) and its orientation quaternion.
 ///
 /// ```
@@ -100,7 +138,7 @@ fn with_orientation(
     if !norm.is_finite() || (norm - 1.0).abs() > 1e-3 {
         issues.push(Issue::BadOrientation);
     }
-    issues.extend(covariance.issues.iter().copied());
+    issues.extend(covariance.issues.iter());
     let health = MessageHealth {
         issues,
         ..covariance
@@ -172,26 +210,24 @@ fn classify_covariance(cov: &[f64; COV_LEN]) -> MessageHealth {
     if asymmetric {
         issues.push(Issue::Asymmetric);
     } else if !kept.is_empty()
-        && !issues.contains(&Issue::UnknownMarker)
+        && !issues.contains(Issue::UnknownMarker)
         && !positive_definite(cov, kept)
     {
-        // Only a block that is not positive definite needs its eigenvalues (most messages'
-        // are: one fixed-size Cholesky factorisation decides, the eigen-decomposition was
-        // most of the health classes' time).
-        let block = DMatrix::from_fn(kept.len(), kept.len(), |r, c| {
-            0.5 * (cov[kept[r] * 6 + kept[c]] + cov[kept[c] * 6 + kept[r]])
+        // Only a block that is not positive definite needs more (most messages' are: one
+        // factorisation on the stack decides; the eigen-decomposition was most of the health
+        // classes' time).
+        min_eigenvalue = Some(match positive_definite_but_zero_axes(cov, kept) {
+            // Positive definite but for axes whose row and column are zero: their
+            // eigenvalue, exactly 0, is the smallest; PSD.
+            true => 0.0,
+            false => {
+                let (lo, hi) = eigenvalue_range(cov, kept);
+                if lo < -psd_tolerance(hi) {
+                    issues.push(Issue::NotPsd);
+                }
+                lo
+            }
         });
-        let eig = SymmetricEigen::new(block);
-        let lo = eig
-            .eigenvalues
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
-        let hi = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
-        min_eigenvalue = Some(lo);
-        if lo < -psd_tolerance(hi) {
-            issues.push(Issue::NotPsd);
-        }
     }
     MessageHealth {
         issues,
@@ -424,12 +460,12 @@ impl TopicHealth {
         };
         let mut h = with_orientation(d.orientation_xyzw, covariance, &d.covariance);
         if let Some(trace) = h.position_trace {
-            h.issues.extend(self.trend.next(trace).iter().copied());
+            h.issues.extend(self.trend.next(trace).iter());
         }
-        for issue in &h.issues {
-            self.health.note(*issue, stamp_ns, index);
+        for issue in h.issues.iter() {
+            self.health.note(issue, stamp_ns, index);
         }
-        if h.issues.contains(&Issue::NotPsd) {
+        if h.issues.contains(Issue::NotPsd) {
             let lo = h.min_eigenvalue.unwrap_or(0.0);
             self.health.min_eigenvalue = Some(self.health.min_eigenvalue.map_or(lo, |m| m.min(lo)));
         }
@@ -505,6 +541,31 @@ mod tests {
     }
 
     #[test]
+    fn zero_axes_are_psd_without_an_eigen_decomposition() {
+        // z, roll and pitch published as exact zeros: positive definite on x, y and yaw, and
+        // the smallest eigenvalue is the zero axes' 0 (what the eigen-decomposition gives).
+        let h = classify(&diag([1e-3, 1e-3, 0.0, 0.0, 0.0, 0.03]), Q);
+        assert!(h.usable() && h.issues.is_empty(), "{:?}", h.issues);
+        assert_eq!(h.min_eigenvalue, Some(0.0));
+        assert_eq!(h.unestimated, [false, false, true, true, true, false]);
+        assert_eq!(
+            eigenvalue_range(
+                &diag([1e-3, 1e-3, 0.0, 0.0, 0.0, 0.03]),
+                &[0, 1, 2, 3, 4, 5]
+            )
+            .0,
+            0.0
+        );
+        // A zero variance correlated with another axis is no zero axis: not PSD.
+        let mut c = diag([1e-3, 1e-3, 0.0, 0.0, 0.0, 0.03]);
+        c[2] = 1e-4;
+        c[12] = 1e-4;
+        let h = classify(&c, Q);
+        assert!(h.issues.contains(Issue::NotPsd), "{:?}", h.issues);
+        assert!(h.min_eigenvalue.unwrap() < -1e-6);
+    }
+
+    #[test]
     fn placeholders_do_not_spoil_the_psd_check() {
         // 1.79e308 next to 1e-3: eigenvalues of the whole matrix would be rounding noise.
         let h = classify(&diag([1e-3, 1e-3, 1.79e308, 1e6, 1e6, 0.03]), Q);
@@ -518,11 +579,7 @@ mod tests {
         s[1] = 1e-3;
         s[6] = 1e-3;
         let h = classify(&s, Q);
-        assert!(
-            h.issues.iter().all(|i| *i != Issue::NotPsd),
-            "{:?}",
-            h.issues
-        );
+        assert!(!h.issues.contains(Issue::NotPsd), "{:?}", h.issues);
         assert!(h.min_eigenvalue.unwrap().abs() < 1e-15);
     }
 }

@@ -121,7 +121,7 @@ impl TopicState {
             },
         );
         if self.drawn.wants(index) {
-            let unusable = h.issues.iter().copied().filter(|i| i.unusable()).collect();
+            let unusable = h.issues.iter().filter(|i| i.unusable()).collect();
             self.drawn.push(
                 index,
                 DrawnMessage {

@@ -1,10 +1,18 @@
-//! The issues of one message, without an allocation.
+//! The issues of one message: a set with one bit per kind of [`Issue`], so nothing can ever be
+//! dropped, and four bytes to copy.
+
+use std::fmt;
 
 use crate::plan::bag::Issue;
 
-/// The issues of one message, in the order found: a list on the stack (every message of a
-/// log has one; a `Vec` was an allocation per message). Compares equal to a `Vec` or slice
-/// of the same issues in the same order.
+/// The issues of one message, each kind at most once, listed in the order the checks find
+/// them ([`Issues::ORDER`]: the orientation, then the covariance's checks in the order
+/// [`classify`](super::classify) makes them, then the trend's). Compares equal to a `Vec` or
+/// slice of the same issues in that order.
+///
+/// It is one bit per kind in a `u32`: [`Issues::ORDER`] holds every kind of [`Issue`] once,
+/// which a compile-time check proves (a kind's bit is an exhaustive `match`, and the bits are
+/// checked to be distinct and below 32), so no message can have an issue it cannot hold.
 ///
 /// ```
 /// use posecov::input::bag::health::Issues;
@@ -13,54 +21,115 @@ use crate::plan::bag::Issue;
 /// issues.push(Issue::Placeholder);
 /// issues.push(Issue::Drop);
 /// assert_eq!(issues, vec![Issue::Placeholder, Issue::Drop]);
-/// assert!(issues.contains(&Issue::Drop) && !issues.is_empty());
+/// assert!(issues.contains(Issue::Drop) && !issues.is_empty());
+/// issues.push(Issue::Placeholder); // the same kind again: held once
+/// assert_eq!(issues.len(), 2);
 /// ```
-#[derive(Debug, Clone, Copy)]
-pub struct Issues {
-    items: [Issue; Issues::CAPACITY],
-    len: usize,
-}
-
-impl Default for Issues {
-    fn default() -> Self {
-        Self {
-            items: [Issue::NonFinite; Issues::CAPACITY],
-            len: 0,
-        }
-    }
-}
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
+pub struct Issues(u32);
 
 impl Issues {
-    /// More than one message can have: one word per check of [`classify`](super::classify)
-    /// and [`Trend`](super::Trend).
-    pub const CAPACITY: usize = 8;
+    /// Every kind of issue, in the order a message lists them: the order the checks find them
+    /// (the orientation; the covariance: not finite, ROS's −1, all zero, placeholders,
+    /// asymmetric, not PSD; the position trace's trend), then the kinds found per topic or
+    /// per log (never in a message's list today), in [`Issue::ALL`]'s order.
+    pub const ORDER: [Issue; 21] = [
+        Issue::BadOrientation,
+        Issue::NonFinite,
+        Issue::UnknownMarker,
+        Issue::AllZero,
+        Issue::PlaceholderUsedAxis,
+        Issue::Placeholder,
+        Issue::Asymmetric,
+        Issue::NotPsd,
+        Issue::Drop,
+        Issue::Growth,
+        Issue::Undecodable,
+        Issue::Constant,
+        Issue::FrozenStamp,
+        Issue::TypeChange,
+        Issue::TfCycle,
+        Issue::TfSeveralParents,
+        Issue::StampFallback,
+        Issue::StampOrder,
+        Issue::TfMissingLink,
+        Issue::TfNoTransform,
+        Issue::TfTiltsPlane,
+    ];
 
-    /// Adds `issue` (beyond [`Self::CAPACITY`] it is not kept; no message has that many).
-    pub fn push(&mut self, issue: Issue) {
-        if let Some(slot) = self.items.get_mut(self.len) {
-            *slot = issue;
-            self.len += 1;
+    /// The bit of `issue`: its place in [`Self::ORDER`]. An exhaustive `match`: a new kind of
+    /// issue does not compile until it has a bit.
+    const fn bit(issue: Issue) -> u32 {
+        match issue {
+            Issue::BadOrientation => 0,
+            Issue::NonFinite => 1,
+            Issue::UnknownMarker => 2,
+            Issue::AllZero => 3,
+            Issue::PlaceholderUsedAxis => 4,
+            Issue::Placeholder => 5,
+            Issue::Asymmetric => 6,
+            Issue::NotPsd => 7,
+            Issue::Drop => 8,
+            Issue::Growth => 9,
+            Issue::Undecodable => 10,
+            Issue::Constant => 11,
+            Issue::FrozenStamp => 12,
+            Issue::TypeChange => 13,
+            Issue::TfCycle => 14,
+            Issue::TfSeveralParents => 15,
+            Issue::StampFallback => 16,
+            Issue::StampOrder => 17,
+            Issue::TfMissingLink => 18,
+            Issue::TfNoTransform => 19,
+            Issue::TfTiltsPlane => 20,
         }
     }
 
-    /// The issues, in the order found.
-    pub fn as_slice(&self) -> &[Issue] {
-        &self.items[..self.len]
-    }
-
-    /// The issues, in the order found.
-    pub fn iter(&self) -> std::slice::Iter<'_, Issue> {
-        self.as_slice().iter()
+    /// Adds `issue` (a kind already held stays held once: one finding per message).
+    pub fn push(&mut self, issue: Issue) {
+        self.0 |= 1 << Self::bit(issue);
     }
 
     /// Whether `issue` is among them.
-    pub fn contains(&self, issue: &Issue) -> bool {
-        self.as_slice().contains(issue)
+    pub fn contains(&self, issue: Issue) -> bool {
+        self.0 & (1 << Self::bit(issue)) != 0
     }
 
     /// Whether there is none.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.0 == 0
+    }
+
+    /// How many kinds.
+    pub fn len(&self) -> usize {
+        self.0.count_ones() as usize
+    }
+
+    /// The issues, in [`Self::ORDER`].
+    pub fn iter(&self) -> impl Iterator<Item = Issue> + use<> {
+        let mut bits = self.0;
+        std::iter::from_fn(move || {
+            let b = bits.trailing_zeros();
+            bits &= bits.wrapping_sub(1);
+            Self::ORDER.get(b as usize).copied()
+        })
+    }
+}
+
+/// Proves at compile time that every kind has its own bit below 32 and is where
+/// [`Issues::ORDER`] lists it (so [`Issues::iter`] gives back what was pushed).
+const _: () = {
+    assert!(Issues::ORDER.len() == Issue::ALL.len() && Issues::ORDER.len() <= 32);
+    let mut k = 0;
+    while k < Issues::ORDER.len() {
+        assert!(Issues::bit(Issues::ORDER[k]) == k as u32);
+        k += 1;
+    }
+};
+
+impl fmt::Debug for Issues {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
     }
 }
 
@@ -72,30 +141,52 @@ impl Extend<Issue> for Issues {
     }
 }
 
-impl<'a> IntoIterator for &'a Issues {
-    type Item = &'a Issue;
-    type IntoIter = std::slice::Iter<'a, Issue>;
-    fn into_iter(self) -> Self::IntoIter {
-        self.iter()
+impl PartialEq<[Issue]> for Issues {
+    fn eq(&self, other: &[Issue]) -> bool {
+        self.iter().eq(other.iter().copied())
     }
 }
-
-impl PartialEq for Issues {
-    fn eq(&self, other: &Issues) -> bool {
-        self.as_slice() == other.as_slice()
-    }
-}
-
-impl Eq for Issues {}
 
 impl PartialEq<Vec<Issue>> for Issues {
     fn eq(&self, other: &Vec<Issue>) -> bool {
-        self.as_slice() == other.as_slice()
+        self == other.as_slice()
     }
 }
 
-impl PartialEq<[Issue]> for Issues {
-    fn eq(&self, other: &[Issue]) -> bool {
-        self.as_slice() == other
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_kind_is_held_in_order() {
+        // Every kind at once, each pushed twice in the reverse order: all kept, in ORDER.
+        let mut issues = Issues::default();
+        for issue in Issue::ALL.iter().rev().chain(Issue::ALL.iter()) {
+            issues.push(*issue);
+        }
+        assert_eq!(issues.len(), Issue::ALL.len());
+        assert_eq!(issues, Issues::ORDER.to_vec());
+        assert!(Issue::ALL.iter().all(|i| issues.contains(*i)));
+        // The order a message's checks push them in is the order listed.
+        let mut found = Issues::default();
+        found.extend([
+            Issue::BadOrientation,
+            Issue::AllZero,
+            Issue::Placeholder,
+            Issue::Drop,
+        ]);
+        assert_eq!(
+            found,
+            vec![
+                Issue::BadOrientation,
+                Issue::AllZero,
+                Issue::Placeholder,
+                Issue::Drop
+            ]
+        );
+        assert_eq!(
+            format!("{found:?}"),
+            "[BadOrientation, AllZero, Placeholder, Drop]"
+        );
     }
 }
