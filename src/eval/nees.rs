@@ -236,7 +236,7 @@ impl NeesObserver {
         let tf_parent = self
             .settings
             .tf_parent_required
-            .then(|| self.reference_frame.clone().unwrap_or_default());
+            .then(|| self.reference_frame.as_deref().unwrap_or_default());
         let Some(state) = self.topics.get_mut(topic) else {
             return;
         };
@@ -325,23 +325,29 @@ impl LogObserver for NeesObserver {
             return;
         }
         let every = self.settings.every;
-        let state = self
-            .topics
-            .entry(m.topic.to_owned())
-            .or_insert_with(|| TopicState {
-                frame_id: m.frame_id.trim_start_matches('/').to_owned(),
-                dof: None,
-                pending: VecDeque::new(),
-                matched: Vec::new(),
-                alignment: None,
-                sums: Sums::default(),
-                skipped: Skipped::default(),
-                series: match every {
-                    Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
-                    None => Decimator::new(1, DEFAULT_MAX_DRAWN),
+        if !self.topics.contains_key(m.topic) {
+            // The topic's name is allocated once, not per message.
+            self.topics.insert(
+                m.topic.to_owned(),
+                TopicState {
+                    frame_id: m.frame_id.trim_start_matches('/').to_owned(),
+                    dof: None,
+                    pending: VecDeque::new(),
+                    matched: Vec::new(),
+                    alignment: None,
+                    sums: Sums::default(),
+                    skipped: Skipped::default(),
+                    series: match every {
+                        Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
+                        None => Decimator::new(1, DEFAULT_MAX_DRAWN),
+                    },
+                    bound: None,
                 },
-                bound: None,
-            });
+            );
+        }
+        let Some(state) = self.topics.get_mut(m.topic) else {
+            return;
+        };
         let Some(gaussian) = gaussian_of(m, self.settings.reading) else {
             state.skipped.unusable += 1;
             return;

@@ -116,7 +116,8 @@ enum Flow {
 #[derive(Default)]
 struct Streams {
     schemas: HashMap<u16, (String, String)>,
-    channels: HashMap<u16, Stream>,
+    /// By channel id (a `u16`): an index, not a hash, per message.
+    channels: Vec<Option<Stream>>,
 }
 
 impl Streams {
@@ -167,7 +168,11 @@ impl Streams {
                     reference,
                 };
                 collector.declare_stream(&stream);
-                self.channels.insert(id, stream);
+                let at = usize::from(id);
+                if self.channels.len() <= at {
+                    self.channels.resize_with(at + 1, || None);
+                }
+                self.channels[at] = Some(stream);
             }
             McapRecord::Message {
                 channel_id,
@@ -178,7 +183,9 @@ impl Streams {
                     return Ok(Flow::Stop);
                 }
                 collector.message_on(
-                    self.channels.get(&channel_id),
+                    self.channels
+                        .get(usize::from(channel_id))
+                        .and_then(Option::as_ref),
                     "channel",
                     channel_id.into(),
                     log_time,
