@@ -90,8 +90,28 @@ fn tf(parent: &str, child: &str, t: f64, x: &Se3) -> TransformStamped {
 
 /// `/odom` (Odometry in `odom_frame`, 20 Hz from 10 s to 30 s), `/amcl_pose` (in `map`, 2 Hz),
 /// `/tf`: `map_edges` at 5 Hz from 11 s to 29 s (the odometry's first and last second fall
-/// outside it) and odom → base_link at 20 Hz; `/tf_static` base_link → laser.
+/// outside it) and odom → base_link at 20 Hz; `/tf_static` base_link → laser. Both pose
+/// topics publish [`planar_cov`] throughout.
 fn log(odom_frame: &str, map_edges: &[(&str, &str)]) -> Vec<u8> {
+    log_with(odom_frame, map_edges, |_| planar_cov())
+}
+
+/// The odometry's covariance at t seconds as dead reckoning makes it: [`planar_cov`] growing
+/// linearly from 10 s (× 6 by 30 s), while AMCL's stays bounded.
+fn growing_cov(t: f64) -> [f64; 36] {
+    let mut c = planar_cov();
+    for i in [0, 1, 6, 7, 35] {
+        c[i] *= 1.0 + 0.25 * (t - 10.0);
+    }
+    c
+}
+
+/// [`log`] with the odometry's covariance at t seconds `odom_cov(t)`.
+fn log_with(
+    odom_frame: &str,
+    map_edges: &[(&str, &str)],
+    odom_cov: fn(f64) -> [f64; 36],
+) -> Vec<u8> {
     let mut log = McapLog::new();
     let laser = Se3::from_xyz_rpy([0.2, 0.0, 0.3], [0.0; 3]);
     let static_tf = TfMessage {
@@ -110,7 +130,7 @@ fn log(odom_frame: &str, map_edges: &[(&str, &str)]) -> Vec<u8> {
             child_frame_id: "base_link".into(),
             pose: PoseWithCovariance {
                 pose: pose_of(&odom_from_base(t)),
-                covariance: nested(&planar_cov()),
+                covariance: nested(&odom_cov(t)),
             },
             twist: Default::default(),
         };
@@ -144,6 +164,42 @@ fn log(odom_frame: &str, map_edges: &[(&str, &str)]) -> Vec<u8> {
         }
     }
     log.finish()
+}
+
+/// The committed AMCL-like log (the README's picture of a join): this file's [`log_with`] with
+/// AMCL's map → odom and the odometry's covariance growing as dead reckoning's does
+/// ([`growing_cov`]). `POSECOV_UPDATE_GOLDEN=1 cargo test --test bag_frames` rewrites it.
+const AMCL_EXAMPLE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mcap/amcl_tf.mcap");
+
+#[test]
+fn committed_amcl_log_is_the_generators_output() {
+    let bytes = log_with("odom", &[("map", "odom")], growing_cov);
+    if std::env::var_os("POSECOV_UPDATE_GOLDEN").is_some() {
+        std::fs::write(AMCL_EXAMPLE, &bytes).expect("write the example");
+    }
+    // The writer's summary order is not byte-stable; what reading it gives must be the same.
+    let options = BagOptions {
+        every: Some(1),
+        ..Default::default()
+    };
+    let generated = file("amcl_generated.mcap", &bytes);
+    let read = |path: &Path| read_bag(path, &options, &mut |_, _| {}, None).expect("read");
+    assert!(
+        read(Path::new(AMCL_EXAMPLE)) == read(&generated),
+        "tests/data/mcap/amcl_tf.mcap is not this generator's output: rerun with POSECOV_UPDATE_GOLDEN=1"
+    );
+    // What the README shows: /odom (in odom) drawn in map beside /amcl_pose.
+    let run = log_run(Path::new(AMCL_EXAMPLE));
+    let odom = run.evaluation.topics.iter().find(|t| t.name == "/odom");
+    let join = odom.and_then(|t| t.joined.as_ref()).expect("joined");
+    assert_eq!((join.from.as_str(), join.to.as_str()), ("odom", "map"));
+    assert!(run.evaluation.frames.problems.is_empty());
+    // The odometry's covariance grows: no defect, so `check` passes with nothing allowed.
+    let out = Command::new(BIN)
+        .args(["check", AMCL_EXAMPLE])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
 }
 
 fn file(name: &str, bytes: &[u8]) -> PathBuf {
