@@ -8,7 +8,7 @@
 //!   10 Hz).
 //! - `nees_bench report FILE` runs what `posecov report FILE --reference /ground_truth --json`
 //!   runs (the library call the binary makes: the log read and streamed, every estimate's NEES,
-//!   the health, the drawn messages and the scene) and prints one JSON line per estimate
+//!   the health and the drawn messages; `report` draws no scene) and prints one JSON line per estimate
 //!   topic — messages, ANEES, position and orientation ANEES, inside_95 — for
 //!   `benches/nees_rosbags.py` to be compared with, plus the seconds it took.
 
