@@ -34,10 +34,17 @@ pub const LEFT_SHARE: f32 = 3.0;
 /// The right column's share of the window.
 pub const RIGHT_SHARE: f32 = 2.0;
 
-/// Width of an average character of the viewer's 13-point Inter, with room for word wraps.
-const CHAR_WIDTH: f64 = 7.2;
-/// Height of a line of label text.
-const LINE_HEIGHT: f64 = 17.0;
+/// The size of the viewer's label text (its 13-point Inter), in points.
+const LABEL_SIZE: f64 = 13.0;
+/// How much wider than [`text_width`] (Liberation Sans) the legend reckons the viewer's label
+/// lines: the viewer's Inter is not bundled here, so its lines were measured instead, in a
+/// screenshot at 1024 × 640 (2 pixels a point): five of se3_global_vs_local's legend lines
+/// were 0.98–0.99 of their [`text_width`] at 13 points. The 4 % over that is a margin for
+/// where the viewer breaks a line.
+const VIEWER_WIDER: f64 = 1.04;
+/// Height of a line of label text: the viewer's lines are 14.5 points apart (measured in
+/// the same screenshot).
+const LINE_HEIGHT: f64 = 15.0;
 /// Above the words: the bar, and the viewer's 5-point gap and 4-point label padding.
 const BAR_SPACE: f64 = 16.0;
 /// Below the words, to the next row.
@@ -130,18 +137,81 @@ pub fn tile_words(entry: &LegendEntry) -> String {
 /// Colour of the words and bar of an axes entry (its own colour is not used).
 pub const AXES_WORDS: Color = Color::rgb(210, 210, 210);
 
-/// Lines the words take in a tile `width` wide (never 0).
+/// Lines the words take in a tile `width` wide (never 0): [`wrap`] at the viewer's label size,
+/// widened for its font.
 fn lines(text: &str, width: f64) -> usize {
-    let per_line = ((width - 2.0 * PAD) / CHAR_WIDTH).floor().max(8.0) as usize;
-    let mut lines = 1;
-    let mut used = 0;
-    for word in text.split(' ') {
-        let n = word.chars().count();
-        if used > 0 && used + 1 + n > per_line {
-            lines += 1;
-            used = n;
-        } else {
-            used += if used > 0 { 1 + n } else { n };
+    wrap(text, LABEL_SIZE * VIEWER_WIDER, width - 2.0 * PAD)
+        .len()
+        .max(1)
+}
+
+/// Advance widths of the printable ASCII characters, `' '` to `'~'`, in Liberation Sans (the
+/// figures' bundled font, `assets/fonts/LiberationSans-Regular.ttf`; its `hmtx` table at 2048
+/// units per em), in thousandths of an em.
+#[rustfmt::skip]
+const ASCII_ADVANCES: [u16; 95] = [
+    278, 278, 355, 556, 556, 889, 667, 191, 333, 333, 389, 584, 278, 333, 278, 278, // ' '..'/'
+    556, 556, 556, 556, 556, 556, 556, 556, 556, 556, 278, 278, 584, 584, 584, 556, // '0'..'?'
+    1015, 667, 667, 722, 722, 667, 611, 778, 722, 278, 500, 667, 556, 833, 722, 778, // '@'..'O'
+    667, 778, 722, 667, 611, 722, 667, 944, 667, 667, 611, 278, 278, 278, 469, 556, // 'P'..'_'
+    333, 556, 556, 500, 556, 556, 278, 556, 556, 222, 222, 500, 222, 833, 556, 556, // '`'..'o'
+    556, 556, 333, 500, 278, 556, 500, 722, 500, 500, 500, 334, 260, 334, 584, // 'p'..'~'
+];
+
+/// A character's advance width in Liberation Sans, in thousandths of an em: the font's own for
+/// ASCII and the signs posecov's words use; a full em for anything else (errs wide).
+fn advance(c: char) -> u16 {
+    match c {
+        ' '..='~' => ASCII_ADVANCES[c as usize - ' ' as usize],
+        '·' | '²' | '³' | '¹' => 333,
+        '°' => 400,
+        '–' => 556,
+        '×' => 584,
+        '±' | '≈' | '≤' | '≥' | '√' => 549,
+        // Greek: σ 617, Σ 618, ρ 569, θ 556, ω 781 …
+        'α'..='ω' | 'Α'..='Ω' => 650,
+        _ => 1000,
+    }
+}
+
+/// How wide `text` is set at `size` (points or pixels) in Liberation Sans, the figures' font:
+/// the sum of its characters' advance widths (kerning, which only narrows, left out). The
+/// figures wrap and place their words with it, and the viewer's legend with it widened for
+/// the viewer's font.
+///
+/// ```
+/// use posecov::scene::layout::text_width;
+/// assert!((text_width("Hi", 10.0) - 9.44).abs() < 1e-9); // H 722 + i 222 thousandths
+/// ```
+pub fn text_width(text: &str, size: f64) -> f64 {
+    let thousandths: u32 = text.chars().map(|c| u32::from(advance(c))).sum();
+    f64::from(thousandths) * size / 1000.0
+}
+
+/// `text` broken at spaces into lines no wider than `width` at `size` ([`text_width`]); a
+/// single longer word stays whole on its line.
+///
+/// ```
+/// use posecov::scene::layout::wrap;
+/// assert_eq!(wrap("first order: Cartesian ellipse", 10.0, 100.0), ["first order: Cartesian", "ellipse"]);
+/// assert!(wrap("", 10.0, 100.0).is_empty());
+/// ```
+pub fn wrap(text: &str, size: f64, width: f64) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let space = text_width(" ", size);
+    let mut used = 0.0;
+    for word in text.split_whitespace() {
+        let w = text_width(word, size);
+        match lines.last_mut() {
+            Some(line) if used + space + w <= width => {
+                line.push(' ');
+                line.push_str(word);
+                used += space + w;
+            }
+            _ => {
+                lines.push(word.to_owned());
+                used = w;
+            }
         }
     }
     lines
@@ -257,7 +327,7 @@ mod tests {
     #[test]
     fn words_wrap_at_the_tile_width() {
         assert_eq!(lines("short", 200.0), 1);
-        // 200 − 16 = 184 units: 25 characters a line.
+        // 200 − 16 = 184 units at 13.5 points: about 27 characters a line.
         let long = "first order: Exp-mapped 95 % region — sky blue";
         assert_eq!(lines(long, 200.0), 2);
         assert_eq!(lines(long, 600.0), 1);

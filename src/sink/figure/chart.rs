@@ -187,15 +187,24 @@ pub fn scale_bar(svg: &mut Svg, area: Rect, metres: f64, scale: f64, pen: Pen) {
     svg.close();
 }
 
-/// Draws the legend in `area` (swatch, then the label wrapped to the width); returns the
-/// height used.
+/// Draws the legend in `area` (swatch, then the label wrapped to the width), an entry that
+/// reads, looks and is coloured like an earlier one once; returns the height used.
 pub fn legend(svg: &mut Svg, area: Rect, entries: &[LegendEntry], pen: Pen) -> f64 {
     let f = pen.font;
     let swatch_w = 2.2 * f;
     let text_x = area.x + swatch_w + 0.6 * f;
     let mut y = area.y;
     svg.open("class=\"legend\"");
-    for entry in entries {
+    for (k, entry) in entries.iter().enumerate() {
+        let same = |e: &LegendEntry| {
+            e.label == entry.label
+                && e.detail == entry.detail
+                && e.swatch == entry.swatch
+                && e.color == entry.color
+        };
+        if entries[..k].iter().any(same) {
+            continue;
+        }
         let lines = wrap(&entry.text(), f, area.right() - text_x);
         let needed = 1.25 * f * lines.len() as f64 + 0.35 * f;
         if y + needed > area.bottom() {

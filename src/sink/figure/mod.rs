@@ -27,6 +27,7 @@ use crate::scene::{ItemKind, Scene, SceneItem, Timeline, Timing};
 
 pub mod chart;
 mod raster;
+mod region;
 pub mod svg;
 pub mod world;
 
@@ -404,7 +405,7 @@ fn draw_world(
     axes.grid(out, pen);
     area.clip(out, "world");
     out.open("class=\"world\" clip-path=\"url(#world)\"");
-    world::draw_regions(out, items, plane, &m, pen);
+    region::draw_regions(out, items, plane, &m, pen);
     world::draw_clouds(out, items, plane, &m, pen);
     world::draw_lines(out, items, plane, &m, pen);
     world::draw_labels(

@@ -1,5 +1,5 @@
-//! A small SVG writer: elements appended to a string with every number rounded to 0.01 px, so
-//! the same scene gives the same bytes.
+//! A small SVG writer: elements appended to a string with every number rounded (to 0.01 px,
+//! path coordinates to 0.1 px), so the same scene gives the same bytes.
 
 use std::fmt::Write as _;
 
@@ -59,22 +59,116 @@ pub fn escape(text: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// A path's `d` through points (`M x y L x y …`, closed with `Z` when asked).
+/// A coordinate in a path's data: one decimal at most, no trailing zeros, no `-0`. A tenth
+/// of a pixel is finer than any screen or print shows a figure; a second decimal made the long
+/// paths a fifth longer and the PDF conversion slower for nothing seen.
+///
+/// ```
+/// use posecov::sink::figure::svg::coord;
+/// assert_eq!(coord(12.0), "12");
+/// assert_eq!(coord(-0.04), "0");
+/// assert_eq!(coord(2.345_678), "2.3");
+/// ```
+pub fn coord(v: f64) -> String {
+    let mut out = String::new();
+    push_coord(&mut out, v);
+    out
+}
+
+/// Appends [`coord`] of `v` to `out` (no allocation: paths have hundreds of thousands).
+fn push_coord(out: &mut String, v: f64) {
+    let tenths = (v * 10.0).round();
+    if !tenths.is_finite() {
+        out.push('0');
+        return;
+    }
+    let tenths = tenths as i64;
+    if tenths < 0 {
+        out.push('-');
+    }
+    let t = tenths.unsigned_abs();
+    let _ = write!(out, "{}", t / 10);
+    if !t.is_multiple_of(10) {
+        let _ = write!(out, ".{}", t % 10);
+    }
+}
+
+/// A path's `d` through points (`M x y L x y …`, closed with `Z` when asked), each
+/// coordinate to a tenth of a pixel ([`coord`]); a point that rounds to the one before it is
+/// left out.
 pub fn path_data(points: &[Px], closed: bool) -> String {
-    let mut d = String::with_capacity(points.len() * 14);
-    for (i, p) in points.iter().enumerate() {
-        let _ = write!(
-            d,
-            "{}{} {}",
-            if i == 0 { "M" } else { "L" },
-            num(p[0]),
-            num(p[1])
-        );
+    let mut d = String::with_capacity(points.len() * 12);
+    let mut last: Option<[i64; 2]> = None;
+    for p in points {
+        let here = p.map(|v| (v * 10.0).round() as i64);
+        if last == Some(here) {
+            continue;
+        }
+        d.push(if last.is_none() { 'M' } else { 'L' });
+        push_coord(&mut d, p[0]);
+        d.push(' ');
+        push_coord(&mut d, p[1]);
+        last = Some(here);
     }
     if closed {
         d.push('Z');
     }
     d
+}
+
+/// How far a simplified line may pass from a point it leaves out, in pixels: a tenth, like
+/// the coordinates' rounding.
+pub const SIMPLIFY_TOLERANCE: f64 = 0.1;
+
+/// A polyline with the points left out that lie within `tolerance` of the straight line
+/// between the points kept around them (Douglas–Peucker): the same line to within that
+/// distance, with far fewer corners where a smooth curve is small on the page (an ellipse of
+/// 96 points a few pixels across). The first and last points are always kept.
+///
+/// ```
+/// use posecov::sink::figure::svg::simplified;
+/// let line = [[0.0, 0.0], [1.0, 0.01], [2.0, 0.0], [2.0, 5.0]];
+/// assert_eq!(simplified(&line, 0.1), vec![[0.0, 0.0], [2.0, 0.0], [2.0, 5.0]]);
+/// ```
+pub fn simplified(points: &[Px], tolerance: f64) -> Vec<Px> {
+    if points.len() < 3 {
+        return points.to_vec();
+    }
+    let mut keep = vec![false; points.len()];
+    keep[0] = true;
+    keep[points.len() - 1] = true;
+    let mut spans = vec![(0, points.len() - 1)];
+    while let Some((a, b)) = spans.pop() {
+        let (p, q) = (points[a], points[b]);
+        let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+        let length = dx.hypot(dy);
+        let distance = |r: Px| {
+            if length > 0.0 {
+                ((r[0] - p[0]) * dy - (r[1] - p[1]) * dx).abs() / length
+            } else {
+                (r[0] - p[0]).hypot(r[1] - p[1])
+            }
+        };
+        let farthest = (a + 1..b).map(|k| (k, distance(points[k]))).fold(
+            None,
+            |best: Option<(usize, f64)>, (k, d)| match best {
+                Some((_, bd)) if bd >= d => best,
+                _ => Some((k, d)),
+            },
+        );
+        if let Some((k, d)) = farthest
+            && d > tolerance
+        {
+            keep[k] = true;
+            spans.push((a, k));
+            spans.push((k, b));
+        }
+    }
+    points
+        .iter()
+        .zip(keep)
+        .filter_map(|(p, k)| k.then_some(*p))
+        .collect()
 }
 
 /// Horizontal anchor of a text.
@@ -137,7 +231,8 @@ impl Svg {
         );
     }
 
-    /// An open polyline (or a closed outline), stroked, not filled.
+    /// An open polyline (or a closed outline), stroked, not filled, [`simplified`] to
+    /// [`SIMPLIFY_TOLERANCE`].
     pub fn polyline(&mut self, points: &[Px], closed: bool, color: Color, width: f64, extra: &str) {
         if points.len() < 2 {
             return;
@@ -145,7 +240,7 @@ impl Svg {
         let _ = writeln!(
             self.out,
             "<path d=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linejoin=\"round\"{extra}/>",
-            path_data(points, closed),
+            path_data(&simplified(points, SIMPLIFY_TOLERANCE), closed),
             rgb(color),
             num(width)
         );
@@ -174,25 +269,28 @@ impl Svg {
         );
     }
 
-    /// Filled dots of one colour, all `radius` wide, as one path of circles with `attributes`
-    /// (a cloud's samples). One element, not one per dot: converting a figure costs per
-    /// element (svg2pdf ≈ 40 µs each), and se3_global_vs_local's 36 000 dots as circles took
-    /// 1.4 s to become a PDF (BENCHMARKS.md §9). Nothing is written without dots.
+    /// Dots of one colour, all `radius` wide, as one path with `attributes` (a cloud's
+    /// samples; its `stroke` is the dots' colour): each dot a zero-length stroke with round
+    /// caps, `Mx yh0`, which SVG and PDF both paint as a filled disc. One element, not one per
+    /// dot (converting a figure costs per element: svg2pdf ≈ 40 µs each), and a short one: a
+    /// dot written as two arcs was 50 bytes of SVG and four Bézier curves of PDF, which svg2pdf
+    /// then compresses (BENCHMARKS.md §9). Nothing is written without dots.
     pub fn dots(&mut self, centers: impl IntoIterator<Item = Px>, radius: f64, attributes: &str) {
         let mut centers = centers.into_iter().peekable();
         if centers.peek().is_none() {
             return;
         }
-        let (r, across) = (num(radius), num(2.0 * radius));
-        let _ = write!(self.out, "<path {attributes} d=\"");
+        let _ = write!(
+            self.out,
+            "<path {attributes} fill=\"none\" stroke-width=\"{}\" stroke-linecap=\"round\" d=\"",
+            num(2.0 * radius)
+        );
         for c in centers {
-            // Two half-circle arcs from the leftmost point round and back.
-            let _ = write!(
-                self.out,
-                "M{} {}a{r} {r} 0 1 0 {across} 0a{r} {r} 0 1 0 -{across} 0",
-                num(c[0] - radius),
-                num(c[1])
-            );
+            self.out.push('M');
+            push_coord(&mut self.out, c[0]);
+            self.out.push(' ');
+            push_coord(&mut self.out, c[1]);
+            self.out.push_str("h0");
         }
         self.out.push_str("\"/>\n");
     }
@@ -221,30 +319,6 @@ impl Svg {
     }
 }
 
-/// Roughly how wide `text` is at `size` pixels in the bundled font (its average advance is
-/// about 0.53 em): enough to wrap legend lines and keep labels apart.
-pub fn text_width(text: &str, size: f64) -> f64 {
-    0.53 * size * text.chars().count() as f64
-}
-
-/// `text` broken into lines no wider than `width` at `size` pixels (at word boundaries; a
-/// single longer word stays whole).
-///
-/// ```
-/// use posecov::sink::figure::svg::wrap;
-/// // At 10 px a line of 100 px holds about 18 characters.
-/// assert_eq!(wrap("first order: Cartesian ellipse", 10.0, 100.0), vec!["first order:", "Cartesian ellipse"]);
-/// ```
-pub fn wrap(text: &str, size: f64, width: f64) -> Vec<String> {
-    let mut lines: Vec<String> = Vec::new();
-    for word in text.split_whitespace() {
-        match lines.last_mut() {
-            Some(line) if text_width(&format!("{line} {word}"), size) <= width => {
-                line.push(' ');
-                line.push_str(word);
-            }
-            _ => lines.push(word.to_owned()),
-        }
-    }
-    lines
-}
+/// Text is measured and wrapped with the viewer's legend's own measure (the bundled font's
+/// advance widths): one measure for both.
+pub use crate::scene::layout::{text_width, wrap};

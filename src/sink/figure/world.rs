@@ -2,16 +2,17 @@
 //! with equal scales on both axes so lengths and shapes read true.
 //!
 //! - Point clouds: one dot per sample (at most [`MAX_DOTS`], evenly strided), each cloud one
-//!   path of circles.
+//!   path of circles, leaving out the dots that the cloud's others cover whole
+//!   ([`visible_dots`]).
 //! - Ellipsoids: their exact shadow on the plane, the ellipse of the projected shape matrix
 //!   P R diag(h)² Rᵀ Pᵀ (P the plane's two rows), dashed.
 //! - Surfaces (Exp-mapped bananas): the union of their projected triangles, filled, with a
-//!   darker outline where the union ends.
+//!   darker outline where the union ends (drawn by the figure's region module).
 //! - Line strips, arrows, frames (x red, y green, z blue) and sample triads as lines.
 
 use nalgebra::{Matrix2, Matrix3, SymmetricEigen, UnitQuaternion, Vector3};
 
-use super::svg::{Px, Svg, darker, num, on_white, path_data, rgb};
+use super::svg::{Px, SIMPLIFY_TOLERANCE, Svg, darker, num, on_white, path_data, rgb, simplified};
 use crate::scene::{AXIS_COLORS, Ellipsoid, FillMode, ItemKind, QuatXyzw, SceneItem, Vec3};
 
 /// At most this many dots per cloud (a larger cloud is strided evenly; its statistics are
@@ -180,47 +181,6 @@ pub struct Pen {
     pub font: f64,
 }
 
-/// Draws the filled regions (surfaces) of `items`: first, under everything else.
-pub fn draw_regions(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mapping, pen: Pen) {
-    for item in items {
-        let ItemKind::Surface(s) = &item.kind else {
-            continue;
-        };
-        // Each projected triangle counter-clockwise on screen, so the non-zero fill of one path
-        // is the union of the triangles (no holes where two overlap with opposite windings).
-        let mut d = String::new();
-        for t in &s.triangles {
-            let mut p: Vec<Px> = t
-                .iter()
-                .map(|&i| m.px(plane.project(s.vertices[i as usize])))
-                .collect();
-            let area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
-                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
-            if area.abs() < 1e-9 {
-                continue;
-            }
-            if area < 0.0 {
-                p.swap(1, 2);
-            }
-            d.push_str(&path_data(&p, true));
-        }
-        if d.is_empty() {
-            continue;
-        }
-        let color = s.color;
-        // The outline: the union stroked dark, then the union filled light on top, so only the
-        // outer half of the stroke shows.
-        svg.open("class=\"region\" opacity=\"0.45\"");
-        svg.raw(&format!(
-            "<path d=\"{d}\" fill=\"{dark}\" stroke=\"{dark}\" stroke-width=\"{}\" stroke-linejoin=\"round\"/>",
-            num(2.4 * pen.unit),
-            dark = rgb(darker(color, 0.35)),
-        ));
-        svg.raw(&format!("<path d=\"{d}\" fill=\"{}\"/>", rgb(color)));
-        svg.close();
-    }
-}
-
 /// Draws the clouds of `items`.
 pub fn draw_clouds(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mapping, pen: Pen) {
     for item in items {
@@ -231,16 +191,94 @@ pub fn draw_clouds(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mappin
         let radius = (cloud.radius * m.scale).clamp(0.6 * pen.unit, 1.6 * pen.unit);
         let alpha = (f64::from(cloud.color.0[3]) / 255.0).min(0.7);
         let color = on_white(darker(cloud.color, 0.25), alpha);
+        let centers: Vec<Px> = cloud
+            .positions
+            .iter()
+            .step_by(stride)
+            .map(|p| m.px(plane.project(*p)))
+            .collect();
         svg.dots(
-            cloud
-                .positions
-                .iter()
-                .step_by(stride)
-                .map(|p| m.px(plane.project(*p))),
+            visible_dots(&centers, radius),
             radius,
-            &format!("class=\"cloud\" fill=\"{}\"", rgb(color)),
+            &format!("class=\"cloud\" stroke=\"{}\"", rgb(color)),
         );
     }
+}
+
+/// The dots of one opaque colour, all `radius` wide, that show: each dot, in order, unless
+/// the dots before it already cover all of it. A cloud is one path filled in one colour, so a
+/// dot inside the others adds nothing to the picture, at any zoom; a dense cloud's core is
+/// most of its samples (BENCHMARKS.md §9).
+///
+/// Coverage is kept on a grid of cells a third of the radius wide: a cell counts as covered
+/// when its four corners lie in one drawn dot (a disc is convex, so the cell does too), and a
+/// dot is left out only when every cell it touches is covered. So a left-out dot is always
+/// inside the drawn ones; near the cloud's edge, where cells are partly covered, dots are kept.
+///
+/// ```
+/// use posecov::sink::figure::world::visible_dots;
+/// // A dense 11 × 11 patch of dots, then one dot inside it: that one is left out.
+/// let mut dots: Vec<[f64; 2]> = (0..121)
+///     .map(|k| [19.0 + 0.2 * (k % 11) as f64, 19.0 + 0.2 * (k / 11) as f64])
+///     .collect();
+/// dots.push([20.1, 20.1]);
+/// let shown = visible_dots(&dots, 1.0);
+/// assert!(!shown.contains(&[20.1, 20.1]));
+/// assert_eq!(shown.len(), 121);
+/// ```
+pub fn visible_dots(centers: &[Px], radius: f64) -> Vec<Px> {
+    let finite: Vec<Px> = centers
+        .iter()
+        .copied()
+        .filter(|c| c.iter().all(|v| v.is_finite()))
+        .collect();
+    if finite.is_empty() || radius <= 0.0 {
+        return finite;
+    }
+    let cell = radius / 3.0;
+    let (mut low, mut high) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for c in &finite {
+        for k in 0..2 {
+            low[k] = low[k].min(c[k] - radius);
+            high[k] = high[k].max(c[k] + radius);
+        }
+    }
+    let size = [0, 1].map(|k| ((high[k] - low[k]) / cell).ceil() as usize + 1);
+    // A grid too large to keep (dots spread over far more than the figure): every dot.
+    if size[0].saturating_mul(size[1]) > 1 << 26 {
+        return finite;
+    }
+    let mut covered = vec![false; size[0] * size[1]];
+    let r2 = radius * radius;
+    let mut shown = Vec::new();
+    for c in finite {
+        // The cells the dot's bounding square touches, in grid coordinates.
+        let first = [0, 1].map(|k| ((c[k] - radius - low[k]) / cell).floor().max(0.0) as usize);
+        let last =
+            [0, 1].map(|k| (((c[k] + radius - low[k]) / cell).floor() as usize).min(size[k] - 1));
+        let cells =
+            || (first[1]..=last[1]).flat_map(move |j| (first[0]..=last[0]).map(move |i| (i, j)));
+        let corner = |i: usize, j: usize| [low[0] + i as f64 * cell, low[1] + j as f64 * cell];
+        let near = |p: Px| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
+        // A cell touches the dot when its nearest point to the centre is inside it.
+        let touches = |i: usize, j: usize| {
+            let [x0, y0] = corner(i, j);
+            near([c[0].clamp(x0, x0 + cell), c[1].clamp(y0, y0 + cell)]) < r2
+        };
+        if cells().all(|(i, j)| !touches(i, j) || covered[j * size[0] + i]) {
+            continue;
+        }
+        for (i, j) in cells() {
+            let inside = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                .iter()
+                .all(|&(di, dj)| near(corner(i + di, j + dj)) <= r2);
+            if inside {
+                covered[j * size[0] + i] = true;
+            }
+        }
+        shown.push(c);
+    }
+    shown
 }
 
 /// Draws the lines of `items`: ellipses, outlines, paths, arrows, triads and frames, with the
@@ -264,6 +302,7 @@ pub fn draw_lines(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mapping
                 for shape in &e.shapes {
                     let points: Vec<Px> =
                         shadow(shape, plane).into_iter().map(|p| m.px(p)).collect();
+                    let points = simplified(&points, SIMPLIFY_TOLERANCE);
                     svg.raw(&format!(
                         "<path class=\"ellipse\" d=\"{}\" stroke=\"{}\" stroke-width=\"{}\"{dash}{}/>",
                         path_data(&points, true),
