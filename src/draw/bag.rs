@@ -30,6 +30,7 @@ use super::{Painter, v3, views};
 use crate::eval::bag::{BagEvaluation, TopicEvaluation};
 use crate::input::{About, Layout};
 use crate::lie::GroupKind;
+use crate::scene::layout::views_aspect;
 use crate::scene::{
     Color, ItemKind, LineStrips, Scene, Swatch, Timeline, Timing, Vec3, View3d, WORLD,
 };
@@ -53,9 +54,6 @@ const RVIZ: Color = Color::rgb(204, 51, 204);
 const MEANING: Color = Method::FirstOrder.color();
 /// Unusable messages.
 const INVALID: Color = Color::rgb(230, 30, 30);
-/// Width over height of one 3-D view when two stand side by side above the plots (a
-/// 1024 × 640 window: the left 60 %, the top 60 % of it).
-const VIEW_ASPECT: f64 = 0.85;
 
 /// What drawing a log needs.
 #[derive(Debug, Clone, PartialEq)]
@@ -202,7 +200,7 @@ fn log_views(scene: &Scene, e: &BagEvaluation, planar: bool) -> Vec<View3d> {
                 Some(format!("{} from {}", t.name, j.from))
             })
             .collect();
-        let mut view = View3d {
+        let view = View3d {
             name: if joined.is_empty() {
                 format!("frame {frame}: the whole log")
             } else {
@@ -218,28 +216,30 @@ fn log_views(scene: &Scene, e: &BagEvaluation, planar: bool) -> Vec<View3d> {
                 .collect(),
             ..Default::default()
         };
-        view.camera = views::camera(
-            &views::points_of(scene, &view, |_| true),
-            &inputs,
-            VIEW_ASPECT,
-        );
-        out.push(view);
+        let points = views::points_of(scene, &view, |_| true);
+        out.push((view, points));
     }
     for t in &e.topics {
         let Some(last) = t.poses.iter().rev().find(|q| q.mean.is_some()) else {
             continue;
         };
-        let mut view = View3d {
+        let view = View3d {
             name: format!("robot scale: {} at the time cursor", t.name),
             include: vec![format!("{}/{}", topic_entity(&t.name), robot::ROBOT)],
             ..Default::default()
         };
         let at = Timing::Stamp(last.stamp_ns);
         let points = views::points_of(scene, &view, |i| i.timing == at);
-        view.camera = views::camera(&points, &inputs, VIEW_ASPECT);
-        out.push(view);
+        out.push((view, points));
     }
-    out
+    // Each camera fitted to the shape its view has above the plots.
+    let aspect = views_aspect(scene, out.len());
+    out.into_iter()
+        .map(|(mut view, points)| {
+            view.camera = views::camera(&points, &inputs, aspect);
+            view
+        })
+        .collect()
 }
 
 fn extent(e: &BagEvaluation) -> f64 {

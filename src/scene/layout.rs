@@ -80,18 +80,39 @@ pub fn has_legend_view(scene: &Scene) -> bool {
     !scene.plots_below && !scene.legend.is_empty()
 }
 
+/// The most plots side by side in one row under a log's views ([`Scene::plots_below`]).
+pub const PLOTS_PER_ROW: usize = 3;
+
+/// The heights of a log's views and of its `rows` rows of plots under them
+/// ([`Scene::plots_below`]), as shares of the left column: the views keep three fifths with
+/// one row, half with more.
+///
+/// ```
+/// use posecov::scene::layout::views_over_plots;
+/// assert_eq!(views_over_plots(1), [3.0, 2.0]);
+/// assert_eq!(views_over_plots(2), [4.0, 2.0, 2.0]);
+/// ```
+pub fn views_over_plots(rows: usize) -> Vec<f32> {
+    std::iter::once(if rows <= 1 { 3.0 } else { 2.0 * rows as f32 })
+        .chain(std::iter::repeat_n(2.0, rows.max(1)))
+        .collect()
+}
+
 /// Width over height of each of `count` 3-D views of `scene` (a grid of them,
-/// [`grid_columns`]) above its legend view, if it has one ([`has_legend_view`]), at
-/// 1024 × 640. Not for a scene with [`Scene::plots_below`], whose plots share the column.
+/// [`grid_columns`]) at 1024 × 640: above its legend view, if it has one
+/// ([`has_legend_view`]), or, for a log ([`Scene::plots_below`]), above its rows of plots
+/// ([`views_over_plots`]).
 pub fn views_aspect(scene: &Scene, count: usize) -> f64 {
     let columns = grid_columns(count);
     let rows = count.max(1).div_ceil(columns);
-    let legend = if has_legend_view(scene) {
-        legend_share(tiles(&scene.legend).height)
+    let height = if scene.plots_below && !scene.plots.is_empty() {
+        let shares = views_over_plots(scene.plots.len().div_ceil(PLOTS_PER_ROW));
+        DESIGN_HEIGHT * f64::from(shares[0]) / f64::from(shares.iter().sum::<f32>())
+    } else if has_legend_view(scene) {
+        DESIGN_HEIGHT - legend_share(tiles(&scene.legend).height)
     } else {
-        0.0
+        DESIGN_HEIGHT
     };
-    let height = DESIGN_HEIGHT - legend;
     let view_height = (height / rows as f64 - VIEW_CHROME).max(1.0);
     DESIGN_WIDTH / columns as f64 / view_height
 }

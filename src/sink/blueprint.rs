@@ -42,11 +42,11 @@ use super::rerun::{STAMP_TIMELINE, STEP_TIMELINE};
 use super::{APPLICATION_ID, SinkError};
 use crate::scene::layout::{
     DESIGN_HEIGHT, DESIGN_WIDTH, LEFT_SHARE, RIGHT_SHARE, has_legend_view, legend_share, tiles,
+    views_over_plots,
 };
 use crate::scene::{self, Camera, Corner, Scene, View3d};
 
-/// The most plots side by side in one row under the views ([`Scene::plots_below`]).
-pub const PLOTS_PER_ROW: usize = 3;
+pub use crate::scene::layout::PLOTS_PER_ROW;
 
 /// Sends the layout of `scene` through `rec` and makes it the active and default blueprint:
 /// the 3-D views on the left (three fifths; several views in a grid, each with its camera, its
@@ -174,10 +174,7 @@ fn layout_messages(
             )?);
         }
         // The views keep three fifths of the height with one row, half with more.
-        let rows = column.len() - 1;
-        let shares: Vec<f32> = std::iter::once(if rows == 1 { 3.0 } else { 2.0 * rows as f32 })
-            .chain(std::iter::repeat_n(2.0, rows))
-            .collect();
+        let shares = views_over_plots(column.len() - 1);
         let left = log_container(&bp, &mut ids, ContainerKind::Vertical, &column, &shares)?;
         let root = ids.next();
         log_container_at(
