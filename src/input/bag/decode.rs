@@ -3,6 +3,8 @@
 //! deserializer, after the 4-byte encapsulation header). Never panics: truncated or garbage
 //! bytes are an error naming what was being read.
 
+use std::borrow::Cow;
+
 use serde::{Deserialize, Serialize};
 
 use crate::plan::bag::{COV_LEN, PoseMessageKind};
@@ -118,15 +120,24 @@ impl<'a> Ros1<'a> {
         }))
     }
     pub(super) fn string(&mut self, what: &str) -> Result<String, DecodeError> {
+        self.str(what).map(Cow::into_owned)
+    }
+    /// A string borrowed from the message (copied only where it is not UTF-8).
+    pub(super) fn str(&mut self, what: &str) -> Result<Cow<'a, str>, DecodeError> {
         let n = self.u32(what)? as usize;
-        Ok(String::from_utf8_lossy(self.take(n, what)?).into_owned())
+        Ok(String::from_utf8_lossy(self.take(n, what)?))
     }
     /// `std_msgs/Header`: seq, stamp (secs, nsecs), frame_id.
     pub(super) fn header(&mut self) -> Result<(Option<i64>, String), DecodeError> {
+        self.header_borrowed()
+            .map(|(stamp, frame)| (stamp, frame.into_owned()))
+    }
+    /// [`header`](Self::header) with the frame borrowed from the message.
+    pub(super) fn header_borrowed(&mut self) -> Result<(Option<i64>, Cow<'a, str>), DecodeError> {
         let _seq = self.u32("header.seq")?;
         let secs = self.u32("header.stamp.secs")?;
         let nsecs = self.u32("header.stamp.nsecs")?;
-        let frame = self.string("header.frame_id")?;
+        let frame = self.str("header.frame_id")?;
         Ok((stamp(i64::from(secs), nsecs), frame))
     }
 }
@@ -280,10 +291,9 @@ pub fn nested(c: &[f64; COV_LEN]) -> [[f64; 6]; 6] {
 /// 0x0001 / 0x0003 (little endian).
 const CDR_HEADER: usize = 4;
 
-pub(super) fn cdr<T: for<'de> Deserialize<'de>>(
-    bytes: &[u8],
-    what: &str,
-) -> Result<T, DecodeError> {
+/// Decodes a CDR message (encapsulation header included) as `T`, which may borrow its strings
+/// from `bytes`.
+pub(super) fn cdr<'a, T: Deserialize<'a>>(bytes: &'a [u8], what: &str) -> Result<T, DecodeError> {
     let Some(body) = bytes.get(CDR_HEADER..) else {
         return Err(DecodeError(format!(
             "truncated: {} bytes, no CDR encapsulation header",
@@ -305,8 +315,9 @@ pub(super) fn cdr<T: for<'de> Deserialize<'de>>(
         .map_err(|e| DecodeError(format!("{what}: {e}")))
 }
 
-pub(super) fn header_stamp(h: &Header) -> Option<i64> {
-    stamp(i64::from(h.stamp.sec), h.stamp.nanosec)
+/// A header's stamp in ns (`None`: zero).
+pub(super) fn header_stamp(t: Time) -> Option<i64> {
+    stamp(i64::from(t.sec), t.nanosec)
 }
 
 /// Decodes a CDR (ROS 2) message of `kind`, encapsulation header included.
@@ -325,7 +336,7 @@ pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, Decode
     let (stamp_ns, frame_id, child_frame_id, pose, twist) = match kind {
         PoseMessageKind::Odometry => {
             let m: Odometry = cdr(bytes, what)?;
-            let s = header_stamp(&m.header);
+            let s = header_stamp(m.header.stamp);
             (
                 s,
                 m.header.frame_id,
@@ -336,7 +347,7 @@ pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, Decode
         }
         PoseMessageKind::PoseWithCovarianceStamped => {
             let m: PoseWithCovarianceStamped = cdr(bytes, what)?;
-            let s = header_stamp(&m.header);
+            let s = header_stamp(m.header.stamp);
             (s, m.header.frame_id, String::new(), m.pose, None)
         }
         PoseMessageKind::PoseWithCovariance => {

@@ -9,11 +9,13 @@
 //! assert!(ros1_reference_type("geometry_msgs/PoseStamped", "0").unwrap().is_err());
 //! ```
 
-use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
+
+use serde::{Deserialize, Deserializer, Serialize};
 
 use super::Codec;
 use super::decode::{
-    DecodeError, Decoded, Header, Ros1, cdr, decode_cdr, decode_ros1, header_stamp, ros2_kind,
+    DecodeError, Decoded, Header, Ros1, Time, cdr, decode_cdr, decode_ros1, header_stamp, ros2_kind,
 };
 use crate::plan::bag::{PoseMessageKind, ReferenceSample};
 
@@ -102,13 +104,14 @@ pub fn ros2_reference_type(schema_name: &str) -> Option<ReferenceType> {
 }
 
 /// One decoded reference pose: its parent frame, its child frame (empty where the type has
-/// none) and the pose; `stamp_ns` is `None` for a zero stamp.
+/// none) and the pose; `stamp_ns` is `None` for a zero stamp. The frame names are borrowed
+/// from the message's bytes where they can be (a `/tf` message at 100 Hz allocates nothing).
 #[derive(Debug, Clone, PartialEq)]
-pub struct ReferencePose {
+pub struct ReferencePose<'a> {
     /// `header.frame_id`.
-    pub frame_id: String,
+    pub frame_id: Cow<'a, str>,
     /// `child_frame_id` (TransformStamped, Odometry).
-    pub child_frame_id: String,
+    pub child_frame_id: Cow<'a, str>,
     /// The header stamp, ns (`None`: zero).
     pub stamp_ns: Option<i64>,
     /// Position.
@@ -117,12 +120,12 @@ pub struct ReferencePose {
     pub orientation_xyzw: [f64; 4],
 }
 
-impl From<Decoded> for ReferencePose {
+impl From<Decoded> for ReferencePose<'_> {
     /// The pose of a pose-with-covariance message (its covariance left out).
     fn from(d: Decoded) -> Self {
         ReferencePose {
-            frame_id: d.frame_id,
-            child_frame_id: d.child_frame_id,
+            frame_id: d.frame_id.into(),
+            child_frame_id: d.child_frame_id.into(),
             stamp_ns: d.stamp_ns,
             position: d.position,
             orientation_xyzw: d.orientation_xyzw,
@@ -130,7 +133,7 @@ impl From<Decoded> for ReferencePose {
     }
 }
 
-impl ReferencePose {
+impl ReferencePose<'_> {
     /// The sample, its stamp the header's or else `log_time_ns`.
     pub fn sample(&self, log_time_ns: i64) -> ReferenceSample {
         ReferenceSample {
@@ -177,6 +180,146 @@ pub struct PoseStamped {
     pub pose: super::decode::Pose,
 }
 
+/// The poses of one reference message: one, or any number for a `TFMessage` (the first kept
+/// inline, so that the usual one-transform `/tf` message allocates nothing).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Poses<'a> {
+    /// The one pose of a message.
+    One(ReferencePose<'a>),
+    /// None, or several.
+    Many(Vec<ReferencePose<'a>>),
+}
+
+impl<'a> Poses<'a> {
+    /// The poses in message order.
+    pub fn iter(&self) -> std::slice::Iter<'_, ReferencePose<'a>> {
+        match self {
+            Poses::One(pose) => std::slice::from_ref(pose).iter(),
+            Poses::Many(poses) => poses.iter(),
+        }
+    }
+
+    /// How many.
+    pub fn len(&self) -> usize {
+        self.iter().len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl<'a> std::ops::Index<usize> for Poses<'a> {
+    type Output = ReferencePose<'a>;
+    fn index(&self, i: usize) -> &ReferencePose<'a> {
+        match self {
+            Poses::One(pose) => std::slice::from_ref(pose).index(i),
+            Poses::Many(poses) => &poses[i],
+        }
+    }
+}
+
+impl<'a> FromIterator<ReferencePose<'a>> for Poses<'a> {
+    fn from_iter<I: IntoIterator<Item = ReferencePose<'a>>>(poses: I) -> Self {
+        let mut poses = poses.into_iter();
+        let Some(first) = poses.next() else {
+            return Poses::Many(Vec::new());
+        };
+        let Some(second) = poses.next() else {
+            return Poses::One(first);
+        };
+        let mut all = vec![first, second];
+        all.extend(poses);
+        Poses::Many(all)
+    }
+}
+
+impl<'a> IntoIterator for Poses<'a> {
+    type Item = ReferencePose<'a>;
+    type IntoIter = std::iter::Chain<
+        std::option::IntoIter<ReferencePose<'a>>,
+        std::vec::IntoIter<ReferencePose<'a>>,
+    >;
+    fn into_iter(self) -> Self::IntoIter {
+        let (one, many) = match self {
+            Poses::One(pose) => (Some(pose), Vec::new()),
+            Poses::Many(poses) => (None, poses),
+        };
+        one.into_iter().chain(many)
+    }
+}
+
+// The CDR types above as they are read: the same fields in the same order, the frame names
+// borrowed from the message (the types above, with owned strings, are the ones written).
+
+/// `std_msgs/Header` read.
+#[derive(Deserialize)]
+struct HeaderIn<'a> {
+    stamp: Time,
+    frame_id: &'a str,
+}
+
+/// `geometry_msgs/TransformStamped` read.
+#[derive(Deserialize)]
+struct TransformStampedIn<'a> {
+    #[serde(borrow)]
+    header: HeaderIn<'a>,
+    child_frame_id: &'a str,
+    transform: Transform,
+}
+
+impl<'a> From<TransformStampedIn<'a>> for ReferencePose<'a> {
+    fn from(t: TransformStampedIn<'a>) -> Self {
+        ReferencePose {
+            stamp_ns: header_stamp(t.header.stamp),
+            frame_id: t.header.frame_id.into(),
+            child_frame_id: t.child_frame_id.into(),
+            position: t.transform.translation,
+            orientation_xyzw: t.transform.rotation,
+        }
+    }
+}
+
+/// `tf2_msgs/TFMessage` read: its transforms as [`Poses`].
+#[derive(Deserialize)]
+struct TfMessageIn<'a> {
+    #[serde(borrow)]
+    transforms: TransformsIn<'a>,
+}
+
+/// A `TransformStamped[]` read into [`Poses`].
+struct TransformsIn<'a>(Poses<'a>);
+
+impl<'de: 'a, 'a> Deserialize<'de> for TransformsIn<'a> {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Each;
+        impl<'de> serde::de::Visitor<'de> for Each {
+            type Value = Poses<'de>;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a sequence of geometry_msgs/msg/TransformStamped")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<Poses<'de>, A::Error> {
+                std::iter::from_fn(|| seq.next_element::<TransformStampedIn<'de>>().transpose())
+                    .map(|t| t.map(ReferencePose::from))
+                    .collect()
+            }
+        }
+        deserializer.deserialize_seq(Each).map(TransformsIn)
+    }
+}
+
+/// `geometry_msgs/PoseStamped` read.
+#[derive(Deserialize)]
+struct PoseStampedIn<'a> {
+    #[serde(borrow)]
+    header: HeaderIn<'a>,
+    pose: super::decode::Pose,
+}
+
 /// Decodes a reference message of type `kind`: one pose, several for a `TFMessage`.
 ///
 /// ```
@@ -186,16 +329,12 @@ pub struct PoseStamped {
 /// m.extend(b"map");
 /// for v in [1.0f64, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0] { m.extend(v.to_le_bytes()); }
 /// let poses = decode_ros1_reference(ReferenceType::PoseStamped, &m).unwrap();
-/// assert_eq!((poses[0].frame_id.as_str(), poses[0].position), ("map", [1.0, 2.0, 3.0]));
+/// assert_eq!((poses[0].frame_id.as_ref(), poses[0].position), ("map", [1.0, 2.0, 3.0]));
 /// ```
-pub fn decode_ros1_reference(
-    kind: ReferenceType,
-    bytes: &[u8],
-) -> Result<Vec<ReferencePose>, DecodeError> {
-    let mut r = Ros1 { bytes, at: 0 };
-    let transform = |r: &mut Ros1<'_>| -> Result<ReferencePose, DecodeError> {
-        let (stamp_ns, frame_id) = r.header()?;
-        let child_frame_id = r.string("child_frame_id")?;
+pub fn decode_ros1_reference(kind: ReferenceType, bytes: &[u8]) -> Result<Poses<'_>, DecodeError> {
+    fn transform<'a>(r: &mut Ros1<'a>) -> Result<ReferencePose<'a>, DecodeError> {
+        let (stamp_ns, frame_id) = r.header_borrowed()?;
+        let child_frame_id = r.str("child_frame_id")?;
         let position = r.f64s::<3>("transform.translation")?;
         let orientation_xyzw = r.f64s::<4>("transform.rotation")?;
         Ok(ReferencePose {
@@ -205,26 +344,27 @@ pub fn decode_ros1_reference(
             position,
             orientation_xyzw,
         })
-    };
+    }
+    let mut r = Ros1 { bytes, at: 0 };
     match kind {
         ReferenceType::PoseStamped => {
-            let (stamp_ns, frame_id) = r.header()?;
+            let (stamp_ns, frame_id) = r.header_borrowed()?;
             let position = r.f64s::<3>("pose.position")?;
             let orientation_xyzw = r.f64s::<4>("pose.orientation")?;
-            Ok(vec![ReferencePose {
+            Ok(Poses::One(ReferencePose {
                 frame_id,
-                child_frame_id: String::new(),
+                child_frame_id: Cow::Borrowed(""),
                 stamp_ns,
                 position,
                 orientation_xyzw,
-            }])
+            }))
         }
-        ReferenceType::TransformStamped => Ok(vec![transform(&mut r)?]),
+        ReferenceType::TransformStamped => Ok(Poses::One(transform(&mut r)?)),
         ReferenceType::TfMessage => {
             let n = r.u32("transforms (length)")?;
             (0..n).map(|_| transform(&mut r)).collect()
         }
-        ReferenceType::Pose(kind) => Ok(vec![decode_ros1(kind, bytes)?.into()]),
+        ReferenceType::Pose(kind) => Ok(Poses::One(decode_ros1(kind, bytes)?.into())),
     }
 }
 
@@ -239,37 +379,27 @@ pub fn decode_ros1_reference(
 /// let poses = decode_cdr_reference(ReferenceType::TfMessage, &bytes).unwrap();
 /// assert_eq!(poses[0].child_frame_id, "base");
 /// ```
-pub fn decode_cdr_reference(
-    kind: ReferenceType,
-    bytes: &[u8],
-) -> Result<Vec<ReferencePose>, DecodeError> {
-    let of_transform = |t: TransformStamped| ReferencePose {
-        stamp_ns: header_stamp(&t.header),
-        frame_id: t.header.frame_id,
-        child_frame_id: t.child_frame_id,
-        position: t.transform.translation,
-        orientation_xyzw: t.transform.rotation,
-    };
+pub fn decode_cdr_reference(kind: ReferenceType, bytes: &[u8]) -> Result<Poses<'_>, DecodeError> {
     match kind {
         ReferenceType::PoseStamped => {
-            let m: PoseStamped = cdr(bytes, "geometry_msgs/msg/PoseStamped")?;
-            Ok(vec![ReferencePose {
-                stamp_ns: header_stamp(&m.header),
-                frame_id: m.header.frame_id,
-                child_frame_id: String::new(),
+            let m: PoseStampedIn = cdr(bytes, "geometry_msgs/msg/PoseStamped")?;
+            Ok(Poses::One(ReferencePose {
+                stamp_ns: header_stamp(m.header.stamp),
+                frame_id: m.header.frame_id.into(),
+                child_frame_id: Cow::Borrowed(""),
                 position: m.pose.position,
                 orientation_xyzw: m.pose.orientation,
-            }])
+            }))
         }
-        ReferenceType::TransformStamped => Ok(vec![of_transform(cdr(
-            bytes,
-            "geometry_msgs/msg/TransformStamped",
-        )?)]),
+        ReferenceType::TransformStamped => {
+            let m: TransformStampedIn = cdr(bytes, "geometry_msgs/msg/TransformStamped")?;
+            Ok(Poses::One(m.into()))
+        }
         ReferenceType::TfMessage => {
-            let m: TfMessage = cdr(bytes, "tf2_msgs/msg/TFMessage")?;
-            Ok(m.transforms.into_iter().map(of_transform).collect())
+            let m: TfMessageIn = cdr(bytes, "tf2_msgs/msg/TFMessage")?;
+            Ok(m.transforms.0)
         }
-        ReferenceType::Pose(kind) => Ok(vec![decode_cdr(kind, bytes)?.into()]),
+        ReferenceType::Pose(kind) => Ok(Poses::One(decode_cdr(kind, bytes)?.into())),
     }
 }
 
@@ -278,7 +408,7 @@ pub(super) fn decode_reference(
     kind: ReferenceType,
     codec: Codec,
     bytes: &[u8],
-) -> Result<Vec<ReferencePose>, DecodeError> {
+) -> Result<Poses<'_>, DecodeError> {
     match codec {
         Codec::Ros1 => decode_ros1_reference(kind, bytes),
         Codec::Cdr => decode_cdr_reference(kind, bytes),
