@@ -96,10 +96,9 @@ impl<G: LieGroup<N>, const N: usize> UncertainPose<G, N> {
         Ok(Self { mean, cov, side })
     }
 
-    /// [`try_new`](Self::try_new) and the information matrix Σ⁻¹
-    /// ([`try_inverse_covariance`]'s, `Err` when Σ is singular) from the one
-    /// eigen-decomposition that validates Σ: what a consumer of every message of a log (the
-    /// NEES) needs, without decomposing Σ twice.
+    /// [`try_new`](Self::try_new) and Σ⁻¹ as [`try_information`] gives it (`Err` when Σ is
+    /// singular), from the one factorisation that validates Σ: what a consumer of every
+    /// message of a log (the NEES) needs, without factorising Σ twice.
     ///
     /// ```
     /// use posecov::lie::{LieGroup, Se2};
@@ -107,7 +106,7 @@ impl<G: LieGroup<N>, const N: usize> UncertainPose<G, N> {
     /// use nalgebra::Matrix3;
     /// let (pose, info) = UncertainPose::try_new_with_information(Se2::identity(), Matrix3::identity() * 4.0, Side::Right).unwrap();
     /// assert_eq!(pose.cov()[(2, 2)], 4.0);
-    /// assert!((info.unwrap() - Matrix3::identity() * 0.25).norm() < 1e-15);
+    /// assert!((info.unwrap().matrix() - Matrix3::identity() * 0.25).norm() < 1e-15);
     /// let (_, info) = UncertainPose::try_new_with_information(Se2::identity(), Matrix3::zeros(), Side::Right).unwrap();
     /// assert!(info.is_err()); // valid (PSD) but singular
     /// ```
@@ -115,10 +114,9 @@ impl<G: LieGroup<N>, const N: usize> UncertainPose<G, N> {
         mean: G,
         cov: TangentMatrix<N>,
         side: Side,
-    ) -> Result<(Self, Result<TangentMatrix<N>>)> {
-        let what = "covariance";
-        let (cov, eigen) = validate::validated_eigen(what, &cov, true)?;
-        Ok((Self { mean, cov, side }, information(what, eigen)))
+    ) -> Result<(Self, Result<Information<N>>)> {
+        let (cov, information) = validated_information("covariance", &cov)?;
+        Ok((Self { mean, cov, side }, information))
     }
 
     /// Wraps an already-valid (symmetric PSD) covariance without checking it; for results
@@ -334,6 +332,79 @@ pub fn try_inverse_covariance<const N: usize>(
     // The decomposition that validated ½(Σ + Σᵀ) is the one inverted (one, not two).
     let (_, eigen) = validate::validated_eigen(what, cov, true)?;
     information(what, eigen)
+}
+
+/// Σ⁻¹ of a valid, non-singular covariance, as a quadratic form εᵀ Σ⁻¹ ε is taken with it
+/// ([`try_information`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Information<const N: usize> {
+    /// Σ = L Lᵀ (L lower triangular), for a well-conditioned Σ: εᵀ Σ⁻¹ ε = ‖L⁻¹ ε‖².
+    Cholesky(TangentMatrix<N>),
+    /// Σ⁻¹ = V diag(1/λ) Vᵀ from the eigen-decomposition that validated Σ.
+    Inverse(TangentMatrix<N>),
+}
+
+impl<const N: usize> Information<N> {
+    /// εᵀ Σ⁻¹ ε (a squared Mahalanobis distance, an NEES).
+    ///
+    /// ```
+    /// use posecov::uncertain::try_information;
+    /// use nalgebra::{Matrix2, Vector2};
+    /// let info = try_information("Σ", &Matrix2::new(4.0, 0.0, 0.0, 0.25)).unwrap();
+    /// assert_eq!(info.quadratic(&Vector2::new(2.0, 1.0)), 5.0);
+    /// ```
+    pub fn quadratic(&self, e: &Tangent<N>) -> f64 {
+        match self {
+            Information::Cholesky(l) => l.solve_lower_triangular_unchecked(e).norm_squared(),
+            Information::Inverse(info) => (e.transpose() * info * e)[0],
+        }
+    }
+
+    /// Σ⁻¹ as a matrix.
+    pub fn matrix(&self) -> TangentMatrix<N> {
+        match self {
+            Information::Cholesky(l) => {
+                let l_inverse = l.solve_lower_triangular_unchecked(&TangentMatrix::<N>::identity());
+                l_inverse.transpose() * l_inverse
+            }
+            Information::Inverse(info) => *info,
+        }
+    }
+}
+
+/// Σ⁻¹ of a covariance, validated first ([`validate_covariance`]), as a quadratic form is
+/// taken with it: for a well-conditioned Σ (tr Σ · tr Σ⁻¹ ≤ 10⁸, which bounds λ_max / λ_min)
+/// its Cholesky factor, which proves Σ positive definite and far from singular without its
+/// eigenvalues; otherwise [`try_inverse_covariance`]'s, which decides through them (the same
+/// decisions either way: 10⁸ is four orders of magnitude inside [`SINGULAR_TOLERANCE`]).
+///
+/// ```
+/// use posecov::uncertain::{Information, try_information};
+/// use nalgebra::Matrix2;
+/// let info = try_information("Σ", &Matrix2::new(4.0, 1.0, 1.0, 2.0)).unwrap();
+/// assert!(matches!(info, Information::Cholesky(_)));
+/// assert!((info.matrix() * Matrix2::new(4.0, 1.0, 1.0, 2.0) - Matrix2::identity()).norm() < 1e-15);
+/// // λ_max / λ_min = 1e10: decided by the eigenvalues (not singular: 1e10 < 1e12).
+/// assert!(matches!(try_information("Σ", &Matrix2::new(1.0, 0.0, 0.0, 1e-10)), Ok(Information::Inverse(_))));
+/// assert!(try_information("Σ", &Matrix2::new(1.0, 1.0, 1.0, 1.0)).is_err());
+/// ```
+pub fn try_information<const N: usize>(
+    what: &'static str,
+    cov: &TangentMatrix<N>,
+) -> Result<Information<N>> {
+    validated_information(what, cov).and_then(|(_, information)| information)
+}
+
+/// ½(Σ + Σᵀ) validated and [`try_information`]'s Σ⁻¹ (`Err` inside: Σ is singular).
+fn validated_information<const N: usize>(
+    what: &'static str,
+    cov: &TangentMatrix<N>,
+) -> Result<(TangentMatrix<N>, Result<Information<N>>)> {
+    if let Some((sym, l)) = validate::well_conditioned_factor(what, cov) {
+        return Ok((sym, Ok(Information::Cholesky(l))));
+    }
+    let (sym, eigen) = validate::validated_eigen(what, cov, true)?;
+    Ok((sym, information(what, eigen).map(Information::Inverse)))
 }
 
 /// Σ⁻¹ = V diag(1/λ) Vᵀ from the decomposition that validated Σ (`None`: a 0 × 0 Σ), or
@@ -560,5 +631,61 @@ impl UncertainPose<Se2, 3> {
             nalgebra::Matrix1::new(self.heading_variance()),
             Side::Right,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Matrix6, Vector6};
+    use rand::{Rng, SeedableRng};
+
+    use super::*;
+
+    /// The Cholesky path decides as the eigenvalues do (valid, singular or not) and gives the
+    /// same quadratic forms, for condition numbers from 1 to 10¹⁶ and for matrices with a
+    /// slightly negative eigenvalue; it is taken for the well-conditioned ones only.
+    #[test]
+    fn information_decides_as_the_eigenvalues_do() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let (mut factored, mut decomposed) = (0, 0);
+        for k in 0..2000 {
+            let q = Matrix6::from_fn(|_, _| rng.random_range(-1.0..1.0))
+                .qr()
+                .q();
+            let log_kappa = f64::from(k % 17);
+            let mut values = Vector6::from_fn(|i, _| {
+                let t = if i == 0 {
+                    0.0
+                } else {
+                    rng.random_range(0.0..1.0)
+                };
+                10f64.powf(-log_kappa * t)
+            });
+            values[5] = 10f64.powf(-log_kappa);
+            if k % 23 == 0 {
+                values[5] = -1e-11;
+            }
+            let scale = 10f64.powf(rng.random_range(-6.0..6.0));
+            let cov = q * Matrix6::from_diagonal(&values) * q.transpose() * scale;
+            let e = Vector6::from_fn(|_, _| rng.random_range(-1.0..1.0));
+            let by_eigen = try_inverse_covariance("Σ", &cov);
+            let by_factor = try_information("Σ", &cov);
+            assert_eq!(by_factor.is_ok(), by_eigen.is_ok(), "{k}: {by_eigen:?}");
+            let (Ok(info), Ok(inverse)) = (by_factor, by_eigen) else {
+                continue;
+            };
+            match info {
+                Information::Cholesky(_) => factored += 1,
+                Information::Inverse(_) => decomposed += 1,
+            }
+            if log_kappa <= 8.0 {
+                let (a, b) = (info.quadratic(&e), (e.transpose() * inverse * e)[0]);
+                assert!((a - b).abs() <= 1e-6 * b, "{k}: {a} vs {b}");
+            }
+        }
+        assert!(
+            factored > 500 && decomposed > 500,
+            "{factored} {decomposed}"
+        );
     }
 }

@@ -57,7 +57,7 @@ use crate::plan::bag::{
     DEFAULT_MAX_DRAWN, Decimator, EstimateMessage, LogObserver, MAX_DRAWN_LIMIT, ReferenceSample,
 };
 use crate::plan::limits::MAX_COORDINATE;
-use crate::uncertain::{Side, UncertainPose, anees_band, chi2_radius};
+use crate::uncertain::{Information, Side, UncertainPose, anees_band, chi2_radius};
 pub use math::{nees_se2, nees_se3, umeyama};
 pub use model::{
     Align, MAX_PENDING, MESSAGE_BOUND_PROBABILITY, NeesSettings, Skipped, TopicConsistency, Verdict,
@@ -74,8 +74,8 @@ enum Truth {
 /// An estimate's Gaussian in the right form, with Σ⁻¹ (`None`: Σ is singular).
 #[derive(Clone)]
 enum Gaussian {
-    Planar(Se2, SMatrix<f64, 3, 3>, Option<SMatrix<f64, 3, 3>>),
-    Spatial(Se3, Box<(Matrix6<f64>, Option<Matrix6<f64>>)>),
+    Planar(Se2, SMatrix<f64, 3, 3>, Option<Information<3>>),
+    Spatial(Se3, Box<(Matrix6<f64>, Option<Information<6>>)>),
 }
 
 impl Gaussian {
@@ -389,7 +389,7 @@ impl LogObserver for NeesObserver {
 }
 
 /// The right-form Gaussian of a usable message (the log drawing's conversion) with Σ⁻¹ from
-/// the decomposition that validates Σ, `None` when it has none.
+/// the factorisation that validates Σ (`uncertain::try_information`), `None` when it has none.
 fn gaussian_of(m: &EstimateMessage<'_>, reading: RosReading) -> Option<Gaussian> {
     if !m.usable
         || m.position

@@ -147,6 +147,60 @@ where
     D: DimSub<U1>,
     DefaultAllocator: Allocator<D, D> + Allocator<D> + Allocator<DimDiff<D, U1>>,
 {
+    let sym = symmetrised(what, cov)?;
+    if sym.nrows() == 0 {
+        return Ok((sym, None));
+    }
+    let (eigenvalues, eigen) = if vectors {
+        let eigen = SymmetricEigen::new(sym.clone());
+        (eigen.eigenvalues.clone(), Some(eigen))
+    } else {
+        (sym.symmetric_eigenvalues(), None)
+    };
+    let min_eigenvalue = eigenvalues.min();
+    let tolerance = psd_tolerance(eigenvalues.max());
+    if min_eigenvalue < -tolerance {
+        return Err(Error::NotPositiveSemiDefinite {
+            what,
+            min_eigenvalue,
+            tolerance,
+        });
+    }
+    Ok((sym, eigen))
+}
+
+/// The bound on tr Σ · tr Σ⁻¹ under which [`well_conditioned_factor`] hands back a Cholesky
+/// factor: κ(Σ) = λ_max / λ_min ≤ tr Σ · tr Σ⁻¹ ≤ 10⁸, four orders of magnitude inside the
+/// singular ratio (`SINGULAR_TOLERANCE` = 10⁻¹²), so that the eigenvalues' round-off (≈ 10⁻¹⁵
+/// λ_max) cannot change what they decide.
+pub(super) const FACTOR_CONDITION_BOUND: f64 = 1e8;
+
+/// ½(Σ + Σᵀ) validated, with the Cholesky factor L (L Lᵀ = ½(Σ + Σᵀ)) when it proves what the
+/// eigenvalues would decide, without computing them: Σ is positive definite (the factor
+/// exists) and tr Σ · tr Σ⁻¹ (tr Σ⁻¹ = ‖L⁻¹‖²_F) ≤ [`FACTOR_CONDITION_BOUND`], so λ_min > 0
+/// passes the PSD rule and λ_min / λ_max ≥ 10⁻⁸ is far from singular. Otherwise (`None`: a
+/// 0 × 0, ill-conditioned, singular or invalid Σ) the caller decomposes Σ as
+/// [`validated_eigen`] does, which decides and words every error.
+pub(super) fn well_conditioned_factor<const N: usize>(
+    what: &'static str,
+    cov: &TangentMatrix<N>,
+) -> Option<(TangentMatrix<N>, TangentMatrix<N>)> {
+    let sym = symmetrised(what, cov).ok()?;
+    if N == 0 {
+        return None;
+    }
+    let l = sym.cholesky()?.unpack();
+    let l_inverse = l.solve_lower_triangular(&TangentMatrix::<N>::identity())?;
+    let bound = sym.trace() * l_inverse.norm_squared();
+    (bound <= FACTOR_CONDITION_BOUND).then_some((sym, l))
+}
+
+/// Square, finite and symmetric within [`SYMMETRY_TOLERANCE`]: ½(Σ + Σᵀ).
+fn symmetrised<D>(what: &'static str, cov: &OMatrix<f64, D, D>) -> Result<OMatrix<f64, D, D>>
+where
+    D: nalgebra::Dim,
+    DefaultAllocator: Allocator<D, D>,
+{
     let (n, cols) = cov.shape();
     if n != cols {
         return Err(Error::WrongShape {
@@ -180,24 +234,5 @@ where
             tolerance,
         });
     }
-    let sym = (cov + cov.transpose()) * 0.5;
-    if n == 0 {
-        return Ok((sym, None));
-    }
-    let (eigenvalues, eigen) = if vectors {
-        let eigen = SymmetricEigen::new(sym.clone());
-        (eigen.eigenvalues.clone(), Some(eigen))
-    } else {
-        (sym.symmetric_eigenvalues(), None)
-    };
-    let min_eigenvalue = eigenvalues.min();
-    let tolerance = psd_tolerance(eigenvalues.max());
-    if min_eigenvalue < -tolerance {
-        return Err(Error::NotPositiveSemiDefinite {
-            what,
-            min_eigenvalue,
-            tolerance,
-        });
-    }
-    Ok((sym, eigen))
+    Ok((cov + cov.transpose()) * 0.5)
 }

@@ -4,7 +4,7 @@
 use nalgebra::{Matrix3, Matrix6, SVector, Vector2, Vector3};
 
 use crate::lie::{LieGroup, Se2, Se3, So2, So3};
-use crate::uncertain::try_inverse_covariance;
+use crate::uncertain::{Information, try_information};
 
 /// The three NEES of one message against the truth, or `None` for a singular covariance.
 ///
@@ -18,30 +18,27 @@ use crate::uncertain::try_inverse_covariance;
 /// assert!((joint - 4.0).abs() < 1e-12 && (position - 4.0).abs() < 1e-12 && orientation.abs() < 1e-12);
 /// ```
 pub fn nees_se3(estimate: &Se3, cov: &Matrix6<f64>, truth: &Se3) -> Option<[f64; 3]> {
-    let info = try_inverse_covariance("Σ", cov).ok()?;
+    let info = try_information("Σ", cov).ok()?;
     nees_se3_informed(estimate, cov, &info, truth)
 }
 
-/// [`nees_se3`] with Σ⁻¹ known (from the decomposition that validated Σ).
+/// [`nees_se3`] with Σ⁻¹ known (from the factorisation that validated Σ).
 pub(super) fn nees_se3_informed(
     estimate: &Se3,
     cov: &Matrix6<f64>,
-    info: &Matrix6<f64>,
+    info: &Information<6>,
     truth: &Se3,
 ) -> Option<[f64; 3]> {
     let e = truth.rminus(estimate);
-    let joint = (e.transpose() * info * e)[0];
     let r = estimate.rotation().to_matrix();
     let dp = r.transpose() * (truth.translation() - estimate.translation());
-    let pos_info =
-        try_inverse_covariance("Σ_ρρ", &cov.fixed_view::<3, 3>(0, 0).into_owned()).ok()?;
+    let pos_info = try_information("Σ_ρρ", &cov.fixed_view::<3, 3>(0, 0).into_owned()).ok()?;
     let theta = truth.rotation().rminus(estimate.rotation());
-    let rot_info =
-        try_inverse_covariance("Σ_θθ", &cov.fixed_view::<3, 3>(3, 3).into_owned()).ok()?;
+    let rot_info = try_information("Σ_θθ", &cov.fixed_view::<3, 3>(3, 3).into_owned()).ok()?;
     Some([
-        joint,
-        (dp.transpose() * pos_info * dp)[0],
-        (theta.transpose() * rot_info * theta)[0],
+        info.quadratic(&e),
+        pos_info.quadratic(&dp),
+        rot_info.quadratic(&theta),
     ])
 }
 
@@ -57,34 +54,32 @@ pub(super) fn nees_se3_informed(
 /// assert!((joint - 1.0).abs() < 1e-12 && (orientation - 1.0).abs() < 1e-12);
 /// ```
 pub fn nees_se2(estimate: &Se2, cov: &Matrix3<f64>, truth: &Se3) -> Option<[f64; 3]> {
-    let info = try_inverse_covariance("Σ", cov).ok()?;
+    let info = try_information("Σ", cov).ok()?;
     nees_se2_informed(estimate, cov, &info, truth)
 }
 
-/// [`nees_se2`] with Σ⁻¹ known (from the decomposition that validated Σ).
+/// [`nees_se2`] with Σ⁻¹ known (from the factorisation that validated Σ).
 pub(super) fn nees_se2_informed(
     estimate: &Se2,
     cov: &Matrix3<f64>,
-    info: &Matrix3<f64>,
+    info: &Information<3>,
     truth: &Se3,
 ) -> Option<[f64; 3]> {
     let t = truth.translation();
     let yaw = truth.rotation().to_rpy()[2];
     let truth = Se2::from_parts(Vector2::new(t.x, t.y), So2::from_angle(yaw));
     let e = truth.rminus(estimate);
-    let joint = (e.transpose() * info * e)[0];
     let r = estimate.rotation().to_matrix();
     let dp: SVector<f64, 2> = r.transpose() * (truth.translation() - estimate.translation());
-    let pos_info =
-        try_inverse_covariance("Σ_ρρ", &cov.fixed_view::<2, 2>(0, 0).into_owned()).ok()?;
+    let pos_info = try_information("Σ_ρρ", &cov.fixed_view::<2, 2>(0, 0).into_owned()).ok()?;
     let theta = truth.rotation().rminus(estimate.rotation())[0];
     let var = cov[(2, 2)];
     if var <= 0.0 {
         return None;
     }
     Some([
-        joint,
-        (dp.transpose() * pos_info * dp)[0],
+        info.quadratic(&e),
+        pos_info.quadratic(&dp),
         theta * theta / var,
     ])
 }
