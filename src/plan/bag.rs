@@ -278,7 +278,7 @@ impl Issue {
     /// use posecov::plan::bag::Issue;
     /// assert!(Issue::NotPsd.unusable() && !Issue::Placeholder.unusable());
     /// ```
-    pub fn unusable(self) -> bool {
+    pub const fn unusable(self) -> bool {
         matches!(
             self,
             Issue::NonFinite
@@ -428,6 +428,29 @@ impl AxisStats {
                     max: sigma,
                 })
             }
+        }
+    }
+
+    /// The statistics of the square roots (statistics kept over variances, σ²: `√` keeps
+    /// their order, so the smallest and largest root are the roots of the smallest and
+    /// largest, to the bit).
+    ///
+    /// ```
+    /// use posecov::plan::bag::AxisStats;
+    /// let mut s = None;
+    /// for variance in [0.25, 0.0625, 0.5625] {
+    ///     AxisStats::add(&mut s, variance);
+    /// }
+    /// let s = s.unwrap().sqrt();
+    /// assert_eq!((s.first, s.last, s.min, s.max), (0.5, 0.75, 0.25, 0.75));
+    /// ```
+    pub fn sqrt(self) -> AxisStats {
+        AxisStats {
+            messages: self.messages,
+            first: self.first.sqrt(),
+            last: self.last.sqrt(),
+            min: self.min.sqrt(),
+            max: self.max.sqrt(),
         }
     }
 }

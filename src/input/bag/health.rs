@@ -24,7 +24,7 @@ pub const CONSTANT_MIN_MESSAGES: u64 = 10;
 const PLANAR_AXES: [usize; 3] = [0, 1, 5];
 
 /// What one message's covariance is.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MessageHealth {
     /// The issues of this message alone (drops and growth come from [`Trend`]).
     pub issues: Issues,
@@ -41,21 +41,35 @@ pub struct MessageHealth {
 impl MessageHealth {
     /// Whether the covariance can be drawn as a Gaussian.
     pub fn usable(&self) -> bool {
-        !self.issues.iter().any(|i| i.unusable())
+        !self.issues.any_unusable()
     }
 }
 
-/// Whether the symmetrised block of `cov` on the `kept` axes is positive definite (its
-/// factorisation L D Lᵀ exists with D > 0, computed here on the stack, without square
-/// roots): then its smallest eigenvalue is positive, above any −tolerance, and it is positive
-/// semi-definite by the one rule without computing it.
-fn positive_definite(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
-    // l[r][c] = L_rc · D_c (c < r), d_inv[c] = 1 / D_c.
-    let mut ld = [[0.0f64; 6]; 6];
-    let mut d_inv = [0.0f64; 6];
+/// The entries of the `kept` axes' block of `cov`, gathered: `b[r][c] = cov[kept[r] · 6 + kept[c]]`
+/// for `r, c < kept.len()`.
+fn gather(cov: &[f64; COV_LEN], kept: &[usize]) -> [[f64; 6]; 6] {
+    let mut b = [[0.0; 6]; 6];
     for (r, &i) in kept.iter().enumerate() {
-        for (c, &j) in kept.iter().enumerate().take(r + 1) {
-            let mut v = 0.5 * (cov[i * 6 + j] + cov[j * 6 + i]);
+        for (c, &j) in kept.iter().enumerate() {
+            b[r][c] = cov[i * 6 + j];
+        }
+    }
+    b
+}
+
+/// Whether the symmetrised N × N block `at(r, c)` (`r, c < N`) is positive definite: its
+/// factorisation L D Lᵀ exists with D > 0, computed here on the stack, without square roots
+/// (then its smallest eigenvalue is positive, above any −tolerance, and it is positive
+/// semi-definite by the one rule without computing it). N is known at compile time, so the
+/// loops unroll and the entries are read without index checks.
+#[inline(always)]
+fn positive_definite_block<const N: usize>(at: &impl Fn(usize, usize) -> f64) -> bool {
+    // l[r][c] = L_rc · D_c (c < r), d_inv[c] = 1 / D_c.
+    let mut ld = [[0.0f64; N]; N];
+    let mut d_inv = [0.0f64; N];
+    for r in 0..N {
+        for c in 0..r + 1 {
+            let mut v = 0.5 * (at(r, c) + at(c, r));
             for k in 0..c {
                 v -= ld[r][k] * ld[c][k] * d_inv[k];
             }
@@ -63,13 +77,116 @@ fn positive_definite(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
                 if v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                     return false;
                 }
-                d_inv[r] = 1.0 / v;
+                // The last row's 1 / D is never used: one division fewer.
+                if r + 1 < N {
+                    d_inv[r] = 1.0 / v;
+                }
             } else {
                 ld[r][c] = v;
             }
         }
     }
     true
+}
+
+/// `f::<N>()` for `N = n` (0 ≤ n ≤ 6): the block functions above are generic in the size.
+macro_rules! by_size {
+    ($n:expr, $f:ident, $($arg:expr),*) => {
+        match $n {
+            0 => $f::<0>($($arg),*),
+            1 => $f::<1>($($arg),*),
+            2 => $f::<2>($($arg),*),
+            3 => $f::<3>($($arg),*),
+            4 => $f::<4>($($arg),*),
+            5 => $f::<5>($($arg),*),
+            _ => $f::<6>($($arg),*),
+        }
+    };
+}
+
+/// Whether the symmetrised block of `cov` on the `kept` axes is positive definite
+/// ([`positive_definite_block`]).
+fn positive_definite(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
+    let b = gather(cov, kept);
+    by_size!(
+        kept.len(),
+        positive_definite_block,
+        &|r: usize, c: usize| b[r][c]
+    )
+}
+
+/// What the checks over the estimated block find.
+struct BlockChecks {
+    /// Every entry is exactly 0.
+    all_zero: bool,
+    /// Some pair Σᵣ꜀, Σ꜀ᵣ differs by more than the symmetry tolerance at the block's scale
+    /// (its largest |variance|).
+    asymmetric: bool,
+}
+
+/// [`BlockChecks`] of the N × N block `at(r, c)`, every entry read once, without early exits
+/// (the compiler compares in vectors).
+#[inline(always)]
+fn block_checks<const N: usize>(at: &impl Fn(usize, usize) -> f64) -> BlockChecks {
+    let mut all_zero = true;
+    let mut scale = 0.0f64;
+    for r in 0..N {
+        scale = scale.max(at(r, r).abs());
+        for c in 0..N {
+            all_zero &= at(r, c) == 0.0;
+        }
+    }
+    // The symmetry rule is evaluation's (`uncertain`): what health calls symmetric,
+    // evaluation accepts.
+    let tol = symmetry_tolerance(scale);
+    let mut asymmetric = false;
+    // Each pair once (|Σᵢⱼ − Σⱼᵢ| is the same from either side; every entry is finite here).
+    for r in 0..N {
+        for c in r + 1..N {
+            asymmetric |= (at(r, c) - at(c, r)).abs() > tol;
+        }
+    }
+    BlockChecks {
+        all_zero,
+        asymmetric,
+    }
+}
+
+/// [`block_checks`] and, when wanted (`pd_wanted(&checks)`), [`positive_definite_block`] of
+/// the N × N block `at`: one function per size, so both unroll.
+fn checks_and_pd<const N: usize>(
+    at: &impl Fn(usize, usize) -> f64,
+    pd_wanted: &impl Fn(&BlockChecks) -> bool,
+) -> (BlockChecks, Option<bool>) {
+    let checks = block_checks::<N>(at);
+    let pd =
+        pd_wanted(&checks).then(|| weakly_correlated::<N>(at) || positive_definite_block::<N>(at));
+    (checks, pd)
+}
+
+/// Whether the symmetrised N × N block `at(r, c)` has a positive diagonal and correlations
+/// ρᵣ꜀ = Σᵣ꜀ / √(Σᵣᵣ Σ꜀꜀) with Σ_{r<c} ρᵣ꜀² ≤ 0.45: then the correlation matrix is I + E with
+/// ‖E‖₂ ≤ ‖E‖_F ≤ √0.9 < 0.95, so its eigenvalues are ≥ 0.05 and the block is positive definite
+/// (by far: the rounding of this sum is 10¹³ times smaller than the margin; anything not
+/// finite fails). A sufficient test without the L D Lᵀ's chain of dependent divisions (six
+/// independent ones here); a block it does not decide goes to [`positive_definite_block`].
+#[inline(always)]
+fn weakly_correlated<const N: usize>(at: &impl Fn(usize, usize) -> f64) -> bool {
+    let mut inv = [0.0f64; N];
+    let mut positive = true;
+    for (r, inv) in inv.iter_mut().enumerate() {
+        let d = at(r, r);
+        positive &= d > 0.0;
+        *inv = 1.0 / d;
+    }
+    let mut sum = 0.0;
+    for r in 0..N {
+        for c in r + 1..N {
+            let m = 0.5 * (at(r, c) + at(c, r));
+            sum += (m * inv[r]) * (m * inv[c]);
+        }
+    }
+    positive && sum <= 0.45
 }
 
 /// Whether the block of `cov` on the `kept` axes is positive definite once the axes whose row
@@ -160,33 +277,40 @@ fn with_orientation(
 /// entries, so a topic whose covariance repeats classifies it once ([`TopicHealth::add`]).
 fn classify_covariance(cov: &[f64; COV_LEN]) -> MessageHealth {
     let mut issues = Issues::default();
-    let diag: [f64; 6] = std::array::from_fn(|i| cov[i * 7]);
-    let mut unestimated = diag.map(|v| v == 0.0 || v >= PLACEHOLDER);
-    if cov.iter().any(|v| !v.is_finite()) {
+    // Every entry read once, without an early exit: in vectors.
+    if !cov.iter().fold(true, |finite, v| finite & v.is_finite()) {
         issues.push(Issue::NonFinite);
-        unestimated = [false; 6];
         return MessageHealth {
             issues,
-            unestimated,
+            unestimated: [false; 6],
             min_eigenvalue: None,
             position_trace: None,
         };
     }
+    let diag: [f64; 6] = std::array::from_fn(|i| cov[i * 7]);
+    let unestimated = diag.map(|v| v == 0.0 || v >= PLACEHOLDER);
     // The estimated axes: not a placeholder (a huge row would swamp the rounding of the rest).
-    let mut axes = [0usize; 6];
-    let mut n = 0;
-    for i in (0..6).filter(|&i| diag[i] < PLACEHOLDER) {
-        axes[n] = i;
-        n += 1;
-    }
+    let mut axes = [0, 1, 2, 3, 4, 5];
+    let mut n = 6;
+    let unknown_marker = cov[0] == -1.0;
+    // Positive definiteness is only asked of a symmetric block (not the −1 marker's).
+    let pd_wanted = |checks: &BlockChecks| !checks.asymmetric && !unknown_marker;
+    let (checks, positive_definite) = if diag.iter().all(|v| *v < PLACEHOLDER) {
+        // Every axis estimated (an EKF's covariance): the block is `cov` itself, read in place.
+        checks_and_pd::<6>(&|r: usize, c: usize| cov[r * 6 + c], &pd_wanted)
+    } else {
+        n = 0;
+        for i in (0..6).filter(|&i| diag[i] < PLACEHOLDER) {
+            axes[n] = i;
+            n += 1;
+        }
+        let b = gather(cov, &axes[..n]);
+        by_size!(n, checks_and_pd, &|r: usize, c: usize| b[r][c], &pd_wanted)
+    };
     let kept = &axes[..n];
-    if cov[0] == -1.0 {
+    if unknown_marker {
         issues.push(Issue::UnknownMarker);
-    } else if !kept.is_empty()
-        && kept
-            .iter()
-            .all(|&i| kept.iter().all(|&j| cov[i * 6 + j] == 0.0))
-    {
+    } else if n > 0 && checks.all_zero {
         issues.push(Issue::AllZero);
     }
     if PLANAR_AXES.iter().any(|&i| diag[i] >= PLACEHOLDER) {
@@ -196,23 +320,10 @@ fn classify_covariance(cov: &[f64; COV_LEN]) -> MessageHealth {
         // topic's collector decides when it has seen every message).
         issues.push(Issue::Placeholder);
     }
-    let scale = kept.iter().map(|&i| diag[i].abs()).fold(0.0, f64::max);
-    // The symmetry and PSD rules are evaluation's (`uncertain`): what health calls PSD,
-    // evaluation accepts.
-    let tol = symmetry_tolerance(scale);
-    // Each pair once (|Σᵢⱼ − Σⱼᵢ| is the same from either side; every entry is finite here).
-    let asymmetric = kept.iter().enumerate().any(|(a, &i)| {
-        kept[a + 1..]
-            .iter()
-            .any(|&j| (cov[i * 6 + j] - cov[j * 6 + i]).abs() > tol)
-    });
     let mut min_eigenvalue = None;
-    if asymmetric {
+    if checks.asymmetric {
         issues.push(Issue::Asymmetric);
-    } else if !kept.is_empty()
-        && !issues.contains(Issue::UnknownMarker)
-        && !positive_definite(cov, kept)
-    {
+    } else if n > 0 && positive_definite == Some(false) {
         // Only a block that is not positive definite needs more (most messages' are: one
         // factorisation on the stack decides; the eigen-decomposition was most of the health
         // classes' time).
@@ -283,14 +394,18 @@ impl Trend {
 /// block) — while the pose moves.
 #[derive(Debug, Clone, Default)]
 pub struct Constancy {
-    previous: Option<([f64; COV_LEN], f64, [f64; 3])>,
+    /// The previous usable message's trace and position (its covariance is kept by the caller,
+    /// who says whether the next one is the same: [`TopicHealth`] keeps one copy for this
+    /// and its repeat cache).
+    previous: Option<(f64, [f64; 3])>,
     current: Option<Stretch>,
     longest: Option<Stretch>,
 }
 
 impl Constancy {
     /// The next usable message (number `index` on the topic) with covariance `cov` at
-    /// `position`; `dead_reckoned`: a covariance that does not grow counts as constant.
+    /// `position`; `same`: `cov` has the same entries (`==`) as the previous usable message's;
+    /// `dead_reckoned`: a covariance that does not grow counts as constant.
     ///
     /// ```
     /// use posecov::input::bag::health::Constancy;
@@ -298,7 +413,7 @@ impl Constancy {
     /// let mut cov = [0.0; 36];
     /// cov[0] = 0.01;
     /// for k in 0..20 {
-    ///     c.next(k, k as i64 * 1_000_000_000, &cov, [0.5 * k as f64, 0.0, 0.0], false);
+    ///     c.next(k, k as i64 * 1_000_000_000, &cov, k > 0, [0.5 * k as f64, 0.0, 0.0], false);
     /// }
     /// let s = c.finding().unwrap();
     /// assert_eq!((s.messages, s.first_index, s.last_stamp_ns), (20, 0, 19_000_000_000));
@@ -309,6 +424,7 @@ impl Constancy {
         index: u64,
         stamp_ns: i64,
         cov: &[f64; COV_LEN],
+        same: bool,
         position: [f64; 3],
         dead_reckoned: bool,
     ) {
@@ -316,18 +432,13 @@ impl Constancy {
             .map(|i| cov[i * 7])
             .filter(|v| *v < PLACEHOLDER)
             .sum();
-        // `==` on every entry (as arrays compare), without an early exit: in vectors.
-        let same = self
-            .previous
-            .as_ref()
-            .is_some_and(|(c, ..)| c.iter().zip(cov).fold(true, |same, (x, y)| same & (x == y)));
+        let same = same && self.previous.is_some();
         let continues = same
             || self
                 .previous
-                .as_ref()
-                .is_some_and(|(_, t, _)| dead_reckoned && trace <= *t);
+                .is_some_and(|(t, _)| dead_reckoned && trace <= t);
         let step = match self.previous {
-            Some((_, _, p)) => {
+            Some((_, p)) => {
                 let d = (0..3)
                     .map(|i| (position[i] - p[i]).powi(2))
                     .sum::<f64>()
@@ -353,14 +464,7 @@ impl Constancy {
                 });
             }
         }
-        match &mut self.previous {
-            // The same entries: only the trace and position move on (no 36-entry copy).
-            Some((_, t, p)) if same => {
-                *t = trace;
-                *p = position;
-            }
-            _ => self.previous = Some((*cov, trace, position)),
-        }
+        self.previous = Some((trace, position));
     }
 
     fn close(&mut self) {
@@ -383,8 +487,9 @@ impl Constancy {
 
 /// A topic's health classes and σ statistics, streamed over its messages: per message what
 /// [`classify`], [`Trend`] and [`Constancy`] find, counted per issue in [`Health`], and σ per
-/// axis ([`AxisStats`]). This is the work a log's read does per message on top of decoding
-/// and keeping the drawn set and series (`benches/bag_read.rs` measures its share).
+/// axis ([`AxisStats`], kept as variances: [`Self::sigma_stats`]). This is the work a log's
+/// read does per message on top of decoding and keeping the drawn set and series
+/// (`benches/bag_read.rs` measures its share).
 ///
 /// ```
 /// use posecov::input::bag::decode::Decoded;
@@ -395,10 +500,11 @@ impl Constancy {
 /// let d = Decoded { stamp_ns: Some(1), frame_id: "odom".into(), child_frame_id: String::new(),
 ///     position: [0.0; 3], orientation_xyzw: [0.0, 0.0, 0.0, 1.0], covariance, twist_covariance: None };
 /// let mut topic = TopicHealth::default();
-/// let (h, sigma) = topic.add(0, 1, &d, true);
+/// let (h, variance) = topic.add(0, 1, &d, true);
 /// assert!(h.usable() && topic.planar);
 /// assert_eq!(topic.health.count(Issue::Placeholder), 1);
-/// assert!((sigma[5].unwrap() - 0.03f64.sqrt()).abs() < 1e-15 && sigma[2].is_none());
+/// assert!(variance[5] == Some(0.03) && variance[2].is_none());
+/// assert_eq!(topic.sigma_stats()[5].unwrap().max, 0.03f64.sqrt());
 /// ```
 #[derive(Debug, Clone)]
 pub struct TopicHealth {
@@ -406,14 +512,22 @@ pub struct TopicHealth {
     pub health: Health,
     pub(super) trend: Trend,
     pub(super) constancy: Constancy,
-    /// The last message's covariance and its classification ([`classify_covariance`]).
-    previous: Option<([f64; COV_LEN], MessageHealth)>,
+    /// The last message's covariance and its classification ([`classify_covariance`]): the
+    /// one copy, for the repeat cache and the constant-stretch search.
+    last: Option<([f64; COV_LEN], MessageHealth)>,
+    /// Whether the last message was usable (then its covariance, `last`, is the one
+    /// [`Constancy`] compares the next usable message with).
+    last_usable: bool,
+    /// The last usable message's covariance when messages that were not usable came after it
+    /// (`last` moved on).
+    usable_before: Option<[f64; COV_LEN]>,
     /// Usable messages (drawable as a Gaussian).
     pub usable: u64,
     /// Every usable message so far has placeholders on z, roll and pitch.
     pub planar: bool,
-    /// σ per ROS axis over the usable messages that estimate it.
-    pub sigma_stats: [Option<AxisStats>; 6],
+    /// The variance's statistics per ROS axis over the usable messages that estimate it
+    /// (clamped at 0): σ's are their square roots, which keep their order.
+    variance_stats: [Option<AxisStats>; 6],
 }
 
 impl Default for TopicHealth {
@@ -422,26 +536,29 @@ impl Default for TopicHealth {
             health: Health::default(),
             trend: Trend::default(),
             constancy: Constancy::default(),
-            previous: None,
+            last: None,
+            last_usable: false,
+            usable_before: None,
             usable: 0,
             planar: true,
-            sigma_stats: [None; 6],
+            variance_stats: [None; 6],
         }
     }
 }
 
-/// Whether two covariances have the same bits in every entry (then every check gives the same
-/// answer, NaN and −0 included).
-fn same_bits(a: &[f64; COV_LEN], b: &[f64; COV_LEN]) -> bool {
+/// Whether `a` and `b` have the same bits in every entry (then every check gives the same
+/// answer, NaN and −0 included), and whether they are equal (`==`: ±0 alike, NaN unequal).
+fn same_entries(a: &[f64; COV_LEN], b: &[f64; COV_LEN]) -> (bool, bool) {
     // Every entry compared, without an early exit: the compiler compares them in vectors.
-    a.iter()
-        .zip(b)
-        .fold(true, |same, (x, y)| same & (x.to_bits() == y.to_bits()))
+    a.iter().zip(b).fold((true, true), |(bits, equal), (x, y)| {
+        (bits & (x.to_bits() == y.to_bits()), equal & (x == y))
+    })
 }
 
 impl TopicHealth {
     /// Message number `index` at `stamp_ns` (`dead_reckoned`: an Odometry in an odom frame):
-    /// its health and its σ per ROS axis (`None` where not estimated, or unusable).
+    /// its health and its variance per ROS axis, clamped at 0 (`None` where not estimated, or
+    /// unusable; its σ is the square root).
     pub fn add(
         &mut self,
         index: u64,
@@ -449,16 +566,17 @@ impl TopicHealth {
         d: &Decoded,
         dead_reckoned: bool,
     ) -> (MessageHealth, [Option<f64>; 6]) {
-        let covariance = match &self.previous {
-            // The same 36 entries as the message before: the same classification.
-            Some((cov, h)) if same_bits(cov, &d.covariance) => h.clone(),
-            _ => {
-                let h = classify_covariance(&d.covariance);
-                self.previous = Some((d.covariance, h.clone()));
-                h
-            }
+        let cov = &d.covariance;
+        let (same_bits, same_values) = match &self.last {
+            Some((last, _)) => same_entries(last, cov),
+            None => (false, false),
         };
-        let mut h = with_orientation(d.orientation_xyzw, covariance, &d.covariance);
+        let covariance = match &self.last {
+            // The same 36 entries as the message before: the same classification.
+            Some((_, h)) if same_bits => *h,
+            _ => classify_covariance(cov),
+        };
+        let mut h = with_orientation(d.orientation_xyzw, covariance, cov);
         if let Some(trace) = h.position_trace {
             h.issues.extend(self.trend.next(trace).iter());
         }
@@ -473,19 +591,46 @@ impl TopicHealth {
         if usable {
             self.usable += 1;
             self.planar &= h.unestimated[2] && h.unestimated[3] && h.unestimated[4];
+            // The same entries as the last usable message: `last` itself when that was the
+            // message before, else the copy kept when it moved on.
+            let same = match (self.last_usable, &self.usable_before) {
+                (true, _) => same_values,
+                (false, Some(before)) => same_entries(before, cov).1,
+                (false, None) => false,
+            };
             self.constancy
-                .next(index, stamp_ns, &d.covariance, d.position, dead_reckoned);
+                .next(index, stamp_ns, cov, same, d.position, dead_reckoned);
+        } else if self.last_usable
+            && let Some((last, _)) = &self.last
+        {
+            // `last` moves on to a message that is not usable: keep the usable one.
+            self.usable_before = Some(*last);
         }
-        let sigma: [Option<f64>; 6] = std::array::from_fn(|i| {
-            let v = d.covariance[i * 7];
-            (usable && !h.unestimated[i]).then(|| v.max(0.0).sqrt())
-        });
-        for (stats, s) in self.sigma_stats.iter_mut().zip(sigma) {
-            if let Some(s) = s {
-                AxisStats::add(stats, s);
+        self.last_usable = usable;
+        match &mut self.last {
+            Some(_) if same_bits => {}
+            // In place: one 36-entry copy.
+            Some((last, h)) => {
+                *last = *cov;
+                *h = covariance;
+            }
+            None => self.last = Some((*cov, covariance)),
+        }
+        let variance: [Option<f64>; 6] =
+            std::array::from_fn(|i| (usable && !h.unestimated[i]).then(|| cov[i * 7].max(0.0)));
+        for (stats, v) in self.variance_stats.iter_mut().zip(variance) {
+            if let Some(v) = v {
+                AxisStats::add(stats, v);
             }
         }
-        (h, sigma)
+        (h, variance)
+    }
+
+    /// σ per ROS axis over the usable messages that estimate it: first, last, smallest and
+    /// largest (the square roots of the variances' — `√` keeps their order, so these are the
+    /// σ's own, to the bit).
+    pub fn sigma_stats(&self) -> [Option<AxisStats>; 6] {
+        self.variance_stats.map(|s| s.map(AxisStats::sqrt))
     }
 }
 

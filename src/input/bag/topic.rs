@@ -35,6 +35,8 @@ pub(super) struct TopicState {
     pub(super) checks: TopicHealth,
     drawn: Decimator<DrawnMessage>,
     trajectory: Decimator<(i64, [f64; 3])>,
+    /// The series, with each axis's variance in place of its σ: the square roots are taken
+    /// for the points kept only ([`Self::into_plan`]).
     series: Decimator<SeriesPoint>,
 }
 
@@ -107,7 +109,7 @@ impl TopicState {
         }
         let dead_reckoned = self.kind == PoseMessageKind::Odometry
             && self.frame_id.as_deref().is_some_and(is_odom_frame);
-        let (h, sigma) = self.checks.add(index, stamp_ns, &d, dead_reckoned);
+        let (h, variance) = self.checks.add(index, stamp_ns, &d, dead_reckoned);
         let usable = h.usable();
         if usable && d.position.iter().all(|v| v.is_finite()) {
             self.trajectory.push(index, (stamp_ns, d.position));
@@ -116,7 +118,7 @@ impl TopicState {
             index,
             SeriesPoint {
                 stamp_ns,
-                sigma,
+                sigma: variance,
                 position_trace: h.position_trace,
             },
         );
@@ -179,8 +181,12 @@ impl TopicState {
         let mut trajectory = self.trajectory.into_items();
         trajectory.sort_by_key(|p| p.0);
         let mut series = self.series.into_items();
+        for p in &mut series {
+            p.sigma = p.sigma.map(|v| v.map(f64::sqrt));
+        }
         series.sort_by_key(|p| p.stamp_ns);
         let checks = self.checks;
+        let sigma_stats = checks.sigma_stats();
         let planar = checks.planar && checks.usable > 0;
         let mut health = checks.health;
         if !planar && let Some(on_used_axes) = health.issues.remove(&Issue::Placeholder) {
@@ -213,7 +219,7 @@ impl TopicState {
             stride,
             trajectory,
             series,
-            sigma_stats: checks.sigma_stats,
+            sigma_stats,
         }
     }
 }

@@ -95,6 +95,25 @@ impl Issues {
         self.0 & (1 << Self::bit(issue)) != 0
     }
 
+    /// The bits of the kinds that make a message unusable ([`Issue::unusable`]).
+    const UNUSABLE: u32 = {
+        let mut bits = 0;
+        let mut k = 0;
+        while k < Self::ORDER.len() {
+            if Self::ORDER[k].unusable() {
+                bits |= 1 << k;
+            }
+            k += 1;
+        }
+        bits
+    };
+
+    /// Whether one of them makes the message unusable ([`Issue::unusable`]): one test of
+    /// the bits.
+    pub fn any_unusable(&self) -> bool {
+        self.0 & Self::UNUSABLE != 0
+    }
+
     /// Whether there is none.
     pub fn is_empty(&self) -> bool {
         self.0 == 0
@@ -167,6 +186,12 @@ mod tests {
         assert_eq!(issues.len(), Issue::ALL.len());
         assert_eq!(issues, Issues::ORDER.to_vec());
         assert!(Issue::ALL.iter().all(|i| issues.contains(*i)));
+        // Each kind alone: unusable exactly when `Issue::unusable` says so.
+        for issue in Issue::ALL {
+            let mut one = Issues::default();
+            one.push(issue);
+            assert_eq!(one.any_unusable(), issue.unusable(), "{issue:?}");
+        }
         // The order a message's checks push them in is the order listed.
         let mut found = Issues::default();
         found.extend([
