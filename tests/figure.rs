@@ -195,6 +195,50 @@ fn all_steps_are_numbered_and_one_step_is_the_viewers_state() {
 }
 
 #[test]
+fn a_log_has_a_panel_per_view_and_its_last_message_once() {
+    // test2.bag (robot_localization): one Odometry topic in `odom`, 200 drawn messages. The
+    // viewer shows two views: the whole log, and the robot scale at the time cursor, where
+    // each message is drawn at the origin. A figure gives each view its own panel and, of
+    // each message's drawing, the last (where the viewer opens): one σ label, not 200 of them
+    // piled at the origin.
+    let s = scene_of(
+        "tests/data/robot_localization/test2.bag",
+        &Overrides::default(),
+    )
+    .expect("scene");
+    assert_eq!(
+        s.views.len(),
+        2,
+        "{:?}",
+        s.views.iter().map(|v| &v.name).collect::<Vec<_>>()
+    );
+    let text = svg(&s, &FigureOptions::default());
+    let summary = structure(&text);
+    for view in &s.views {
+        let shown = summary
+            .lines()
+            .any(|l| l.starts_with(&format!("text: {}", view.name.split(':').next().unwrap())));
+        assert!(
+            shown,
+            "panel title for {:?} missing in\n{summary}",
+            view.name
+        );
+    }
+    assert_eq!(
+        text.matches("clip-path=\"url(#world").count(),
+        2,
+        "{summary}"
+    );
+    let labels: Vec<&str> = summary
+        .lines()
+        .filter(|l| l.starts_with("text: message "))
+        .collect();
+    assert_eq!(labels.len(), 1, "{labels:?}");
+    assert!(labels[0].contains("σx 31.6"), "{labels:?}");
+    assert!(summary.contains("the last message"), "{summary}");
+}
+
+#[test]
 fn planes_show_their_axes() {
     let s = scene("se3_global_vs_local", 200);
     for (plane, x, y) in [(Plane::Xz, "x (m)", "z (m)"), (Plane::Yz, "y (m)", "z (m)")] {

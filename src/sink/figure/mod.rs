@@ -3,11 +3,13 @@
 //! system library, text in the bundled Liberation Sans (SIL OFL 1.1, `assets/fonts/`).
 //!
 //! A figure is the scene projected orthographically on a coordinate [`Plane`], at equal scale
-//! on both axes, with every step of a propagation at once ([`Steps::All`], each step's frame
-//! numbered) or the state at one step ([`Steps::At`], what the viewer shows with its time
-//! cursor there). Around it: the title, the confidence of every drawn region, axes in metres
-//! with a grid whose spacing is stated and a scale bar, the legend with colour swatches
-//! ([`Scene::legend`]) and the scene's plots against step or time.
+//! on both axes, one panel per 3-D view of the scene (the viewer's layout: a log's frames and
+//! its robot-scale view, a graph's before and after, one method each), with every step of a
+//! propagation at once ([`Steps::All`], each step's frame numbered; a robot log's messages:
+//! the last, as the viewer opens) or the state at one step ([`Steps::At`], what the viewer
+//! shows with its time cursor there). Around it: the title, the confidence of every drawn
+//! region, axes in metres with a grid whose spacing is stated and a scale bar, the legend with
+//! colour swatches ([`Scene::legend`]) and the scene's plots against step or time.
 //!
 //! The same scene gives the same bytes (every number is rounded to 0.01 px and written in
 //! order; PNG and PDF are rendered from that text).
@@ -152,7 +154,7 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
     };
     let f = pen.font;
     let mut out = Svg::new(options.size.0, options.size.1);
-    let items = selected(scene, options.steps);
+    let panels = panels(scene, options.steps);
     // Title and what the figure shows.
     out.text(
         [0.8 * f, 1.9 * f],
@@ -188,14 +190,66 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
     } else {
         (0.34 * w).max(14.0 * f)
     };
-    let world_area = Rect {
-        x: 5.0 * f,
-        y: top,
-        w: (w - column - 6.0 * f).max(10.0),
-        h: (h - top - 4.0 * f).max(10.0),
-    };
-    let grid = draw_world(&mut out, &items, options, world_area, pen, steps.len() > 1);
-    about.push(format!("grid {}", chart::length_label(grid)));
+    let cells = cells(
+        Rect {
+            x: 0.0,
+            y: top,
+            w: (w - column).max(10.0),
+            h: h - top,
+        },
+        panels.len(),
+    );
+    // Each panel's name (several panels) in at most two lines over its world; every panel
+    // keeps the same room for it, so the worlds line up.
+    let titles: Vec<Vec<String>> = panels
+        .iter()
+        .zip(&cells)
+        .map(|(panel, cell)| {
+            panel
+                .title
+                .map_or_else(Vec::new, |t| title_lines(t, f, cell.w - 6.0 * f))
+        })
+        .collect();
+    let title_room = titles.iter().map(Vec::len).max().unwrap_or(0) as f64 * 1.2 * f;
+    for (i, ((panel, cell), title)) in panels.iter().zip(cells).zip(&titles).enumerate() {
+        // The world inside the cell, with room for the axes' ticks and titles.
+        let area = Rect {
+            x: cell.x + 5.0 * f,
+            y: cell.y + title_room,
+            w: (cell.w - 6.0 * f).max(10.0),
+            h: (cell.h - title_room - 4.0 * f).max(10.0),
+        };
+        for (k, line) in title.iter().enumerate() {
+            let y = cell.y + 1.2 * f * (k as f64 + 1.0) - 0.4 * f;
+            out.text([area.x, y], f, Anchor::Start, "#222", line);
+        }
+        let clip = if i == 0 {
+            "world".to_owned()
+        } else {
+            format!("world{i}")
+        };
+        let grid = draw_world(
+            &mut out,
+            &panel.items,
+            options,
+            (area, &clip),
+            pen,
+            steps.len() > 1,
+        );
+        if panels.len() == 1 {
+            about.push(format!("grid {}", chart::length_label(grid)));
+        }
+    }
+    if panels.len() > 1 {
+        about.push("one panel per view, grid lines a scale bar apart".to_owned());
+    }
+    let log = scene
+        .items
+        .iter()
+        .any(|i| matches!(i.timing, Timing::Stamp(_)));
+    if log && options.steps == Steps::All {
+        about.push("the last message, every drawn one's outline faint".to_owned());
+    }
     out.text(
         [0.8 * f, 3.0 * f],
         0.9 * f,
@@ -235,29 +289,106 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
     out.finish()
 }
 
-/// The items a figure draws: geometry only (no text), shown in some view and not hidden in
-/// every view that shows it, at the chosen steps.
-fn selected(scene: &Scene, steps: Steps) -> Vec<&SceneItem> {
-    let visible = |path: &str| {
-        scene.views.is_empty()
-            || scene.views.iter().any(|v| {
-                v.shows(path)
-                    && !v.hidden.iter().any(|h| {
-                        path.strip_prefix(h.as_str())
-                            .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
-                    })
+/// A world panel of a figure: the items one 3-D view of the scene shows, with the view's name
+/// when the scene has several (each its own panel, as the viewer lays them out: a log's frames
+/// and its robot-scale view, a graph's before and after, one method each).
+struct Panel<'a> {
+    /// The view's name, for a figure of several panels.
+    title: Option<&'a str>,
+    /// What the panel draws.
+    items: Vec<&'a SceneItem>,
+}
+
+/// The figure's world panels (see [`Panel`]); one for a scene of one view or none.
+fn panels(scene: &Scene, steps: Steps) -> Vec<Panel<'_>> {
+    let items = selected(scene, steps);
+    let in_view = |view: &crate::scene::View3d, path: &str| {
+        view.shows(path)
+            && !view.hidden.iter().any(|h| {
+                path.strip_prefix(h.as_str())
+                    .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
             })
     };
-    let drawable = |i: &&SceneItem| !matches!(i.kind, ItemKind::Text(_)) && visible(&i.path);
+    match scene.views.as_slice() {
+        [] => vec![Panel { title: None, items }],
+        [view] => vec![Panel {
+            title: None,
+            items: items
+                .into_iter()
+                .filter(|i| in_view(view, &i.path))
+                .collect(),
+        }],
+        views => views
+            .iter()
+            .map(|view| Panel {
+                title: Some(view.name.as_str()),
+                items: items
+                    .iter()
+                    .copied()
+                    .filter(|i| in_view(view, &i.path))
+                    .collect(),
+            })
+            .filter(|panel| !panel.items.is_empty())
+            .collect(),
+    }
+}
+
+/// `count` cells filling `area` in a grid: the columns that give the largest square-ish cell
+/// (a world is drawn at equal scale on both axes), fewer rows on a tie.
+fn cells(area: Rect, count: usize) -> Vec<Rect> {
+    let count = count.max(1);
+    let size = |cols: usize| {
+        let rows = count.div_ceil(cols);
+        (area.w / cols as f64).min(area.h / rows as f64)
+    };
+    let cols = (1..=count)
+        .max_by(|a, b| size(*a).total_cmp(&size(*b)).then(a.cmp(b)))
+        .unwrap_or(1);
+    let rows = count.div_ceil(cols);
+    let (w, h) = (area.w / cols as f64, area.h / rows as f64);
+    (0..count)
+        .map(|i| Rect {
+            x: area.x + w * (i % cols) as f64,
+            y: area.y + h * (i / cols) as f64,
+            w,
+            h,
+        })
+        .collect()
+}
+
+/// A panel's name in at most two lines no wider than `width` at font size `size`, the second
+/// ending in "…" when the name is longer.
+fn title_lines(name: &str, size: f64, width: f64) -> Vec<String> {
+    let mut lines = svg::wrap(name, size, width);
+    if lines.len() > 2 {
+        lines.truncate(2);
+        lines[1].push_str(" …");
+    }
+    lines
+}
+
+/// The items a figure draws: geometry only (no text), at the chosen steps. With every step, a
+/// robot log's items (at stamps) are each entity's last, as the viewer opens: the last message
+/// drawn whole over the static outlines of every drawn message.
+fn selected(scene: &Scene, steps: Steps) -> Vec<&SceneItem> {
+    let drawable = |i: &&SceneItem| !matches!(i.kind, ItemKind::Text(_));
     match steps {
         Steps::All => {
             let drawn = drawn_steps(scene);
+            let mut last_stamp: std::collections::BTreeMap<&str, i64> = Default::default();
+            for item in &scene.items {
+                if let Timing::Stamp(ns) = item.timing {
+                    let last = last_stamp.entry(item.path.as_str()).or_insert(ns);
+                    *last = (*last).max(ns);
+                }
+            }
             scene
                 .items
                 .iter()
                 .filter(|i| match i.timing {
                     Timing::Step(k) => drawn.contains(&k),
-                    Timing::Static | Timing::Stamp(_) => true,
+                    Timing::Stamp(ns) => last_stamp.get(i.path.as_str()) == Some(&ns),
+                    Timing::Static => true,
                 })
                 .filter(drawable)
                 .collect()
@@ -327,7 +458,7 @@ fn draw_world(
     out: &mut Svg,
     items: &[&SceneItem],
     options: &FigureOptions,
-    area: Rect,
+    (area, clip): (Rect, &str),
     pen: Pen,
     steps: bool,
 ) -> f64 {
@@ -403,8 +534,8 @@ fn draw_world(
         titles: (&xt, &yt),
     };
     axes.grid(out, pen);
-    area.clip(out, "world");
-    out.open("class=\"world\" clip-path=\"url(#world)\"");
+    area.clip(out, clip);
+    out.open(&format!("class=\"world\" clip-path=\"url(#{clip})\""));
     region::draw_regions(out, items, plane, &m, pen);
     world::draw_clouds(out, items, plane, &m, pen);
     world::draw_lines(out, items, plane, &m, pen);
@@ -414,7 +545,7 @@ fn draw_world(
         plane,
         &m,
         pen,
-        steps && options.steps == Steps::All,
+        (steps && options.steps == Steps::All, area.right()),
     );
     out.close();
     axes.frame(out, pen);

@@ -395,14 +395,15 @@ fn arrow(svg: &mut Svg, a: Px, b: Px, color: crate::scene::Color, unit: f64) {
 }
 
 /// Labels: each frame's own label, and in an all-steps figure the step number beside each
-/// step's frame (at most about a dozen, evenly spaced, always the last).
+/// step's frame (at most about a dozen, evenly spaced, always the last). A label too long for
+/// the room left of the panel's `right` edge is broken into lines ([`label_lines`]).
 pub fn draw_labels(
     svg: &mut Svg,
     items: &[&SceneItem],
     plane: Plane,
     m: &Mapping,
     pen: Pen,
-    steps: bool,
+    (steps, right): (bool, f64),
 ) {
     let frames: Vec<(&SceneItem, &crate::scene::Frame)> = items
         .iter()
@@ -437,15 +438,43 @@ pub fn draw_labels(
             (crate::scene::Timing::Step(k), true) => labelled(k).then(|| format!("{k}")),
             _ => frame.label.clone().filter(|l| named.insert(l.clone())),
         };
-        if let Some(text) = text {
+        let Some(text) = text else {
+            continue;
+        };
+        let (x, lines) = label_lines(&text, at[0], pen.font, right);
+        for (i, line) in lines.iter().enumerate() {
             svg.raw(&format!(
                 "<text class=\"label\" x=\"{}\" y=\"{}\" font-size=\"{}\" fill=\"#222\" stroke=\"white\" stroke-width=\"{}\" paint-order=\"stroke\">{}</text>",
-                num(at[0]),
-                num(at[1]),
+                num(x),
+                num(at[1] + 1.2 * pen.font * i as f64),
                 num(pen.font),
                 num(0.25 * pen.font),
-                super::svg::escape(&text)
+                super::svg::escape(line)
             ));
         }
     }
+}
+
+/// A label starting at column `x` as lines that end before the panel's `right` edge: whole when
+/// it fits, else broken at spaces to the room it has (at least twelve font sizes) and moved
+/// left as far as its widest line needs. Returns the lines' left edge and the lines.
+///
+/// ```
+/// use posecov::sink::figure::world::label_lines;
+/// assert_eq!(label_lines("step 3", 10.0, 10.0, 500.0), (10.0, vec!["step 3".to_owned()]));
+/// let (x, lines) = label_lines("message 7: σx 31.6 mm, σy 31.6 mm, σyaw 10.00°", 400.0, 10.0, 500.0);
+/// assert!(lines.len() == 2 && x < 400.0);
+/// ```
+pub fn label_lines(text: &str, x: f64, font: f64, right: f64) -> (f64, Vec<String>) {
+    let margin = 0.3 * font;
+    let room = right - x - margin;
+    if super::svg::text_width(text, font) <= room {
+        return (x, vec![text.to_owned()]);
+    }
+    let lines = super::svg::wrap(text, font, room.max(12.0 * font));
+    let widest = lines
+        .iter()
+        .map(|l| super::svg::text_width(l, font))
+        .fold(0.0, f64::max);
+    (x.min(right - margin - widest), lines)
 }
