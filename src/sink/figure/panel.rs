@@ -1,0 +1,85 @@
+//! A figure's world panels: one per 3-D view of the scene, as the viewer lays them out, and
+//! their places in a grid.
+
+use super::Steps;
+use super::chart::Rect;
+use super::svg;
+use crate::scene::{Scene, SceneItem};
+
+/// A world panel of a figure: the items one 3-D view of the scene shows, with the view's name
+/// when the scene has several (each its own panel, as the viewer lays them out: a log's frames
+/// and its robot-scale view, a graph's before and after, one method each).
+pub(super) struct Panel<'a> {
+    /// The view's name, for a figure of several panels.
+    pub title: Option<&'a str>,
+    /// What the panel draws.
+    pub items: Vec<&'a SceneItem>,
+}
+
+/// The figure's world panels (see [`Panel`]); one for a scene of one view or none.
+pub(super) fn panels(scene: &Scene, steps: Steps) -> Vec<Panel<'_>> {
+    let items = super::selected(scene, steps);
+    let in_view = |view: &crate::scene::View3d, path: &str| {
+        view.shows(path)
+            && !view.hidden.iter().any(|h| {
+                path.strip_prefix(h.as_str())
+                    .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
+            })
+    };
+    match scene.views.as_slice() {
+        [] => vec![Panel { title: None, items }],
+        [view] => vec![Panel {
+            title: None,
+            items: items
+                .into_iter()
+                .filter(|i| in_view(view, &i.path))
+                .collect(),
+        }],
+        views => views
+            .iter()
+            .map(|view| Panel {
+                title: Some(view.name.as_str()),
+                items: items
+                    .iter()
+                    .copied()
+                    .filter(|i| in_view(view, &i.path))
+                    .collect(),
+            })
+            .filter(|panel| !panel.items.is_empty())
+            .collect(),
+    }
+}
+
+/// `count` cells filling `area` in a grid: the columns that give the largest square-ish cell
+/// (a world is drawn at equal scale on both axes), fewer rows on a tie.
+pub(super) fn cells(area: Rect, count: usize) -> Vec<Rect> {
+    let count = count.max(1);
+    let size = |cols: usize| {
+        let rows = count.div_ceil(cols);
+        (area.w / cols as f64).min(area.h / rows as f64)
+    };
+    let cols = (1..=count)
+        .max_by(|a, b| size(*a).total_cmp(&size(*b)).then(a.cmp(b)))
+        .unwrap_or(1);
+    let rows = count.div_ceil(cols);
+    let (w, h) = (area.w / cols as f64, area.h / rows as f64);
+    (0..count)
+        .map(|i| Rect {
+            x: area.x + w * (i % cols) as f64,
+            y: area.y + h * (i / cols) as f64,
+            w,
+            h,
+        })
+        .collect()
+}
+
+/// A panel's name in at most two lines no wider than `width` at font size `size`, the second
+/// ending in "…" when the name is longer.
+pub(super) fn title_lines(name: &str, size: f64, width: f64) -> Vec<String> {
+    let mut lines = svg::wrap(name, size, width);
+    if lines.len() > 2 {
+        lines.truncate(2);
+        lines[1].push_str(" …");
+    }
+    lines
+}
