@@ -2,13 +2,13 @@
 //! growth and a covariance that stays constant while the pose moves. Names, classes and
 //! thresholds are the README's ("Covariance health").
 
-use nalgebra::{DMatrix, SymmetricEigen};
-
 use super::decode::Decoded;
-use crate::plan::bag::{AxisStats, COV_LEN, Health, Issue, Stretch};
-use crate::uncertain::{psd_tolerance, symmetry_tolerance};
+use crate::plan::bag::{AxisStats, COV_LEN, Health, Issue, IssueCount, Stretch};
 
+mod classify;
 mod issues;
+pub use classify::{MessageHealth, classify};
+use classify::{classify_covariance, with_orientation};
 pub use issues::Issues;
 
 pub use crate::plan::bag::PLACEHOLDER;
@@ -20,333 +20,6 @@ pub const GROWTH_FACTOR: f64 = 100.0;
 pub const CONSTANT_MIN_DISTANCE_M: f64 = 1.0;
 /// … and at least this many messages.
 pub const CONSTANT_MIN_MESSAGES: u64 = 10;
-/// The axes planar motion uses (x, y, yaw), by ROS index.
-const PLANAR_AXES: [usize; 3] = [0, 1, 5];
-
-/// What one message's covariance is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MessageHealth {
-    /// The issues of this message alone (drops and growth come from [`Trend`]).
-    pub issues: Issues,
-    /// Axes whose variance is ≥ [`PLACEHOLDER`] or exactly 0, per ROS axis.
-    pub unestimated: [bool; 6],
-    /// Smallest eigenvalue of the estimated block, computed when it is finite, symmetric and
-    /// not positive definite; exactly 0 when it is positive definite but for axes whose row
-    /// and column are zero (`None` otherwise: a positive definite block is PSD).
-    pub min_eigenvalue: Option<f64>,
-    /// Trace of the estimated position block, m² (usable messages only).
-    pub position_trace: Option<f64>,
-}
-
-impl MessageHealth {
-    /// Whether the covariance can be drawn as a Gaussian.
-    pub fn usable(&self) -> bool {
-        !self.issues.any_unusable()
-    }
-}
-
-/// The entries of the `kept` axes' block of `cov`, gathered: `b[r][c] = cov[kept[r] · 6 + kept[c]]`
-/// for `r, c < kept.len()`.
-fn gather(cov: &[f64; COV_LEN], kept: &[usize]) -> [[f64; 6]; 6] {
-    let mut b = [[0.0; 6]; 6];
-    for (r, &i) in kept.iter().enumerate() {
-        for (c, &j) in kept.iter().enumerate() {
-            b[r][c] = cov[i * 6 + j];
-        }
-    }
-    b
-}
-
-/// Whether the symmetrised N × N block `at(r, c)` (`r, c < N`) is positive definite: its
-/// factorisation L D Lᵀ exists with D > 0, computed here on the stack, without square roots
-/// (then its smallest eigenvalue is positive, above any −tolerance, and it is positive
-/// semi-definite by the one rule without computing it). N is known at compile time, so the
-/// loops unroll and the entries are read without index checks.
-#[inline(always)]
-fn positive_definite_block<const N: usize>(at: &impl Fn(usize, usize) -> f64) -> bool {
-    // l[r][c] = L_rc · D_c (c < r), d_inv[c] = 1 / D_c.
-    let mut ld = [[0.0f64; N]; N];
-    let mut d_inv = [0.0f64; N];
-    for r in 0..N {
-        for c in 0..r + 1 {
-            let mut v = 0.5 * (at(r, c) + at(c, r));
-            for k in 0..c {
-                v -= ld[r][k] * ld[c][k] * d_inv[k];
-            }
-            if r == c {
-                if v.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                    return false;
-                }
-                // The last row's 1 / D is never used: one division fewer.
-                if r + 1 < N {
-                    d_inv[r] = 1.0 / v;
-                }
-            } else {
-                ld[r][c] = v;
-            }
-        }
-    }
-    true
-}
-
-/// `f::<N>()` for `N = n` (0 ≤ n ≤ 6): the block functions above are generic in the size.
-macro_rules! by_size {
-    ($n:expr, $f:ident, $($arg:expr),*) => {
-        match $n {
-            0 => $f::<0>($($arg),*),
-            1 => $f::<1>($($arg),*),
-            2 => $f::<2>($($arg),*),
-            3 => $f::<3>($($arg),*),
-            4 => $f::<4>($($arg),*),
-            5 => $f::<5>($($arg),*),
-            _ => $f::<6>($($arg),*),
-        }
-    };
-}
-
-/// Whether the symmetrised block of `cov` on the `kept` axes is positive definite
-/// ([`positive_definite_block`]).
-fn positive_definite(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
-    let b = gather(cov, kept);
-    by_size!(
-        kept.len(),
-        positive_definite_block,
-        &|r: usize, c: usize| b[r][c]
-    )
-}
-
-/// What the checks over the estimated block find.
-struct BlockChecks {
-    /// Every entry is exactly 0.
-    all_zero: bool,
-    /// Some pair Σᵣ꜀, Σ꜀ᵣ differs by more than the symmetry tolerance at the block's scale
-    /// (its largest |variance|).
-    asymmetric: bool,
-}
-
-/// [`BlockChecks`] of the N × N block `at(r, c)`, every entry read once, without early exits
-/// (the compiler compares in vectors).
-#[inline(always)]
-fn block_checks<const N: usize>(at: &impl Fn(usize, usize) -> f64) -> BlockChecks {
-    let mut all_zero = true;
-    let mut scale = 0.0f64;
-    for r in 0..N {
-        scale = scale.max(at(r, r).abs());
-        for c in 0..N {
-            all_zero &= at(r, c) == 0.0;
-        }
-    }
-    // The symmetry rule is evaluation's (`uncertain`): what health calls symmetric,
-    // evaluation accepts.
-    let tol = symmetry_tolerance(scale);
-    let mut asymmetric = false;
-    // Each pair once (|Σᵢⱼ − Σⱼᵢ| is the same from either side; every entry is finite here).
-    for r in 0..N {
-        for c in r + 1..N {
-            asymmetric |= (at(r, c) - at(c, r)).abs() > tol;
-        }
-    }
-    BlockChecks {
-        all_zero,
-        asymmetric,
-    }
-}
-
-/// [`block_checks`] and, when wanted (`pd_wanted(&checks)`), [`positive_definite_block`] of
-/// the N × N block `at`: one function per size, so both unroll.
-fn checks_and_pd<const N: usize>(
-    at: &impl Fn(usize, usize) -> f64,
-    pd_wanted: &impl Fn(&BlockChecks) -> bool,
-) -> (BlockChecks, Option<bool>) {
-    let checks = block_checks::<N>(at);
-    let pd =
-        pd_wanted(&checks).then(|| weakly_correlated::<N>(at) || positive_definite_block::<N>(at));
-    (checks, pd)
-}
-
-/// Whether the symmetrised N × N block `at(r, c)` has a positive diagonal and correlations
-/// ρᵣ꜀ = Σᵣ꜀ / √(Σᵣᵣ Σ꜀꜀) with Σ_{r<c} ρᵣ꜀² ≤ 0.45: then the correlation matrix is I + E with
-/// ‖E‖₂ ≤ ‖E‖_F ≤ √0.9 < 0.95, so its eigenvalues are ≥ 0.05 and the block is positive definite
-/// (by far: the rounding of this sum is 10¹³ times smaller than the margin; anything not
-/// finite fails). A sufficient test without the L D Lᵀ's chain of dependent divisions (six
-/// independent ones here); a block it does not decide goes to [`positive_definite_block`].
-#[inline(always)]
-fn weakly_correlated<const N: usize>(at: &impl Fn(usize, usize) -> f64) -> bool {
-    let mut inv = [0.0f64; N];
-    let mut positive = true;
-    for (r, inv) in inv.iter_mut().enumerate() {
-        let d = at(r, r);
-        positive &= d > 0.0;
-        *inv = 1.0 / d;
-    }
-    let mut sum = 0.0;
-    for r in 0..N {
-        for c in r + 1..N {
-            let m = 0.5 * (at(r, c) + at(c, r));
-            sum += (m * inv[r]) * (m * inv[c]);
-        }
-    }
-    positive && sum <= 0.45
-}
-
-/// Whether the block of `cov` on the `kept` axes is positive definite once the axes whose row
-/// and column are zero in it are left out (a variance of exactly 0 without correlation, "not
-/// estimated", as some drivers publish z, roll and pitch): each such axis adds an eigenvalue
-/// of exactly 0 and leaves the others to the rest, so the block is then PSD with smallest
-/// eigenvalue 0, without an eigen-decomposition.
-fn positive_definite_but_zero_axes(cov: &[f64; COV_LEN], kept: &[usize]) -> bool {
-    let mut rest = [0usize; 6];
-    let mut m = 0;
-    for &i in kept {
-        if kept
-            .iter()
-            .any(|&j| cov[i * 6 + j] != 0.0 || cov[j * 6 + i] != 0.0)
-        {
-            rest[m] = i;
-            m += 1;
-        }
-    }
-    m < kept.len() && positive_definite(cov, &rest[..m])
-}
-
-/// The smallest eigenvalue and the largest (at least 0) of the symmetrised block of `cov` on
-/// the `kept` axes, by nalgebra's symmetric eigen-decomposition: the numbers a covariance
-/// that is not positive definite reports.
-fn eigenvalue_range(cov: &[f64; COV_LEN], kept: &[usize]) -> (f64, f64) {
-    let block = DMatrix::from_fn(kept.len(), kept.len(), |r, c| {
-        0.5 * (cov[kept[r] * 6 + kept[c]] + cov[kept[c] * 6 + kept[r]])
-    });
-    let eig = SymmetricEigen::new(block);
-    let lo = eig
-        .eigenvalues
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
-    let hi = eig.eigenvalues.iter().copied().fold(0.0, f64::max);
-    (lo, hi)
-}
-
-/// Classifies one covariance (ROS layout) and its orientation quaternion.
-///
-/// ```
-/// use posecov::input::bag::health::classify;
-/// use posecov::plan::bag::Issue;
-/// let mut cov = [0.0; 36];
-/// for (i, v) in [0.001, 0.001, 1e6, 1e6, 1e6, 0.03].iter().enumerate() { cov[i * 7] = *v; }
-/// let h = classify(&cov, [0.0, 0.0, 0.0, 1.0]);
-/// assert_eq!(h.issues, vec![Issue::Placeholder]);
-/// assert!(h.usable());
-/// assert_eq!(h.unestimated, [false, false, true, true, true, false]);
-/// ```
-pub fn classify(cov: &[f64; COV_LEN], orientation_xyzw: [f64; 4]) -> MessageHealth {
-    with_orientation(orientation_xyzw, classify_covariance(cov), cov)
-}
-
-/// The message's health from its orientation and its covariance's classification
-/// ([`classify_covariance`]): a bad orientation first, then the covariance's issues, and the
-/// position trace if the message is usable.
-fn with_orientation(
-    orientation_xyzw: [f64; 4],
-    covariance: MessageHealth,
-    cov: &[f64; COV_LEN],
-) -> MessageHealth {
-    let mut issues = Issues::default();
-    let norm = orientation_xyzw.iter().map(|q| q * q).sum::<f64>().sqrt();
-    if !norm.is_finite() || (norm - 1.0).abs() > 1e-3 {
-        issues.push(Issue::BadOrientation);
-    }
-    issues.extend(covariance.issues.iter());
-    let health = MessageHealth {
-        issues,
-        ..covariance
-    };
-    let unestimated = health.unestimated;
-    let position_trace = health.usable().then(|| {
-        (0..3)
-            .filter(|&i| !unestimated[i])
-            .map(|i| cov[i * 7])
-            .sum::<f64>()
-    });
-    MessageHealth {
-        position_trace,
-        ..health
-    }
-}
-
-/// What the covariance alone says (no orientation, no position trace): a function of its 36
-/// entries, so a topic whose covariance repeats classifies it once ([`TopicHealth::add`]).
-fn classify_covariance(cov: &[f64; COV_LEN]) -> MessageHealth {
-    let mut issues = Issues::default();
-    // Every entry read once, without an early exit: in vectors.
-    if !cov.iter().fold(true, |finite, v| finite & v.is_finite()) {
-        issues.push(Issue::NonFinite);
-        return MessageHealth {
-            issues,
-            unestimated: [false; 6],
-            min_eigenvalue: None,
-            position_trace: None,
-        };
-    }
-    let diag: [f64; 6] = std::array::from_fn(|i| cov[i * 7]);
-    let unestimated = diag.map(|v| v == 0.0 || v >= PLACEHOLDER);
-    // The estimated axes: not a placeholder (a huge row would swamp the rounding of the rest).
-    let mut axes = [0, 1, 2, 3, 4, 5];
-    let mut n = 6;
-    let unknown_marker = cov[0] == -1.0;
-    // Positive definiteness is only asked of a symmetric block (not the −1 marker's).
-    let pd_wanted = |checks: &BlockChecks| !checks.asymmetric && !unknown_marker;
-    let (checks, positive_definite) = if diag.iter().all(|v| *v < PLACEHOLDER) {
-        // Every axis estimated (an EKF's covariance): the block is `cov` itself, read in place.
-        checks_and_pd::<6>(&|r: usize, c: usize| cov[r * 6 + c], &pd_wanted)
-    } else {
-        n = 0;
-        for i in (0..6).filter(|&i| diag[i] < PLACEHOLDER) {
-            axes[n] = i;
-            n += 1;
-        }
-        let b = gather(cov, &axes[..n]);
-        by_size!(n, checks_and_pd, &|r: usize, c: usize| b[r][c], &pd_wanted)
-    };
-    let kept = &axes[..n];
-    if unknown_marker {
-        issues.push(Issue::UnknownMarker);
-    } else if n > 0 && checks.all_zero {
-        issues.push(Issue::AllZero);
-    }
-    if PLANAR_AXES.iter().any(|&i| diag[i] >= PLACEHOLDER) {
-        issues.push(Issue::PlaceholderUsedAxis);
-    } else if diag.iter().any(|v| *v >= PLACEHOLDER) {
-        // z, roll or pitch only: a note if the topic turns out planar, else a defect (the
-        // topic's collector decides when it has seen every message).
-        issues.push(Issue::Placeholder);
-    }
-    let mut min_eigenvalue = None;
-    if checks.asymmetric {
-        issues.push(Issue::Asymmetric);
-    } else if n > 0 && positive_definite == Some(false) {
-        // Only a block that is not positive definite needs more (most messages' are: one
-        // factorisation on the stack decides; the eigen-decomposition was most of the health
-        // classes' time).
-        min_eigenvalue = Some(match positive_definite_but_zero_axes(cov, kept) {
-            // Positive definite but for axes whose row and column are zero: their
-            // eigenvalue, exactly 0, is the smallest; PSD.
-            true => 0.0,
-            false => {
-                let (lo, hi) = eigenvalue_range(cov, kept);
-                if lo < -psd_tolerance(hi) {
-                    issues.push(Issue::NotPsd);
-                }
-                lo
-            }
-        });
-    }
-    MessageHealth {
-        issues,
-        unestimated,
-        min_eigenvalue,
-        position_trace: None,
-    }
-}
 
 /// The running state of a topic's position trace: finds sudden drops and unbounded growth.
 #[derive(Debug, Clone, Copy, Default)]
@@ -428,11 +101,17 @@ impl Constancy {
         position: [f64; 3],
         dead_reckoned: bool,
     ) {
-        let trace: f64 = (0..6)
-            .map(|i| cov[i * 7])
-            .filter(|v| *v < PLACEHOLDER)
-            .sum();
         let same = same && self.previous.is_some();
+        // The same entries, the same trace (only compared when they differ).
+        let trace: f64 = match self.previous {
+            Some((t, _)) if same => t,
+            // The variances below the placeholder, summed from −0 as `Iterator::sum` does (a
+            // −0 for each one left out changes nothing, to the bit), without a branch.
+            _ => (0..6).fold(-0.0, |t, i| {
+                let v = cov[i * 7];
+                t + if v < PLACEHOLDER { v } else { -0.0 }
+            }),
+        };
         let continues = same
             || self
                 .previous
@@ -502,14 +181,20 @@ impl Constancy {
 /// let mut topic = TopicHealth::default();
 /// let (h, variance) = topic.add(0, 1, &d, true);
 /// assert!(h.usable() && topic.planar);
-/// assert_eq!(topic.health.count(Issue::Placeholder), 1);
 /// assert!(variance[5] == Some(0.03) && variance[2].is_none());
 /// assert_eq!(topic.sigma_stats()[5].unwrap().max, 0.03f64.sqrt());
+/// let (health, constant) = topic.into_findings();
+/// assert_eq!(health.count(Issue::Placeholder), 1);
+/// assert!(constant.is_none());
 /// ```
 #[derive(Debug, Clone)]
 pub struct TopicHealth {
-    /// Per issue, the count and the first message.
+    /// Per issue, the count and the first message: the topic's own findings (stamps, types);
+    /// the messages' own issues are counted in `counts` until [`Self::into_findings`].
     pub health: Health,
+    /// Per kind of issue (its place in [`Issues::ORDER`]), the messages' count and the first
+    /// ([`Health::note`]'s numbers, without a map lookup per message).
+    counts: [IssueCount; Issues::ORDER.len()],
     pub(super) trend: Trend,
     pub(super) constancy: Constancy,
     /// The last message's covariance and its classification ([`classify_covariance`]): the
@@ -527,13 +212,18 @@ pub struct TopicHealth {
     pub planar: bool,
     /// The variance's statistics per ROS axis over the usable messages that estimate it
     /// (clamped at 0): σ's are their square roots, which keep their order.
-    variance_stats: [Option<AxisStats>; 6],
+    variance_stats: VarianceColumns,
 }
 
 impl Default for TopicHealth {
     fn default() -> Self {
         Self {
             health: Health::default(),
+            counts: [IssueCount {
+                count: 0,
+                first_stamp_ns: 0,
+                first_index: 0,
+            }; Issues::ORDER.len()],
             trend: Trend::default(),
             constancy: Constancy::default(),
             last: None,
@@ -541,18 +231,85 @@ impl Default for TopicHealth {
             usable_before: None,
             usable: 0,
             planar: true,
-            variance_stats: [None; 6],
+            variance_stats: VarianceColumns::default(),
         }
     }
 }
 
-/// Whether `a` and `b` have the same bits in every entry (then every check gives the same
-/// answer, NaN and −0 included), and whether they are equal (`==`: ±0 alike, NaN unequal).
-fn same_entries(a: &[f64; COV_LEN], b: &[f64; COV_LEN]) -> (bool, bool) {
-    // Every entry compared, without an early exit: the compiler compares them in vectors.
-    a.iter().zip(b).fold((true, true), |(bits, equal), (x, y)| {
-        (bits & (x.to_bits() == y.to_bits()), equal & (x == y))
-    })
+/// Whether `a` and `b` have the same bits in every entry: then every check gives the same
+/// answer, NaN and −0 included. The first row is compared first (an EKF's covariance differs
+/// from the one before there), then the other 30 entries; each part as one loop of fixed
+/// length without an early exit, which the compiler does in vectors.
+fn same_bits(a: &[f64; COV_LEN], b: &[f64; COV_LEN]) -> bool {
+    let mut differ = 0u64;
+    for i in 0..6 {
+        differ |= a[i].to_bits() ^ b[i].to_bits();
+    }
+    if differ != 0 {
+        return false;
+    }
+    for i in 6..COV_LEN {
+        differ |= a[i].to_bits() ^ b[i].to_bits();
+    }
+    differ == 0
+}
+
+/// Whether `a` and `b` are equal in every entry (`==`: ±0 alike, NaN unequal), compared as
+/// [`same_bits`] does.
+fn same_values(a: &[f64; COV_LEN], b: &[f64; COV_LEN]) -> bool {
+    let mut equal = true;
+    for i in 0..6 {
+        equal &= a[i] == b[i];
+    }
+    if !equal {
+        return false;
+    }
+    for i in 6..COV_LEN {
+        equal &= a[i] == b[i];
+    }
+    equal
+}
+
+/// The variance's statistics per ROS axis, kept as six columns; [`Self::axis`] gives one
+/// axis's [`AxisStats`], the same numbers [`AxisStats::add`] would have kept.
+#[derive(Debug, Clone, Copy, Default)]
+struct VarianceColumns {
+    messages: [u64; 6],
+    first: [f64; 6],
+    last: [f64; 6],
+    min: [f64; 6],
+    max: [f64; 6],
+}
+
+impl VarianceColumns {
+    /// Adds the next message's variance `v` on axis `i`: finite and either positive or +0 (a
+    /// variance clamped at 0; an exact ±0 is "not estimated"), so `<` and `>` keep what
+    /// `f64::min` and `f64::max` would.
+    #[inline]
+    fn add(&mut self, i: usize, v: f64) {
+        if self.messages[i] == 0 {
+            (self.first[i], self.min[i], self.max[i]) = (v, v, v);
+        }
+        self.messages[i] += 1;
+        self.last[i] = v;
+        if v < self.min[i] {
+            self.min[i] = v;
+        }
+        if v > self.max[i] {
+            self.max[i] = v;
+        }
+    }
+
+    /// Axis `i`'s statistics (`None` before its first message).
+    fn axis(&self, i: usize) -> Option<AxisStats> {
+        (self.messages[i] > 0).then(|| AxisStats {
+            messages: self.messages[i],
+            first: self.first[i],
+            last: self.last[i],
+            min: self.min[i],
+            max: self.max[i],
+        })
+    }
 }
 
 impl TopicHealth {
@@ -567,25 +324,34 @@ impl TopicHealth {
         dead_reckoned: bool,
     ) -> (MessageHealth, [Option<f64>; 6]) {
         let cov = &d.covariance;
-        let (same_bits, same_values) = match &self.last {
-            Some((last, _)) => same_entries(last, cov),
-            None => (false, false),
+        let repeated = match &self.last {
+            Some((last, _)) => same_bits(last, cov),
+            None => false,
         };
         let covariance = match &self.last {
             // The same 36 entries as the message before: the same classification.
-            Some((_, h)) if same_bits => *h,
+            Some((_, h)) if repeated => *h,
             _ => classify_covariance(cov),
         };
         let mut h = with_orientation(d.orientation_xyzw, covariance, cov);
         if let Some(trace) = h.position_trace {
             h.issues.extend(self.trend.next(trace).iter());
         }
-        for issue in h.issues.iter() {
-            self.health.note(issue, stamp_ns, index);
-        }
-        if h.issues.contains(Issue::NotPsd) {
-            let lo = h.min_eigenvalue.unwrap_or(0.0);
-            self.health.min_eigenvalue = Some(self.health.min_eigenvalue.map_or(lo, |m| m.min(lo)));
+        if !h.issues.is_empty() {
+            for (k, _) in h.issues.iter_placed() {
+                // As `Health::note`: the count, and the earliest stamp's message.
+                let c = &mut self.counts[k];
+                if c.count == 0 || stamp_ns < c.first_stamp_ns {
+                    c.first_stamp_ns = stamp_ns;
+                    c.first_index = index;
+                }
+                c.count += 1;
+            }
+            if h.issues.contains(Issue::NotPsd) {
+                let lo = h.min_eigenvalue.unwrap_or(0.0);
+                self.health.min_eigenvalue =
+                    Some(self.health.min_eigenvalue.map_or(lo, |m| m.min(lo)));
+            }
         }
         let usable = h.usable();
         if usable {
@@ -593,10 +359,11 @@ impl TopicHealth {
             self.planar &= h.unestimated[2] && h.unestimated[3] && h.unestimated[4];
             // The same entries as the last usable message: `last` itself when that was the
             // message before, else the copy kept when it moved on.
-            let same = match (self.last_usable, &self.usable_before) {
-                (true, _) => same_values,
-                (false, Some(before)) => same_entries(before, cov).1,
-                (false, None) => false,
+            // (A usable covariance is finite: the same bits are the same values.)
+            let same = match (self.last_usable, &self.usable_before, &self.last) {
+                (true, _, Some((last, _))) => repeated || same_values(last, cov),
+                (false, Some(before), _) => same_values(before, cov),
+                _ => false,
             };
             self.constancy
                 .next(index, stamp_ns, cov, same, d.position, dead_reckoned);
@@ -608,7 +375,7 @@ impl TopicHealth {
         }
         self.last_usable = usable;
         match &mut self.last {
-            Some(_) if same_bits => {}
+            Some(_) if repeated => {}
             // In place: one 36-entry copy.
             Some((last, h)) => {
                 *last = *cov;
@@ -616,115 +383,36 @@ impl TopicHealth {
             }
             None => self.last = Some((*cov, covariance)),
         }
-        let variance: [Option<f64>; 6] =
-            std::array::from_fn(|i| (usable && !h.unestimated[i]).then(|| cov[i * 7].max(0.0)));
-        for (stats, v) in self.variance_stats.iter_mut().zip(variance) {
-            if let Some(v) = v {
-                AxisStats::add(stats, v);
+        let mut variance = [None; 6];
+        if usable {
+            for (i, variance) in variance.iter_mut().enumerate() {
+                if !h.unestimated[i] {
+                    let v = cov[i * 7].max(0.0);
+                    self.variance_stats.add(i, v);
+                    *variance = Some(v);
+                }
             }
         }
         (h, variance)
+    }
+
+    /// The topic's findings once every message is in: its [`Health`] with the messages' own
+    /// issues counted in, and the longest constant stretch when it makes a finding
+    /// ([`Constancy::finding`]).
+    pub fn into_findings(self) -> (Health, Option<Stretch>) {
+        let mut health = self.health;
+        for (issue, counted) in Issues::ORDER.iter().zip(self.counts) {
+            if counted.count > 0 {
+                health.add(*issue, counted);
+            }
+        }
+        (health, self.constancy.finding())
     }
 
     /// σ per ROS axis over the usable messages that estimate it: first, last, smallest and
     /// largest (the square roots of the variances' — `√` keeps their order, so these are the
     /// σ's own, to the bit).
     pub fn sigma_stats(&self) -> [Option<AxisStats>; 6] {
-        self.variance_stats.map(|s| s.map(AxisStats::sqrt))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn diag(d: [f64; 6]) -> [f64; 36] {
-        let mut c = [0.0; 36];
-        for i in 0..6 {
-            c[i * 7] = d[i];
-        }
-        c
-    }
-    const Q: [f64; 4] = [0.0, 0.0, 0.0, 1.0];
-
-    #[test]
-    fn each_case_has_its_word() {
-        assert!(classify(&diag([0.1; 6]), Q).issues.is_empty());
-        assert_eq!(classify(&[0.0; 36], Q).issues, vec![Issue::AllZero]);
-        let mut m = diag([0.1; 6]);
-        m[0] = -1.0;
-        assert_eq!(classify(&m, Q).issues, vec![Issue::UnknownMarker]);
-        assert_eq!(
-            classify(&diag([0.1, 0.1, 1.79e308, 0.1, 0.1, 0.1]), Q).issues,
-            vec![Issue::Placeholder]
-        );
-        assert_eq!(
-            classify(&diag([1e6, 0.1, 0.1, 0.1, 0.1, 0.1]), Q).issues,
-            vec![Issue::PlaceholderUsedAxis]
-        );
-        // Zeros on x, y, yaw with placeholders elsewhere: nothing is estimated.
-        assert_eq!(
-            classify(&diag([0.0, 0.0, 1e6, 1e6, 1e6, 0.0]), Q).issues,
-            vec![Issue::AllZero, Issue::Placeholder]
-        );
-        let mut n = diag([0.1; 6]);
-        n[3] = f64::NAN;
-        assert_eq!(classify(&n, Q).issues, vec![Issue::NonFinite]);
-        let mut a = diag([0.1; 6]);
-        a[1] = 0.05;
-        assert_eq!(classify(&a, Q).issues, vec![Issue::Asymmetric]);
-        let mut p = diag([0.1; 6]);
-        p[1] = 0.5;
-        p[6] = 0.5;
-        let h = classify(&p, Q);
-        assert_eq!(h.issues, vec![Issue::NotPsd]);
-        assert!((h.min_eigenvalue.unwrap() - (0.1 - 0.5)).abs() < 1e-12);
-        assert_eq!(
-            classify(&diag([0.1; 6]), [0.0, 0.0, 0.0, 2.0]).issues,
-            vec![Issue::BadOrientation]
-        );
-    }
-
-    #[test]
-    fn zero_axes_are_psd_without_an_eigen_decomposition() {
-        // z, roll and pitch published as exact zeros: positive definite on x, y and yaw, and
-        // the smallest eigenvalue is the zero axes' 0 (what the eigen-decomposition gives).
-        let h = classify(&diag([1e-3, 1e-3, 0.0, 0.0, 0.0, 0.03]), Q);
-        assert!(h.usable() && h.issues.is_empty(), "{:?}", h.issues);
-        assert_eq!(h.min_eigenvalue, Some(0.0));
-        assert_eq!(h.unestimated, [false, false, true, true, true, false]);
-        assert_eq!(
-            eigenvalue_range(
-                &diag([1e-3, 1e-3, 0.0, 0.0, 0.0, 0.03]),
-                &[0, 1, 2, 3, 4, 5]
-            )
-            .0,
-            0.0
-        );
-        // A zero variance correlated with another axis is no zero axis: not PSD.
-        let mut c = diag([1e-3, 1e-3, 0.0, 0.0, 0.0, 0.03]);
-        c[2] = 1e-4;
-        c[12] = 1e-4;
-        let h = classify(&c, Q);
-        assert!(h.issues.contains(Issue::NotPsd), "{:?}", h.issues);
-        assert!(h.min_eigenvalue.unwrap() < -1e-6);
-    }
-
-    #[test]
-    fn placeholders_do_not_spoil_the_psd_check() {
-        // 1.79e308 next to 1e-3: eigenvalues of the whole matrix would be rounding noise.
-        let h = classify(&diag([1e-3, 1e-3, 1.79e308, 1e6, 1e6, 0.03]), Q);
-        assert!(h.usable());
-        // Positive definite: decided by Cholesky, no eigenvalue computed.
-        assert_eq!(h.min_eigenvalue, None);
-        assert_eq!(h.position_trace, Some(2e-3));
-        // Singular but PSD (x and y fully correlated): the eigenvalues decide, within the
-        // tolerance.
-        let mut s = diag([1e-3, 1e-3, 1e6, 1e6, 1e6, 0.03]);
-        s[1] = 1e-3;
-        s[6] = 1e-3;
-        let h = classify(&s, Q);
-        assert!(!h.issues.contains(Issue::NotPsd), "{:?}", h.issues);
-        assert!(h.min_eigenvalue.unwrap().abs() < 1e-15);
+        std::array::from_fn(|i| self.variance_stats.axis(i).map(AxisStats::sqrt))
     }
 }

@@ -188,12 +188,12 @@ impl TopicState {
         let checks = self.checks;
         let sigma_stats = checks.sigma_stats();
         let planar = checks.planar && checks.usable > 0;
-        let mut health = checks.health;
+        let (mut health, constant) = checks.into_findings();
         if !planar && let Some(on_used_axes) = health.issues.remove(&Issue::Placeholder) {
             // z, roll and pitch are axes a 3-D topic uses.
             health.add(Issue::PlaceholderUsedAxis, on_used_axes);
         }
-        if let Some(stretch) = checks.constancy.finding() {
+        if let Some(stretch) = constant {
             health.add(
                 Issue::Constant,
                 IssueCount {

@@ -29,6 +29,9 @@ use crate::plan::bag::Issue;
 pub struct Issues(u32);
 
 impl Issues {
+    /// No issue.
+    pub const EMPTY: Issues = Issues(0);
+
     /// Every kind of issue, in the order a message lists them: the order the checks find them
     /// (the orientation; the covariance: not finite, ROS's −1, all zero, placeholders,
     /// asymmetric, not PSD; the position trace's trend), then the kinds found per topic or
@@ -122,6 +125,16 @@ impl Issues {
     /// How many kinds.
     pub fn len(&self) -> usize {
         self.0.count_ones() as usize
+    }
+
+    /// The issues with their places in [`Self::ORDER`], in that order.
+    pub fn iter_placed(&self) -> impl Iterator<Item = (usize, Issue)> + use<> {
+        let mut bits = self.0;
+        std::iter::from_fn(move || {
+            let b = bits.trailing_zeros() as usize;
+            bits &= bits.wrapping_sub(1);
+            Self::ORDER.get(b).map(|issue| (b, *issue))
+        })
     }
 
     /// The issues, in [`Self::ORDER`].
