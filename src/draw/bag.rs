@@ -108,8 +108,9 @@ pub fn bag_scene(e: &BagEvaluation, settings: &BagDrawSettings, summary: &str) -
     p.scene.planar = planar;
     p.scene.plots_below = true;
     p.scene.confidence = Some(settings.confidence);
+    let noting = rviz_noting(e);
     for (k, topic) in e.topics.iter().enumerate() {
-        draw_topic(&mut p, k, topic);
+        draw_topic(&mut p, k, topic, noting.contains(&topic.name.as_str()));
     }
     // Dates, or durations when the stamps are not dates (simulated time).
     let stamps = p.scene.items.iter().filter_map(|i| match i.timing {
@@ -178,6 +179,26 @@ fn by_frame(e: &BagEvaluation) -> BTreeMap<&str, Vec<&TopicEvaluation>> {
         frames.entry(frame_name(t)).or_default().push(t);
     }
     frames
+}
+
+/// The topics that say RViz's note on a clipped placeholder in their whole-log view: per view,
+/// the first whose RViz shape has a clipped axis. A view's topics are drawn at much the same
+/// place (an odometry, its EKF, AMCL: one robot), where the same note from each would be
+/// written over the others; every topic's own placeholder finding is in the text panel.
+fn rviz_noting(e: &BagEvaluation) -> Vec<&str> {
+    by_frame(e)
+        .into_values()
+        .filter_map(|topics| {
+            topics.into_iter().find(|t| {
+                t.poses.iter().any(|q| {
+                    q.rviz
+                        .as_ref()
+                        .is_some_and(|r| rviz::has_clipped_axis(r, t.planar))
+                })
+            })
+        })
+        .map(|t| t.name.as_str())
+        .collect()
 }
 
 /// The views: per frame the whole log of its topics (their robot views left out), then per
@@ -256,7 +277,10 @@ fn flat(planar: bool, v: &Vector3<f64>) -> Vec3 {
     if planar { [v.x, v.y, 0.0] } else { v3(v) }
 }
 
-fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
+/// Draws topic `t` (number `k`, for its colour): its trajectory, the faint overview, each
+/// drawn message in the whole-log view (RViz's placeholder note on the shape when
+/// `rviz_note`, [`rviz_noting`]) and its robot view.
+fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation, rviz_note: bool) {
     let base = topic_entity(&t.name);
     let color = Method::ALL[k % Method::ALL.len()].color();
     let strip: Vec<Vec3> = t
@@ -282,6 +306,7 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation) {
         base: &base,
         shift: Vector3::zeros(),
         label: None,
+        rviz_note,
     };
     for pose in &t.poses {
         if let Some(mean) = pose.mean {
@@ -408,5 +433,48 @@ mod tests {
                 && matches!(&i.kind, ItemKind::Frame(f) if f.translation[..2] == [0.0, 0.0])
         });
         assert!(frames.count() > 0);
+    }
+
+    #[test]
+    fn rviz_s_placeholder_note_is_said_once_per_view() {
+        // amcl_tf.mcap: /amcl_pose and /odom (joined into `map` through /tf), one view, both
+        // with RViz's z placeholder, drawn at much the same place. The note is on one topic's
+        // shapes only; both shapes are still drawn clipped.
+        let scene = scene_of("mcap/amcl_tf.mcap");
+        let whole: Vec<&View3d> = scene
+            .views
+            .iter()
+            .filter(|v| v.name.starts_with("frame "))
+            .collect();
+        assert_eq!(whole.len(), 1, "{:?}", scene.views);
+        assert_eq!(whole[0].include.len(), 2, "{:?}", whole[0]);
+        let shapes = |labelled: bool| -> BTreeMap<String, usize> {
+            let mut by_topic = BTreeMap::new();
+            for i in &scene.items {
+                if let ItemKind::Ellipsoids(e) = &i.kind
+                    && i.path.ends_with("/rviz/position")
+                    && !i.path.contains("/robot/")
+                    && e.label.is_some() == labelled
+                {
+                    *by_topic.entry(i.path.clone()).or_insert(0) += 1;
+                }
+            }
+            by_topic
+        };
+        let labelled = shapes(true);
+        assert_eq!(labelled.len(), 1, "{labelled:?}");
+        let (path, count) = labelled.iter().next().unwrap();
+        assert!(*count > 1, "{labelled:?}");
+        // The other topic's shapes are drawn, unlabelled.
+        let unlabelled = shapes(false);
+        assert!(unlabelled.keys().any(|p| p != path), "{unlabelled:?}");
+        let note = scene.items.iter().find_map(|i| match &i.kind {
+            ItemKind::Ellipsoids(e) if i.path == *path => e.label.clone(),
+            _ => None,
+        });
+        assert_eq!(
+            note.as_deref(),
+            Some("RViz: z placeholder (σ² ≥ 1e6), clipped")
+        );
     }
 }

@@ -27,6 +27,9 @@ pub(super) struct Placement<'a> {
     pub shift: Vector3<f64>,
     /// The frame's label, if any.
     pub label: Option<String>,
+    /// Whether RViz's note on a clipped placeholder is said on its shape (where no frame label
+    /// is, and only by one topic of a view: [`rviz_noting`](super::rviz_noting)).
+    pub rviz_note: bool,
 }
 
 /// Draws one message of topic `t` at `place` (see the [module docs](self)).
@@ -46,9 +49,9 @@ pub(super) fn message(
         p.confidence().radius(1),
     );
     // RViz's note on a clipped placeholder labels its shape where no frame label is (the
-    // whole-log view); the robot view's frame label is the message's σ.
+    // whole-log view, one topic of it); the robot view's frame label is the message's σ.
     if let Some(rviz) = &pose.rviz {
-        let label_shape = place.label.is_none();
+        let label_shape = place.label.is_none() && place.rviz_note;
         rviz_picture(
             p,
             base,

@@ -86,6 +86,7 @@ pub(super) fn robot_view(p: &mut Painter, base: &str, t: &TopicEvaluation) {
                 shift
             },
             label: Some(label(t, pose)),
+            rviz_note: false,
         };
         message(p, &place, t, pose, &mean);
     }

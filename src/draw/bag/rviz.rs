@@ -18,6 +18,25 @@ const RVIZ_MAX_ANGLE: f64 = 89.0 * std::f64::consts::PI / 180.0;
 /// A placeholder axis is clipped at this many times the largest estimated half-size.
 const PLACEHOLDER_CLIP: f64 = 3.0;
 
+/// The position block RViz draws (its x–y block alone when it takes the pose as 2-D) and its
+/// placeholder axes (σ² ≥ [`PLACEHOLDER`]), which [`rviz_position`] clips and labels.
+fn position_block(rviz: &RvizNumbers, planar: bool) -> (Matrix3<f64>, Vec<usize>) {
+    let mut cov = rviz.position_cov;
+    let flat_2d = rviz.pose_2d || planar && rviz.position_cov[(2, 2)] <= 0.0;
+    if flat_2d {
+        cov.row_mut(2).fill(0.0);
+        cov.column_mut(2).fill(0.0);
+    }
+    let placeholders = (0..3).filter(|&i| cov[(i, i)] >= PLACEHOLDER).collect();
+    (cov, placeholders)
+}
+
+/// Whether RViz's position shape of this message has a clipped placeholder axis (then
+/// [`rviz_position`] returns its label).
+pub(super) fn has_clipped_axis(rviz: &RvizNumbers, planar: bool) -> bool {
+    !position_block(rviz, planar).1.is_empty()
+}
+
 /// RViz's position shape: the 3-D ellipsoid of the parent-frame position block, or the
 /// ellipse of its x–y block when RViz takes the pose as 2-D. An axis whose variance is a
 /// placeholder (≥ 1e6) is drawn clipped at [`PLACEHOLDER_CLIP`] × the largest estimated
@@ -32,13 +51,7 @@ pub(super) fn rviz_position(
     fallback: f64,
     planar: bool,
 ) -> (Ellipsoid, Option<String>) {
-    let mut cov = rviz.position_cov;
-    let flat_2d = rviz.pose_2d || planar && rviz.position_cov[(2, 2)] <= 0.0;
-    if flat_2d {
-        cov.row_mut(2).fill(0.0);
-        cov.column_mut(2).fill(0.0);
-    }
-    let placeholders: Vec<usize> = (0..3).filter(|&i| cov[(i, i)] >= PLACEHOLDER).collect();
+    let (cov, placeholders) = position_block(rviz, planar);
     if placeholders.is_empty() {
         return (ellipsoid_of(center, &cov, r), None);
     }
