@@ -16,7 +16,9 @@ pub(super) struct Panel<'a> {
     pub items: Vec<&'a SceneItem>,
 }
 
-/// The figure's world panels (see [`Panel`]); one for a scene of one view or none.
+/// The figure's world panels (see [`Panel`]); one for a scene of one view or none, and one
+/// untitled empty panel when no view of several shows anything (its axes, as one empty view
+/// gets: never a figure without its world).
 pub(super) fn panels(scene: &Scene, steps: Steps) -> Vec<Panel<'_>> {
     let items = super::selected(scene, steps);
     let in_view = |view: &crate::scene::View3d, path: &str| {
@@ -35,18 +37,49 @@ pub(super) fn panels(scene: &Scene, steps: Steps) -> Vec<Panel<'_>> {
                 .filter(|i| in_view(view, &i.path))
                 .collect(),
         }],
-        views => views
-            .iter()
-            .map(|view| Panel {
-                title: Some(view.name.as_str()),
-                items: items
-                    .iter()
-                    .copied()
-                    .filter(|i| in_view(view, &i.path))
-                    .collect(),
+        views => {
+            let shown: Vec<Panel<'_>> = views
+                .iter()
+                .map(|view| Panel {
+                    title: Some(view.name.as_str()),
+                    items: items
+                        .iter()
+                        .copied()
+                        .filter(|i| in_view(view, &i.path))
+                        .collect(),
+                })
+                .filter(|panel| !panel.items.is_empty())
+                .collect();
+            if shown.is_empty() {
+                vec![Panel {
+                    title: None,
+                    items: Vec::new(),
+                }]
+            } else {
+                shown
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::View3d;
+
+    #[test]
+    fn views_that_show_nothing_leave_one_empty_panel() {
+        let mut scene = Scene::new("t", "d");
+        scene.views = ["a", "b"]
+            .map(|name| View3d {
+                name: name.into(),
+                include: vec![format!("world/{name}")],
+                ..Default::default()
             })
-            .filter(|panel| !panel.items.is_empty())
-            .collect(),
+            .to_vec();
+        let panels = panels(&scene, Steps::All);
+        assert_eq!(panels.len(), 1);
+        assert!(panels[0].title.is_none() && panels[0].items.is_empty());
     }
 }
 
