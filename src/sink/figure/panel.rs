@@ -62,27 +62,6 @@ pub(super) fn panels(scene: &Scene, steps: Steps) -> Vec<Panel<'_>> {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scene::View3d;
-
-    #[test]
-    fn views_that_show_nothing_leave_one_empty_panel() {
-        let mut scene = Scene::new("t", "d");
-        scene.views = ["a", "b"]
-            .map(|name| View3d {
-                name: name.into(),
-                include: vec![format!("world/{name}")],
-                ..Default::default()
-            })
-            .to_vec();
-        let panels = panels(&scene, Steps::All);
-        assert_eq!(panels.len(), 1);
-        assert!(panels[0].title.is_none() && panels[0].items.is_empty());
-    }
-}
-
 /// `count` cells filling `area` in a grid: the columns that give the largest square-ish cell
 /// (a world is drawn at equal scale on both axes), fewer rows on a tie.
 pub(super) fn cells(area: Rect, count: usize) -> Vec<Rect> {
@@ -115,4 +94,25 @@ pub(super) fn title_lines(name: &str, size: f64, width: f64) -> Vec<String> {
         lines[1].push_str(" …");
     }
     lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::View3d;
+
+    #[test]
+    fn views_that_show_nothing_leave_one_empty_panel() {
+        let mut scene = Scene::new("t", "d");
+        scene.views = ["a", "b"]
+            .map(|name| View3d {
+                name: name.into(),
+                include: vec![format!("world/{name}")],
+                ..Default::default()
+            })
+            .to_vec();
+        let panels = panels(&scene, Steps::All);
+        assert_eq!(panels.len(), 1);
+        assert!(panels[0].title.is_none() && panels[0].items.is_empty());
+    }
 }
