@@ -323,6 +323,15 @@ mod tests {
     use crate::input::bag::{BagOptions, read_bag};
     use crate::scene::Ellipsoid;
 
+    /// The scene's whole-log views (one per frame; the robot views left out).
+    fn whole_log_views(scene: &Scene) -> Vec<&View3d> {
+        scene
+            .views
+            .iter()
+            .filter(|v| v.name.starts_with("frame "))
+            .collect()
+    }
+
     /// The scene of a log under `tests/data/`, drawn with the defaults.
     fn scene_of(file: &str) -> Scene {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -413,11 +422,7 @@ mod tests {
         // The health-case MCAP: /planar/odom in `odom`, /amcl_pose in `map`, /bare without a
         // header (no frame_id).
         let scene = scene_of("mcap/health_cases.mcap");
-        let whole: Vec<&View3d> = scene
-            .views
-            .iter()
-            .filter(|v| v.name.starts_with("frame "))
-            .collect();
+        let whole = whole_log_views(&scene);
         assert_eq!(whole.len(), 3, "{:?}", scene.views);
         for view in &whole {
             // Each frame's view shows its own topics only, their robot views left out.
@@ -441,11 +446,7 @@ mod tests {
         // with RViz's z placeholder, drawn at much the same place. The note is on one topic's
         // shapes only; both shapes are still drawn clipped.
         let scene = scene_of("mcap/amcl_tf.mcap");
-        let whole: Vec<&View3d> = scene
-            .views
-            .iter()
-            .filter(|v| v.name.starts_with("frame "))
-            .collect();
+        let whole = whole_log_views(&scene);
         assert_eq!(whole.len(), 1, "{:?}", scene.views);
         assert_eq!(whole[0].include.len(), 2, "{:?}", whole[0]);
         let shapes = |labelled: bool| -> BTreeMap<String, usize> {

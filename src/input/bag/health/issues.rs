@@ -139,12 +139,7 @@ impl Issues {
 
     /// The issues, in [`Self::ORDER`].
     pub fn iter(&self) -> impl Iterator<Item = Issue> + use<> {
-        let mut bits = self.0;
-        std::iter::from_fn(move || {
-            let b = bits.trailing_zeros();
-            bits &= bits.wrapping_sub(1);
-            Self::ORDER.get(b as usize).copied()
-        })
+        self.iter_placed().map(|(_, issue)| issue)
     }
 }
 
