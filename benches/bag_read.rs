@@ -1,4 +1,4 @@
-//! Reading a robot log with posecov: `input::bag::read_bag` on robot_localization's test2.bag
+//! Reading a robot log with posecov: `input::log::read_log` on robot_localization's test2.bag
 //! (ROS 1, bz2 chunks, 3060 nav_msgs/Odometry + 3061 skipped IMU messages): every chunk
 //! decompressed, every Odometry decoded and its covariance health classified, the drawn set
 //! and the series kept. The twin, reading the same bag with the Python `rosbags` package, is
@@ -11,7 +11,7 @@
 //!   the same parallel batches on the same rayon threads as posecov's reader. posecov's read
 //!   should stay within 1.2× of it.
 //! - `bag_health/NAME`: the health classes and σ statistics alone
-//!   ([`TopicHealth::add`](posecov::input::bag::health::TopicHealth) over every pose message,
+//!   ([`TopicHealth::add`](posecov::input::log::health::TopicHealth) over every pose message,
 //!   decoded beforehand and handed over in cache, a block of 64 at a time, as the read hands
 //!   them over after decoding): they should add ≤ 10 % to the read's time.
 //!
@@ -24,9 +24,9 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use posecov::input::bag::decode::{Decoded, decode_ros1, ros1_kind};
-use posecov::input::bag::health::TopicHealth;
-use posecov::input::bag::{BagOptions, read_bag};
+use posecov::input::log::decode::{Decoded, decode_ros1, ros1_kind};
+use posecov::input::log::health::TopicHealth;
+use posecov::input::log::{LogOptions, read_log};
 use rayon::prelude::*;
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
@@ -40,9 +40,9 @@ const MCAP: &str = concat!(
 );
 
 fn pose_messages(path: &str) -> u64 {
-    let plan = read_bag(
+    let plan = read_log(
         Path::new(path),
-        &BagOptions::default(),
+        &LogOptions::default(),
         &mut |_, _| {},
         None,
     )
@@ -66,7 +66,7 @@ fn bags() -> Vec<(String, String)> {
     bags
 }
 
-/// Per bag, its three measures one right after the other (a shared machine's load changes
+/// Per log, its three measures one right after the other (a shared machine's load changes
 /// over minutes: what is compared is measured seconds apart).
 fn bag_benches(c: &mut Criterion) {
     for (name, path) in &bags() {
@@ -85,9 +85,9 @@ fn bag_read(c: &mut Criterion, name: &str, path: &str) {
     group.throughput(Throughput::Elements(pose_messages(path)));
     group.bench_function(name, |b| {
         b.iter(|| {
-            let plan = read_bag(
+            let plan = read_log(
                 Path::new(black_box(path)),
-                &BagOptions::default(),
+                &LogOptions::default(),
                 &mut |_, _| {},
                 None,
             )
@@ -144,7 +144,7 @@ fn bag_libbz2(c: &mut Criterion, name: &str, path: &str) {
     group.finish();
 }
 
-/// Every pose message of a ROS 1 bag, decoded.
+/// Every pose message of a ROS 1 log, decoded.
 fn decoded(path: &str) -> Vec<(i64, Decoded)> {
     let bag = RosBag::new(path).unwrap();
     let mut kinds = std::collections::HashMap::new();

@@ -8,12 +8,12 @@
 //! This crate is the library behind the `posecov` binary. Data flows one way, through five
 //! stages, each getting only its own settings and handing plain data to the next:
 //!
-//! 1. [`input`]: a file (TOML scenario, g2o / GTSAM / TORO pose graph, ROS 1 bag, MCAP) or a
+//! 1. [`input`]: a file (TOML scenario, g2o / GTSAM / TORO pose graph, ROS 1 log, MCAP) or a
 //!    bundled example, its format decided once, read and checked with every error at its
 //!    `file:line:column` → a typed [`plan`] ([`plan::Plan`]; a robot log:
-//!    [`plan::bag::LogSummary`]).
+//!    [`plan::log::LogSummary`]).
 //! 2. [`eval`]: numbers only — every method's estimate, Monte Carlo statistics and typed
-//!    findings ([`eval::Evaluation`]; logs: [`eval::bag`]).
+//!    findings ([`eval::Evaluation`]; logs: [`eval::log`]).
 //! 3. [`draw`]: what to show — shapes, clouds, plots, text and views as plain data.
 //! 4. [`scene`]: that plain data ([`scene::Scene`]), validated, knowing nothing of Rerun.
 //! 5. `sink` (viewer feature): the scene to the Rerun viewer, an .rrd file, stdout or a web

@@ -194,7 +194,7 @@ struct ScenarioArgs {
     /// (default), `first` (the first poses coincide) or `se3` (Umeyama/Horn fit of the
     /// positions, no scale).
     #[arg(long, value_name = "none|first|se3")]
-    align: Option<posecov::eval::nees::Align>,
+    align: Option<posecov::eval::log::nees::Align>,
 }
 
 /// How to evaluate: values that override the file's.

@@ -26,8 +26,8 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-pub mod bag;
 pub mod graph;
+pub mod log;
 
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 pub use crate::propagate::odometry::StepNoise;

@@ -7,11 +7,11 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
-use posecov::input::bag::decode::{
+use posecov::input::log::decode::{
     Header, Pose, PoseWithCovariance, PoseWithCovarianceStamped, Time, nested,
 };
-use posecov::input::bag::{BagOptions, read_bag};
-use posecov::plan::bag::{Issue, LogSummary};
+use posecov::input::log::{LogOptions, read_log};
+use posecov::plan::log::{Issue, LogSummary};
 
 const TEST2: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -30,7 +30,7 @@ fn file(name: &str, bytes: &[u8]) -> PathBuf {
 }
 
 fn read(path: &Path) -> LogSummary {
-    read_bag(path, &BagOptions::default(), &mut |_, _| {}, None)
+    read_log(path, &LogOptions::default(), &mut |_, _| {}, None)
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
@@ -99,14 +99,18 @@ fn a_bag_cut_inside_a_chunk_keeps_its_whole_chunks_and_says_where() {
 #[test]
 fn a_cut_bag_through_the_app_is_drawn_said_and_fails_check() {
     use posecov::app::{
-        Overrides, bag,
+        Overrides, log,
         run::{Run, open},
     };
     let bytes = std::fs::read(TEST2).unwrap();
     let path = file("cut.bag", &bytes[..300_000]);
     let name = path.display().to_string();
-    let Run::Log(run) = Run::start(open(&name).unwrap(), &Overrides::default(), None).unwrap()
-    else {
+    let Run::Log(run) = Run::start(
+        open(&name).unwrap(),
+        &Overrides::default(),
+        posecov::app::run::RunOptions::shown(),
+    )
+    .unwrap() else {
         panic!("a log")
     };
     assert!(
@@ -116,13 +120,13 @@ fn a_cut_bag_through_the_app_is_drawn_said_and_fails_check() {
         "{}",
         run.scene.description_markdown
     );
-    let json = bag::report_json("cut", &run);
+    let json = log::report_json("cut", &run);
     assert_eq!(
         json["meta"]["cut_short"]["chunks_read"], 2,
         "{}",
         json["meta"]
     );
-    let checked = bag::check(&run, "cut", &posecov::plan::bag::Issue::ALL);
+    let checked = log::check(&run, "cut", &posecov::plan::log::Issue::ALL);
     assert_eq!(checked.exit_code(), 1, "{checked:?}");
     assert!(
         checked.defects[0].contains("the log stops early"),
@@ -142,7 +146,7 @@ fn a_cut_before_any_whole_chunk_is_no_pose_topic() {
     let path = file("early.bag", &bytes[..60_000]);
     let e = posecov::input::locate(&path.display().to_string())
         .and_then(|l| {
-            posecov::input::bag::read_located(&l, &BagOptions::default(), &mut |_, _| {}, None)
+            posecov::input::log::read_located(&l, &LogOptions::default(), &mut |_, _| {}, None)
         })
         .unwrap_err()
         .to_string();
@@ -244,14 +248,14 @@ fn a_topic_whose_type_changes_is_read_in_its_first_type_and_said() {
         t.health.other_types,
         ["sensor_msgs/msg/Imu", "nav_msgs/msg/Odometry"]
     );
-    let sentence = posecov::draw::bag::issue_sentence(Issue::TypeChange, t);
+    let sentence = posecov::draw::log::issue_sentence(Issue::TypeChange, t);
     assert!(
         sentence.contains("sensor_msgs/msg/Imu, nav_msgs/msg/Odometry"),
         "{sentence}"
     );
     assert_eq!(
         Issue::TypeChange.class(false),
-        posecov::plan::bag::Class::Defect
+        posecov::plan::log::Class::Defect
     );
     assert_eq!(Issue::from_name("type_change"), Some(Issue::TypeChange));
 }

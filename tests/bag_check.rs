@@ -7,7 +7,7 @@ use std::io::Cursor;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
-use posecov::input::bag::decode::{
+use posecov::input::log::decode::{
     Header, Odometry, Pose, PoseWithCovariance, Time, TwistWithCovariance, nested,
 };
 

@@ -14,19 +14,19 @@ use std::process::Command;
 use common::logs::{McapLog, cdr, header};
 use nalgebra::{Matrix3, Matrix6, Vector6};
 use posecov::app::{
-    Overrides, bag,
+    Overrides, log,
     run::{Run, open},
 };
-use posecov::eval::bag::{BagEvalSettings, PoseState, evaluate_bag};
-use posecov::eval::frames::{FrameProblemKind, join_plan};
-use posecov::input::bag::decode::{
+use posecov::eval::log::frames::{FrameProblemKind, join_plan};
+use posecov::eval::log::{LogEvalSettings, PoseState, evaluate_log};
+use posecov::input::log::decode::{
     Odometry, Pose, PoseWithCovariance, PoseWithCovarianceStamped, nested,
 };
-use posecov::input::bag::reference::{TfMessage, Transform, TransformStamped};
-use posecov::input::bag::{BagOptions, read_bag};
+use posecov::input::log::reference::{TfMessage, Transform, TransformStamped};
+use posecov::input::log::{LogOptions, read_log};
 use posecov::interop::{RosReading, ros_cov_moved, ros_cov_to_right};
 use posecov::lie::{LieGroup, Se3, So3};
-use posecov::plan::bag::{ReferenceSample, TfEdge, TfTree};
+use posecov::plan::log::{ReferenceSample, TfEdge, TfTree};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -178,12 +178,12 @@ fn committed_amcl_log_is_the_generators_output() {
         std::fs::write(AMCL_EXAMPLE, &bytes).expect("write the example");
     }
     // The writer's summary order is not byte-stable; what reading it gives must be the same.
-    let options = BagOptions {
+    let options = LogOptions {
         every: Some(1),
         ..Default::default()
     };
     let generated = file("amcl_generated.mcap", &bytes);
-    let read = |path: &Path| read_bag(path, &options, &mut |_, _| {}, None).expect("read");
+    let read = |path: &Path| read_log(path, &options, &mut |_, _| {}, None).expect("read");
     assert!(
         read(Path::new(AMCL_EXAMPLE)) == read(&generated),
         "tests/data/mcap/amcl_tf.mcap is not this generator's output: rerun with POSECOV_UPDATE_GOLDEN=1"
@@ -210,12 +210,18 @@ fn file(name: &str, bytes: &[u8]) -> PathBuf {
     path
 }
 
-fn log_run(path: &Path) -> bag::LogRun {
+fn log_run(path: &Path) -> log::LogRun {
     let overrides = Overrides {
         every: Some(1),
         ..Default::default()
     };
-    match Run::start(open(path.to_str().unwrap()).unwrap(), &overrides, None).unwrap() {
+    match Run::start(
+        open(path.to_str().unwrap()).unwrap(),
+        &overrides,
+        posecov::app::run::RunOptions::shown(),
+    )
+    .unwrap()
+    {
         Run::Log(run) => *run,
         _ => panic!("a log"),
     }
@@ -245,16 +251,16 @@ fn check_allowing(path: &Path, names: &[&str]) -> (Option<i32>, String, String) 
 #[test]
 fn amcl_map_to_odom_joins_the_odometry_to_the_map() {
     let path = file("amcl.mcap", &log("odom", &[("map", "odom")]));
-    let options = BagOptions {
+    let options = LogOptions {
         every: Some(1),
         ..Default::default()
     };
-    let plan = read_bag(&path, &options, &mut |_, _| {}, None).unwrap();
+    let plan = read_log(&path, &options, &mut |_, _| {}, None).unwrap();
     let names: Vec<String> = plan.tf.edges.iter().map(|e| e.name()).collect();
     assert_eq!(names, ["base_link→laser", "odom→base_link", "map→odom"]);
     let map_odom = plan.tf.edge("map", "odom").unwrap();
     assert_eq!((map_odom.messages, map_odom.samples.len()), (91, 91));
-    let e = evaluate_bag(&plan, &BagEvalSettings::default());
+    let e = evaluate_log(&plan, &LogEvalSettings::default());
     assert!(e.frames.problems.is_empty(), "{:?}", e.frames);
     let odom = e.topics.iter().find(|t| t.name == "/odom").unwrap();
     let join = odom.joined.as_ref().expect("joined");
@@ -265,12 +271,12 @@ fn amcl_map_to_odom_joins_the_odometry_to_the_map() {
     assert_eq!(odom.frame_id, "map");
     let amcl = e.topics.iter().find(|t| t.name == "/amcl_pose").unwrap();
     assert!(amcl.joined.is_none() && amcl.frame_id == "map");
-    let unmoved = evaluate_bag(
-        &posecov::plan::bag::LogSummary {
+    let unmoved = evaluate_log(
+        &posecov::plan::log::LogSummary {
             tf: TfTree::default(),
             ..plan.clone()
         },
-        &BagEvalSettings::default(),
+        &LogEvalSettings::default(),
     );
     let unmoved = unmoved.topics.iter().find(|t| t.name == "/odom").unwrap();
     assert_eq!(unmoved.frame_id, "odom");
@@ -349,7 +355,7 @@ fn amcl_map_to_odom_joins_the_odometry_to_the_map() {
         text.contains("both blocks rotated by the transform (tf2's reading)"),
         "{text}"
     );
-    let json = bag::report_json("amcl", &run);
+    let json = log::report_json("amcl", &run);
     let odom = &json["topics"][1];
     assert_eq!(odom["name"], "/odom");
     assert_eq!(odom["frame_id"], "odom");
@@ -411,7 +417,7 @@ fn a_cycle_is_a_defect_said_and_nothing_is_joined() {
     );
     let run = log_run(&path);
     assert!(run.evaluation.topics.iter().all(|t| t.joined.is_none()));
-    let json = bag::report_json("cycle", &run);
+    let json = log::report_json("cycle", &run);
     let kinds: Vec<&str> = json["frames"]["problems"]
         .as_array()
         .unwrap()
@@ -468,7 +474,7 @@ fn a_missing_link_and_a_frame_never_transformed_are_said() {
     // transform at all.
     let path = file("missing.mcap", &log("odom", &[("world", "odom")]));
     let run = log_run(&path);
-    let json = bag::report_json("missing", &run);
+    let json = log::report_json("missing", &run);
     let problem = &json["frames"]["problems"][0];
     assert_eq!(problem["kind"], "tf_no_transform");
     assert_eq!(problem["class"], "note");
@@ -490,7 +496,7 @@ fn a_missing_link_and_a_frame_never_transformed_are_said() {
         &log("odom", &[("world", "odom"), ("map", "utm")]),
     );
     let run = log_run(&path);
-    let json = bag::report_json("apart", &run);
+    let json = log::report_json("apart", &run);
     let problem = &json["frames"]["problems"][0];
     assert_eq!(problem["kind"], "tf_missing_link");
     assert_eq!(problem["roots"], serde_json::json!(["map", "world"]));

@@ -8,12 +8,12 @@
 use std::collections::BTreeMap;
 use std::io::Cursor;
 
-use posecov::input::bag::decode::{
+use posecov::input::log::decode::{
     Header, Odometry, Pose, PoseWithCovariance, PoseWithCovarianceStamped, Time,
     TwistWithCovariance, nested,
 };
-use posecov::input::bag::{BagOptions, read_bag};
-use posecov::plan::bag::{Issue, PoseMessageKind};
+use posecov::input::log::{LogOptions, read_log};
+use posecov::plan::log::{Issue, PoseMessageKind};
 
 const EXAMPLE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -193,7 +193,7 @@ fn write_example() -> Vec<u8> {
     w.into_inner().into_inner()
 }
 
-fn read(bytes: &[u8], options: &BagOptions) -> posecov::plan::bag::LogSummary {
+fn read(bytes: &[u8], options: &LogOptions) -> posecov::plan::log::LogSummary {
     let dir = std::env::temp_dir().join(format!("posecov-mcap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // Tests run in parallel: one file each.
@@ -201,7 +201,7 @@ fn read(bytes: &[u8], options: &BagOptions) -> posecov::plan::bag::LogSummary {
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let path = dir.join(format!("log-{n}.mcap"));
     std::fs::write(&path, bytes).unwrap();
-    let plan = read_bag(&path, options, &mut |_, _| {}, None).unwrap();
+    let plan = read_log(&path, options, &mut |_, _| {}, None).unwrap();
     std::fs::remove_file(&path).ok();
     plan
 }
@@ -216,8 +216,8 @@ fn committed_example_is_the_generators_output() {
     let committed = std::fs::read(EXAMPLE).expect("run with POSECOV_UPDATE_GOLDEN=1 once");
     // The writer's summary order is not byte-stable; what it says must be the same.
     let (a, b) = (
-        read(&committed, &BagOptions::default()),
-        read(&bytes, &BagOptions::default()),
+        read(&committed, &LogOptions::default()),
+        read(&bytes, &LogOptions::default()),
     );
     assert_eq!(
         format!("{a:?}"),
@@ -228,7 +228,7 @@ fn committed_example_is_the_generators_output() {
 
 #[test]
 fn topics_types_and_skips() {
-    let plan = read(&write_example(), &BagOptions::default());
+    let plan = read(&write_example(), &LogOptions::default());
     let names: Vec<&str> = plan.topics.iter().map(|t| t.name.as_str()).collect();
     assert_eq!(names, ["/amcl_pose", "/bare", "/planar/odom"]);
     let kinds: Vec<PoseMessageKind> = plan.topics.iter().map(|t| t.kind).collect();
@@ -253,7 +253,7 @@ fn topics_types_and_skips() {
     assert_eq!(plan.messages_total, 50 + 12 + 3 + 4 + 1);
     let only = read(
         &write_example(),
-        &BagOptions {
+        &LogOptions {
             topics: vec!["/bare".into()],
             every: None,
             ..Default::default()
@@ -265,7 +265,7 @@ fn topics_types_and_skips() {
 
 #[test]
 fn planar_odometry_numbers_are_exact() {
-    let plan = read(&write_example(), &BagOptions::default());
+    let plan = read(&write_example(), &LogOptions::default());
     let odom = &plan.topics[2];
     assert!(odom.planar);
     assert_eq!(
@@ -308,7 +308,7 @@ fn planar_odometry_numbers_are_exact() {
 
 #[test]
 fn every_health_case_is_counted_once() {
-    let plan = read(&write_example(), &BagOptions::default());
+    let plan = read(&write_example(), &LogOptions::default());
     let amcl = &plan.topics[0];
     assert_eq!(amcl.count, 12);
     assert!(!amcl.planar);
@@ -370,7 +370,7 @@ fn damaged_mcap_is_an_error_not_a_panic() {
     for cut in [9, 100, bytes.len() / 2, bytes.len() - 3] {
         let path = dir.join(format!("cut{cut}.mcap"));
         std::fs::write(&path, &bytes[..cut]).unwrap();
-        let e = read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None).unwrap_err();
+        let e = read_log(&path, &LogOptions::default(), &mut |_, _| {}, None).unwrap_err();
         assert!(e.to_string().contains(&format!("cut{cut}.mcap")), "{e}");
         // Cut inside a record: said in plain words, not as a length limit.
         let e = e.to_string();
@@ -385,7 +385,7 @@ fn damaged_mcap_is_an_error_not_a_panic() {
     }
     let path = dir.join("flipped.mcap");
     std::fs::write(&path, &flipped).unwrap();
-    let _ = read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None);
+    let _ = read_log(&path, &LogOptions::default(), &mut |_, _| {}, None);
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -424,7 +424,7 @@ fn a_falsified_chunk_size_ends_with_an_error() {
         let (tx, rx) = std::sync::mpsc::channel();
         let p = path.clone();
         std::thread::spawn(move || {
-            let r = read_bag(&p, &BagOptions::default(), &mut |_, _| {}, None).map(drop);
+            let r = read_log(&p, &LogOptions::default(), &mut |_, _| {}, None).map(drop);
             tx.send(r.map_err(|e| e.to_string())).ok();
         });
         let result = rx
@@ -444,8 +444,8 @@ fn a_falsified_chunk_size_ends_with_an_error() {
 /// the public API). Alone, it is no pose topic to draw: an error naming it.
 #[test]
 fn a_topic_without_messages_is_drawn() {
-    use posecov::draw::bag::{BagDrawSettings, bag_scene, description};
-    use posecov::eval::bag::evaluate_bag;
+    use posecov::draw::log::{LogDrawSettings, description, draw_log};
+    use posecov::eval::log::evaluate_log;
     use posecov::input::{About, Format};
     use posecov::uncertain::Confidence;
     let log = |with_messages: bool| {
@@ -486,7 +486,7 @@ fn a_topic_without_messages_is_drawn() {
     };
     let path = std::env::temp_dir().join(format!("posecov-mcap-empty-{}.mcap", std::process::id()));
     std::fs::write(&path, log(false)).unwrap();
-    let err = read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None)
+    let err = read_log(&path, &LogOptions::default(), &mut |_, _| {}, None)
         .unwrap_err()
         .to_string();
     std::fs::remove_file(&path).ok();
@@ -494,14 +494,14 @@ fn a_topic_without_messages_is_drawn() {
         err.contains("pose topics without messages: /empty"),
         "{err}"
     );
-    let plan = read(&log(true), &BagOptions::default());
+    let plan = read(&log(true), &LogOptions::default());
     assert_eq!(plan.topics.len(), 2);
     let empty = plan.topics.iter().find(|t| t.name == "/empty").unwrap();
     assert_eq!(empty.count, 0);
-    let e = evaluate_bag(&plan, &Default::default());
+    let e = evaluate_log(&plan, &Default::default());
     let text = description(&plan, Format::Mcap, &e, Confidence::DEFAULT);
     assert!(text.contains("0 messages"), "{text}");
-    let settings = BagDrawSettings {
+    let settings = LogDrawSettings {
         about: About {
             title: "t".into(),
             description: String::new(),
@@ -510,5 +510,5 @@ fn a_topic_without_messages_is_drawn() {
         confidence: Confidence::DEFAULT,
         axis_length: None,
     };
-    assert!(bag_scene(&e, &settings, &text).validate().is_ok());
+    assert!(draw_log(&e, &settings, &text).validate().is_ok());
 }

@@ -1,8 +1,8 @@
 //! The ROS 1 reader on a real bag: robot_localization's test2.bag (a Jackal's odometry with
 //! 1e6 placeholders for z, roll and pitch; bz2 chunks).
 
-use posecov::input::bag::{BagOptions, read_bag};
-use posecov::plan::bag::{Issue, PoseMessageKind};
+use posecov::input::log::{LogOptions, read_log};
+use posecov::plan::log::{Issue, PoseMessageKind};
 
 const TEST2: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -11,7 +11,7 @@ const TEST2: &str = concat!(
 
 #[test]
 fn test2_bag_reads_with_its_placeholders() {
-    let plan = read_bag(TEST2.as_ref(), &BagOptions::default(), &mut |_, _| {}, None).unwrap();
+    let plan = read_log(TEST2.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
     let odom = &plan.topics[0];
     assert_eq!(odom.kind, PoseMessageKind::Odometry);
     assert_eq!(odom.health.count(Issue::Placeholder), odom.count);
@@ -54,20 +54,20 @@ fn test2_bag_reads_with_its_placeholders() {
 
 #[test]
 fn topic_selection_and_every() {
-    let only = BagOptions {
+    let only = LogOptions {
         topics: vec!["/jackal_velocity_controller/odom".into()],
         every: Some(100),
         ..Default::default()
     };
-    let plan = read_bag(TEST2.as_ref(), &only, &mut |_, _| {}, None).unwrap();
+    let plan = read_log(TEST2.as_ref(), &only, &mut |_, _| {}, None).unwrap();
     assert_eq!(plan.topics[0].drawn.len(), 31); // messages 0, 100, …, 3000
     assert_eq!(plan.topics[0].stride, 100);
-    let wrong = BagOptions {
+    let wrong = LogOptions {
         topics: vec!["/imu/data".into()],
         every: None,
         ..Default::default()
     };
-    let e = read_bag(TEST2.as_ref(), &wrong, &mut |_, _| {}, None)
+    let e = read_log(TEST2.as_ref(), &wrong, &mut |_, _| {}, None)
         .unwrap_err()
         .to_string();
     assert!(
@@ -76,12 +76,12 @@ fn topic_selection_and_every() {
         ),
         "{e}"
     );
-    let missing = BagOptions {
+    let missing = LogOptions {
         topics: vec!["/odom".into()],
         every: None,
         ..Default::default()
     };
-    let e = read_bag(TEST2.as_ref(), &missing, &mut |_, _| {}, None)
+    let e = read_log(TEST2.as_ref(), &missing, &mut |_, _| {}, None)
         .unwrap_err()
         .to_string();
     assert!(
@@ -108,7 +108,7 @@ fn damaged_bags_are_errors_not_panics() {
     ] {
         let path = dir.join(name);
         std::fs::write(&path, &data).unwrap();
-        match read_bag(&path, &BagOptions::default(), &mut |_, _| {}, None) {
+        match read_log(&path, &LogOptions::default(), &mut |_, _| {}, None) {
             Err(e) => assert!(e.to_string().contains(name), "{e}"),
             // Flipped bytes inside messages are counted, not fatal; a bag cut short keeps its
             // whole chunks and says where it stops (tests/bag_bad_input.rs).
@@ -126,9 +126,9 @@ fn ctrl_c_keeps_what_was_read_and_draws_it() {
     use std::sync::atomic::{AtomicBool, Ordering};
     let cancel = AtomicBool::new(false);
     // Raise the flag after the first chunk, as Ctrl-C would mid-read.
-    let plan = read_bag(
+    let plan = read_log(
         TEST2.as_ref(),
-        &BagOptions::default(),
+        &LogOptions::default(),
         &mut |_, _| cancel.store(true, Ordering::Relaxed),
         Some(&cancel),
     )
@@ -136,18 +136,18 @@ fn ctrl_c_keeps_what_was_read_and_draws_it() {
     assert!(plan.cancelled);
     let odom = &plan.topics[0];
     assert!(odom.count > 0 && odom.count < 3060, "{}", odom.count);
-    let e = posecov::eval::bag::evaluate_bag(&plan, &Default::default());
+    let e = posecov::eval::log::evaluate_log(&plan, &Default::default());
     let about = posecov::input::About {
         title: "t".into(),
         description: String::new(),
         source: String::new(),
     };
-    let settings = posecov::draw::bag::BagDrawSettings {
+    let settings = posecov::draw::log::LogDrawSettings {
         about,
         confidence: posecov::uncertain::Confidence::DEFAULT,
         axis_length: None,
     };
-    let text = posecov::draw::bag::description(
+    let text = posecov::draw::log::description(
         &plan,
         posecov::input::Format::Ros1Bag,
         &e,
@@ -155,7 +155,7 @@ fn ctrl_c_keeps_what_was_read_and_draws_it() {
     );
     assert!(text.contains("Interrupted (Ctrl-C)"), "{text}");
     assert!(
-        posecov::draw::bag::bag_scene(&e, &settings, &text)
+        posecov::draw::log::draw_log(&e, &settings, &text)
             .validate()
             .is_ok()
     );

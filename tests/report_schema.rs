@@ -221,7 +221,7 @@ fn a_log_report_with_a_reference_validates_and_documents_its_consistency_keys() 
     std::fs::write(&log, common::logs::nees_log(3)).unwrap();
     let overrides = Overrides {
         reference: Some("tf:base_link".into()),
-        align: Some(posecov::eval::nees::Align::Se3),
+        align: Some(posecov::eval::log::nees::Align::Se3),
         ..Default::default()
     };
     let text = report(log.to_str().unwrap(), &overrides, true).unwrap();

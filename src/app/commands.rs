@@ -2,13 +2,11 @@
 
 use std::fmt::Write as _;
 
-use super::run::{Opened, PlanRun, open};
-use super::{
-    AppError, EXIT_FAILED, Overrides, SettingsError, bag, evaluate, report_json, resolve,
-    resolve_log,
-};
+pub use super::checked::Checked;
+use super::run::{Opened, PlanRun, Run, RunOptions, open};
+use super::{AppError, Overrides, SettingsError, log, report_json, resolve};
 use crate::input::{Format, examples, open_text};
-use crate::plan::bag::Issue;
+use crate::plan::log::Issue;
 
 /// Samples `check` evaluates with (enough to exercise every path, quick on any input).
 pub const CHECK_SAMPLES: u64 = 32;
@@ -38,7 +36,7 @@ pub fn list() -> Result<String, AppError> {
         }
         let _ = writeln!(out, "{} ({}):", format.name_plural(), extensions.join(", "));
         for e in of_format {
-            let title = match crate::input::bag::bundled::find(e.name) {
+            let title = match crate::input::log::bundled::find(e.name) {
                 Some(log) => log.title.to_owned(),
                 None => open_text(e.text, e.file, e.format)?.1.about.title,
             };
@@ -87,18 +85,25 @@ pub(super) fn report_as(
         ReportStyle::JsonLine => value.to_string() + "\n",
         _ => serde_json::to_string_pretty(&value).unwrap_or_default() + "\n",
     };
-    let loaded = match open(scenario)? {
-        Opened::Plan(loaded) => *loaded,
-        Opened::Log(located) => {
-            let run = bag::run_with(&located, &resolve_log(overrides)?, None, bar, false)?;
+    let options = RunOptions {
+        progress: bar,
+        ..RunOptions::numbers()
+    };
+    let run = match Run::start(open(scenario)?, overrides, options)? {
+        Run::Log(run) => {
             return Ok(match style {
-                ReportStyle::Text => bag::report_text(scenario, &run),
-                _ => printed(bag::report_json(scenario, &run)),
+                ReportStyle::Text => log::report_text(scenario, &run),
+                _ => printed(log::report_json(scenario, &run)),
             });
         }
+        Run::Plan(run) => run,
     };
-    let settings = resolve(&loaded.input, overrides, None)?;
-    let evaluation = evaluate(&loaded, &settings.eval)?;
+    let PlanRun {
+        loaded,
+        settings,
+        evaluation,
+        ..
+    } = *run;
     let confidence = settings.draw.confidence;
     if style != ReportStyle::Text {
         return Ok(printed(report_json(
@@ -147,27 +152,6 @@ pub(super) fn report_as(
     Ok(out)
 }
 
-/// What `posecov check` found: one line for stdout, and the first defect of each topic of a
-/// log for stderr (none for a scenario or a graph, whose errors stop the check).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Checked {
-    /// `NAME: ok (…)` or `NAME: defects on …`.
-    pub line: String,
-    /// One line per topic with a defect not `--allow`ed.
-    pub defects: Vec<String>,
-}
-
-impl Checked {
-    /// 0, or [`EXIT_FAILED`] when a defect was found.
-    pub fn exit_code(&self) -> u8 {
-        if self.defects.is_empty() {
-            0
-        } else {
-            EXIT_FAILED
-        }
-    }
-}
-
 /// The findings `--allow NAME` (repeatable) names, each checked against [`Issue::ALL`].
 ///
 /// ```
@@ -213,23 +197,35 @@ pub(super) fn check_as(
     allow: &[Issue],
     bar: bool,
 ) -> Result<Checked, AppError> {
-    let loaded = match open(scenario)? {
-        Opened::Plan(loaded) => *loaded,
-        Opened::Log(located) => {
-            let run = bag::run_with(&located, &resolve_log(overrides)?, None, bar, true)?;
-            return Ok(bag::check(&run, scenario, allow));
+    let opened = open(scenario)?;
+    let quick = match &opened {
+        Opened::Log(_) => overrides.clone(),
+        // A plan is checked with few samples, after its flags are checked as given: `check`
+        // refuses what `report` refuses.
+        Opened::Plan(loaded) => {
+            resolve(&loaded.input, overrides, None)?;
+            Overrides {
+                samples: Some(
+                    overrides
+                        .samples
+                        .unwrap_or(CHECK_SAMPLES)
+                        .min(CHECK_SAMPLES),
+                ),
+                ..overrides.clone()
+            }
         }
     };
-    let quick = Overrides {
-        samples: Some(
-            overrides
-                .samples
-                .unwrap_or(CHECK_SAMPLES)
-                .min(CHECK_SAMPLES),
-        ),
-        ..overrides.clone()
+    // A log is checked on its numbers (not drawn); a plan is drawn, its line counting the
+    // items its scenario draws.
+    let options = RunOptions {
+        draw: matches!(opened, Opened::Plan(_)),
+        progress: bar,
+        cancel: None,
     };
-    let run = PlanRun::from_loaded(loaded, &quick, None)?;
+    let run = match Run::start(opened, &quick, options)? {
+        Run::Log(run) => return Ok(log::check(&run, scenario, allow)),
+        Run::Plan(run) => run,
+    };
     let (evaluation, scene) = (run.evaluation, run.scene);
     let findings = evaluation.findings().len();
     let line = format!(

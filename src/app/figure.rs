@@ -17,7 +17,11 @@ use crate::sink::figure::{self, FigureOptions};
 /// assert!(!scene.legend.is_empty());
 /// ```
 pub fn scene_of(name_or_path: &str, overrides: &Overrides) -> Result<Scene, AppError> {
-    let run = Run::start(open(name_or_path)?, overrides, None)?;
+    let run = Run::start(
+        open(name_or_path)?,
+        overrides,
+        crate::app::run::RunOptions::shown(),
+    )?;
     Ok(match run {
         Run::Plan(r) => r.scene,
         Run::Log(r) => r.scene,

@@ -21,7 +21,7 @@ use rayon::prelude::*;
 use super::commands::{self, Checked, ReportStyle};
 use super::{AppError, EXIT_OK, Overrides};
 use crate::input::{Format, InputError, InputKind};
-use crate::plan::bag::Issue;
+use crate::plan::log::Issue;
 
 /// The inputs of one command line.
 #[derive(Debug, Clone, PartialEq, Eq)]

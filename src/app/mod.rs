@@ -22,10 +22,11 @@ use crate::eval::{self, AnyEvaluation, EvalError, EvalSettings};
 use crate::input::{self, Format, Input, InputError, Source};
 use crate::scene::{Scene, SceneError};
 
-pub mod bag;
+pub mod checked;
 pub mod commands;
 pub mod figure;
 pub mod live;
+pub mod log;
 pub mod many;
 pub mod run;
 #[cfg(feature = "viewer")]
@@ -262,21 +263,31 @@ pub fn pipeline(
     overrides: &Overrides,
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<(AnyEvaluation, Scene), AppError> {
-    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, cancel, None)?;
+    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, cancel, None, true)?;
     Ok((evaluation, scene))
 }
 
 /// Resolves, evaluates, draws and validates: the one plan path ([`pipeline`],
-/// [`run::PlanRun::from_loaded`]).
+/// [`run::Run::start`]); undrawn when `drawn` is false (the scene keeps the title and
+/// description).
 fn evaluate_and_draw(
     loaded: &Loaded,
     overrides: &Overrides,
     cancel: Option<Arc<AtomicBool>>,
     progress: Option<crate::eval::graph::ProgressHook>,
+    drawn: bool,
 ) -> Result<(Settings, AnyEvaluation, Scene), AppError> {
     let mut settings = resolve(&loaded.input, overrides, cancel)?;
     settings.eval.graph_progress = progress;
     let evaluation = evaluate(loaded, &settings.eval)?;
+    if !drawn {
+        let about = &loaded.input.about;
+        return Ok((
+            settings,
+            evaluation,
+            Scene::new(about.title.clone(), about.description.clone()),
+        ));
+    }
     let scene = draw::scene(&evaluation, &settings.draw);
     scene.validate()?;
     Ok((settings, evaluation, scene))

@@ -5,10 +5,10 @@
 //! ([`PlanRun::block`]); every sink shows it through one sequence (`session::show`).
 //!
 //! ```
-//! use posecov::app::{Overrides, run::{Run, open}};
+//! use posecov::app::{Overrides, run::{Run, RunOptions, open}};
 //! let overrides = Overrides { samples: Some(64), ..Default::default() };
-//! let plan = Run::start(open("camera_on_robot").unwrap(), &overrides, None).unwrap();
-//! let log = Run::start(open("covariance_health").unwrap(), &overrides, None).unwrap();
+//! let plan = Run::start(open("camera_on_robot").unwrap(), &overrides, RunOptions::shown()).unwrap();
+//! let log = Run::start(open("covariance_health").unwrap(), &overrides, RunOptions::shown()).unwrap();
 //! assert!(matches!(plan, Run::Plan(_)) && matches!(log, Run::Log(_)));
 //! assert!(plan.scene().validate().is_ok() && log.scene().validate().is_ok());
 //! ```
@@ -19,7 +19,7 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::bag::{self, LogRun};
+use super::log::{self, LogRun};
 use super::{AppError, Loaded, Overrides, Settings, resolve_log};
 use crate::draw;
 use crate::eval::graph::{Iteration, ProgressHook, Stage};
@@ -34,6 +34,57 @@ pub enum Opened {
     Plan(Box<Loaded>),
     /// A robot log, found but not read yet (it is streamed by the run).
     Log(Located),
+}
+
+/// What a [`Run`] is wanted for: the one set of choices every command passes to
+/// [`Run::start`].
+///
+/// ```
+/// use posecov::app::run::RunOptions;
+/// assert!(RunOptions::shown().draw && !RunOptions::numbers().draw);
+/// assert!(!RunOptions::numbers().progress);
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Build the scene (the viewer, `--save`, figures). `report` and `check` print numbers and
+    /// findings, so their runs draw nothing but a plan's check, whose line counts the items a
+    /// scenario draws.
+    pub draw: bool,
+    /// Show progress on a terminal (a log's bar, a plan's spinner); off when many inputs run
+    /// at once under one bar.
+    pub progress: bool,
+    /// Set by Ctrl-C: a log's read stops and keeps what was read; a plan's evaluation stops.
+    pub cancel: Option<Arc<AtomicBool>>,
+}
+
+impl RunOptions {
+    /// A run to show: drawn, with progress.
+    pub fn shown() -> Self {
+        Self {
+            draw: true,
+            progress: true,
+            cancel: None,
+        }
+    }
+
+    /// A run for its numbers only: not drawn, no progress shown.
+    pub fn numbers() -> Self {
+        Self::default()
+    }
+
+    /// The same run, stopped by `cancel`.
+    ///
+    /// ```
+    /// use std::sync::{Arc, atomic::AtomicBool};
+    /// let o = posecov::app::run::RunOptions::shown().cancelled_by(Arc::new(AtomicBool::new(false)));
+    /// assert!(o.cancel.is_some());
+    /// ```
+    pub fn cancelled_by(self, cancel: Arc<AtomicBool>) -> Self {
+        Self {
+            cancel: Some(cancel),
+            ..self
+        }
+    }
 }
 
 /// Finds an input (a file, or a bundled example by name), decides its format and kind once
@@ -84,19 +135,20 @@ impl PlanRun {
         overrides: &Overrides,
         cancel: Option<Arc<AtomicBool>>,
     ) -> Result<Self, AppError> {
-        Self::from_loaded_with(loaded, overrides, cancel, None)
+        Self::run(loaded, overrides, cancel, None, true)
     }
 
-    /// [`from_loaded`](Self::from_loaded), with a pose graph's solves reporting their steps to
-    /// `progress`.
-    pub fn from_loaded_with(
+    /// Resolves and evaluates a loaded plan, a pose graph's solves reporting their steps to
+    /// `progress`, and draws it when `draw` (else the scene holds the title and description).
+    fn run(
         loaded: Loaded,
         overrides: &Overrides,
         cancel: Option<Arc<AtomicBool>>,
         progress: Option<ProgressHook>,
+        draw: bool,
     ) -> Result<Self, AppError> {
         let (settings, evaluation, scene) =
-            super::evaluate_and_draw(&loaded, overrides, cancel, progress)?;
+            super::evaluate_and_draw(&loaded, overrides, cancel, progress, draw)?;
         Ok(Self {
             loaded,
             settings,
@@ -142,9 +194,11 @@ pub enum Run {
 }
 
 impl Run {
-    /// Resolves the settings of an opened input and evaluates and draws it: a plan with a
-    /// spinner on a terminal past 0.3 s, a log streamed with a progress bar (`cancel` stops
-    /// the read and keeps what was read).
+    /// Resolves the settings of an opened input (the one place that matches the input's kind),
+    /// evaluates it and, when [`RunOptions::draw`] asks, draws it: a plan with a spinner on a
+    /// terminal past 0.3 s, a log streamed with a progress bar ([`RunOptions::progress`];
+    /// [`RunOptions::cancel`] stops the read and keeps what was read). Undrawn, the scene holds
+    /// the run's title and description only.
     ///
     /// See the [module docs](self) for an example.
     ///
@@ -153,20 +207,31 @@ impl Run {
     pub fn start(
         opened: Opened,
         overrides: &Overrides,
-        cancel: Option<Arc<AtomicBool>>,
+        options: RunOptions,
     ) -> Result<Run, AppError> {
         match opened {
             Opened::Plan(loaded) => {
                 let what = format!("evaluating {}", loaded.input.about.title);
-                with_spinner(&what, |spinner| {
-                    let hook = graph_progress(spinner.clone(), what.clone());
-                    PlanRun::from_loaded_with(*loaded, overrides, cancel, Some(hook))
-                })
-                .map(|run| Run::Plan(Box::new(run)))
+                let work = |spinner: Option<&ProgressBar>| {
+                    let hook = spinner.map(|s| graph_progress(s.clone(), what.clone()));
+                    PlanRun::run(
+                        *loaded,
+                        overrides,
+                        options.cancel.clone(),
+                        hook,
+                        options.draw,
+                    )
+                };
+                let run = if options.progress {
+                    with_spinner(&what, |spinner| work(Some(spinner)))
+                } else {
+                    work(None)
+                };
+                run.map(|run| Run::Plan(Box::new(run)))
             }
             Opened::Log(located) => {
                 let settings = resolve_log(overrides)?;
-                bag::run(&located, &settings, cancel.as_deref()).map(|run| Run::Log(Box::new(run)))
+                log::run(&located, &settings, &options).map(|run| Run::Log(Box::new(run)))
             }
         }
     }
@@ -199,7 +264,7 @@ impl Run {
     pub fn cut_short(&self) -> bool {
         match self {
             Run::Plan(_) => false,
-            Run::Log(r) => r.plan.cancelled,
+            Run::Log(r) => r.summary.cancelled,
         }
     }
 }

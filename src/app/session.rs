@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use super::run::{Opened, PlanRun, Run, open};
+use super::run::{Opened, PlanRun, Run, RunOptions, open};
 use super::sinks::{
     EXIT_INTERRUPTED, ViewOptions, choose_sink, finish, flush, render_with, scenario_name, serve,
     watch_file,
@@ -121,7 +121,11 @@ pub(crate) fn show(
     opened: Opened,
     cancel: &Arc<AtomicBool>,
 ) -> Result<u8, AppError> {
-    let run = Run::start(opened, &options.overrides, Some(Arc::clone(cancel)))?;
+    let run = Run::start(
+        opened,
+        &options.overrides,
+        RunOptions::shown().cancelled_by(Arc::clone(cancel)),
+    )?;
     let ids = run.ids(&options.scenario);
     if let Some((png, size)) = &options.png {
         let log = |rec: &rerun::RecordingStream| run.log(rec, cancel);
@@ -189,5 +193,5 @@ pub(crate) fn watch_saving(
 
 /// Opens and runs the watched file again.
 fn start(scenario: &str, overrides: &Overrides) -> Result<Run, AppError> {
-    Run::start(open(scenario)?, overrides, None)
+    Run::start(open(scenario)?, overrides, RunOptions::shown())
 }

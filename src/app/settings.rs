@@ -6,10 +6,10 @@ use std::sync::atomic::AtomicBool;
 
 use crate::draw::DrawSettings;
 use crate::eval::EvalSettings;
-use crate::eval::bag::{BagEvalSettings, DEFAULT_CLOUD_SAMPLES};
 use crate::eval::graph::{GraphReading, GraphSettings, Optimizer};
-use crate::eval::nees::Align;
-use crate::input::bag::BagOptions;
+use crate::eval::log::nees::Align;
+use crate::eval::log::{DEFAULT_CLOUD_SAMPLES, LogEvalSettings};
+use crate::input::log::LogOptions;
 use crate::input::{Input, InputKind};
 use crate::interop::RosReading;
 use crate::plan::{StepPolicy, limits};
@@ -431,10 +431,10 @@ pub struct ReferenceSettings {
 pub struct LogSettings {
     /// `--reference` and `--align`: NEES against a ground truth, if asked for.
     pub reference: Option<ReferenceSettings>,
-    /// For [`crate::input::bag::read_located`]: topics and thinning.
-    pub read: BagOptions,
-    /// For [`crate::eval::bag::evaluate_bag`]: seed and cloud samples.
-    pub eval: BagEvalSettings,
+    /// For [`crate::input::log::read_located`]: topics and thinning.
+    pub read: LogOptions,
+    /// For [`crate::eval::log::evaluate_log`]: seed and cloud samples.
+    pub eval: LogEvalSettings,
     /// Probability inside drawn regions.
     pub confidence: Confidence,
 }
@@ -476,12 +476,12 @@ pub fn resolve_log(overrides: &Overrides) -> Result<LogSettings, SettingsError> 
     };
     Ok(LogSettings {
         reference,
-        read: BagOptions {
+        read: LogOptions {
             topics: overrides.topics.clone(),
             every: overrides.every,
             reference: None,
         },
-        eval: BagEvalSettings {
+        eval: LogEvalSettings {
             seed: overrides.seed.unwrap_or(0),
             cloud_samples: samples as usize,
             reading: overrides.ros_reading.unwrap_or_default(),

@@ -29,6 +29,7 @@
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
+use std::sync::atomic::{AtomicU64, Ordering as AtomicOrdering};
 
 use nalgebra::Vector3;
 
@@ -43,9 +44,9 @@ use crate::scene::{
 };
 use crate::uncertain::{Confidence, Method};
 
-pub mod bag;
 mod graph;
 mod legend;
+pub mod log;
 mod node;
 mod painter;
 use node::{draw_node, draw_particles};
@@ -97,7 +98,29 @@ impl DrawSettings {
 ///
 /// See the [module docs](self) for an example.
 pub fn scene(evaluation: &AnyEvaluation, settings: &DrawSettings) -> Scene {
-    crate::with_evaluation!(evaluation, e => build(e, settings))
+    counted(crate::with_evaluation!(evaluation, e => build(e, settings)))
+}
+
+/// Scene items built by the draw stage in this process ([`scene`], [`log::draw_log`]).
+static ITEMS_DRAWN: AtomicU64 = AtomicU64::new(0);
+
+/// How many scene items the draw stage has built in this process, over every scene: a command
+/// that only prints numbers (`report`, a log's `check`) leaves it where it was.
+///
+/// ```
+/// use posecov::draw::items_drawn;
+/// let before = items_drawn();
+/// posecov::app::pipeline(&posecov::app::load("camera_on_robot").unwrap(), &Default::default(), None).unwrap();
+/// assert!(items_drawn() > before);
+/// ```
+pub fn items_drawn() -> u64 {
+    ITEMS_DRAWN.load(AtomicOrdering::Relaxed)
+}
+
+/// A scene just built, its items counted in [`items_drawn`].
+fn counted(scene: Scene) -> Scene {
+    ITEMS_DRAWN.fetch_add(scene.items.len() as u64, AtomicOrdering::Relaxed);
+    scene
 }
 
 /// The particle clouds of block `part` (≥ 1) of a blocked Monte Carlo sample, sized as in

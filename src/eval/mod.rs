@@ -36,21 +36,18 @@ use std::ops::Range;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-pub mod bag;
 pub mod batch_means;
 mod blocked;
 pub mod consistency;
 mod engine;
 mod findings;
-pub mod frames;
 pub mod graph;
 pub mod groups;
+pub mod log;
 mod model;
-pub mod nees;
 mod ops;
 mod propagations;
 mod reports;
-pub mod stamped;
 
 pub use consistency::{Anees, Consistency, CoverageSummary};
 pub use model::{

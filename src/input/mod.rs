@@ -8,10 +8,10 @@
 //!
 //! [`locate`] is the one entry: it finds the file (or a bundled example by name) and decides
 //! its [`Format`] by content and extension, once; [`Format::kind`] says whether it is a plan
-//! ([`open_located`]: that format's reader) or a robot log ([`bag::read_located`]). A new plan
+//! ([`open_located`]: that format's reader) or a robot log ([`log::read_located`]). A new plan
 //! format is a [`Format`] variant, a [`Source`] variant and one arm in [`open_file`] and
 //! [`open_text`]; a new log source is one module under [`bag`] and one arm in
-//! [`bag::read_located`].
+//! [`log::read_located`].
 //!
 //! ```
 //! use posecov::input::{Format, open};
@@ -28,10 +28,10 @@ use serde::Serialize;
 use crate::plan::AnyPlan;
 use crate::uncertain::Method;
 
-pub mod bag;
 pub mod format;
 pub mod graph;
 mod located;
+pub mod log;
 pub mod scenario;
 pub mod suggest;
 pub mod tum;
@@ -106,7 +106,7 @@ pub struct Example {
 }
 
 /// Every bundled example, scenarios first, then graphs, then robot logs (binary: their
-/// `text` is empty, see [`bag::bundled`]).
+/// `text` is empty, see [`log::bundled`]).
 ///
 /// ```
 /// use posecov::input::{Format, examples};
@@ -121,7 +121,7 @@ pub fn examples() -> Vec<Example> {
     });
     scenarios
         .chain(graph::bundled::examples())
-        .chain(bag::bundled::examples())
+        .chain(log::bundled::examples())
         .collect()
 }
 
@@ -235,7 +235,7 @@ pub fn open(name_or_path: &str) -> Result<(Source, Input), InputError> {
 }
 
 /// Reads and checks a located plan input (a scenario or a graph) in its decided format; a
-/// robot log is refused (it is streamed by [`bag::read_located`]).
+/// robot log is refused (it is streamed by [`log::read_located`]).
 ///
 /// ```
 /// let located = posecov::input::locate("camera_on_robot").unwrap();
@@ -298,7 +298,7 @@ pub fn open_text(text: &str, origin: &str, format: Format) -> Result<(Source, In
     }
 }
 
-/// A robot log is streamed into a log summary ([`bag::read_located`]), not opened as an
+/// A robot log is streamed into a log summary ([`log::read_located`]), not opened as an
 /// [`Input`]: the application routes it by [`Format::kind`].
 fn not_a_plan(file: &str, format: Format) -> InputError {
     InputError::Format {

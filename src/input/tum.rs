@@ -16,7 +16,7 @@ use std::path::Path;
 
 use super::InputError;
 use crate::lie::So3;
-use crate::plan::bag::ReferenceSample;
+use crate::plan::log::ReferenceSample;
 
 /// The eight fields of a line, in order.
 const FIELDS: [&str; 8] = ["timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"];

@@ -7,8 +7,8 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 
 use nalgebra::{Cholesky, Matrix6, Vector3, Vector6};
-use posecov::input::bag::decode::{Header, Odometry, Pose, PoseWithCovariance, Time, nested};
-use posecov::input::bag::reference::{PoseStamped, TfMessage, Transform, TransformStamped};
+use posecov::input::log::decode::{Header, Odometry, Pose, PoseWithCovariance, Time, nested};
+use posecov::input::log::reference::{PoseStamped, TfMessage, Transform, TransformStamped};
 use posecov::lie::{LieGroup, Se3, So3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

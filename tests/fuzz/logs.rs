@@ -3,7 +3,7 @@
 //! --json` run a log: read (streamed, every read bounded) → evaluate (a few samples per
 //! drawn message) → draw → validate → the JSON report.
 //!
-//! Seeds: the bundled logs (a real bz2 bag, the generated health-case MCAP) and a small
+//! Seeds: the bundled logs (a real bz2 log, the generated health-case MCAP) and a small
 //! uncompressed bag written here, so that mutations reach the records, the index and the
 //! messages, not only a compressed stream.
 
@@ -13,7 +13,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use posecov::app::Overrides;
-use posecov::app::bag::report_json;
+use posecov::app::log::report_json;
 use posecov::app::run::{Run as AppRun, open};
 
 use crate::harness::{
@@ -36,7 +36,7 @@ pub struct Logs {
 
 impl Logs {
     pub fn new(kind: LogKind) -> Self {
-        let bundled = posecov::input::bag::bundled::LOGS
+        let bundled = posecov::input::log::bundled::LOGS
             .iter()
             .filter(|l| l.file.ends_with(kind.extension()))
             .map(|l| l.bytes.to_vec());
@@ -129,7 +129,9 @@ fn run_log(path: PathBuf, stage: Stage) -> Result<serde_json::Value, String> {
         ..Default::default()
     };
     let opened = open(&path.display().to_string()).map_err(|e| e.to_string())?;
-    let AppRun::Log(log) = AppRun::start(opened, &overrides, None).map_err(|e| e.to_string())?
+    let AppRun::Log(log) =
+        AppRun::start(opened, &overrides, posecov::app::run::RunOptions::shown())
+            .map_err(|e| e.to_string())?
     else {
         return Err("read as a plan, not a log".to_owned());
     };

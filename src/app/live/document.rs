@@ -5,8 +5,6 @@
 //! file ([`load_text`]); only when that succeeds does the copy become
 //! current. A bad value is refused with the file's field and message, and nothing changes.
 
-use std::path::Path;
-
 use toml_edit::{Array, DocumentMut, Item, Value};
 
 use super::controls::{self, Control, ControlKind, Place, Seg, Slot};
@@ -127,28 +125,28 @@ impl LiveDocument {
     /// # Errors
     /// [`AppError::Live`] for an input that is not a scenario file; the file's error.
     pub fn open(name_or_path: &str) -> Result<Self, AppError> {
-        let path = Path::new(name_or_path);
-        if path.exists() {
-            if path.extension().and_then(|e| e.to_str()) != Some("toml") {
-                return Err(AppError::Live(format!(
-                    "{name_or_path}: live mode edits scenario files (.toml) only; \
-                     show other inputs with `posecov {name_or_path}`"
-                )));
-            }
-            let text = std::fs::read_to_string(path).map_err(|e| {
-                crate::input::scenario::ScenarioError::Read {
-                    path: name_or_path.to_owned(),
-                    reason: e.to_string(),
-                }
-            })?;
-            return Self::new(&text, name_or_path);
+        // Found and its format decided by the one place that does ([`crate::input::locate`]);
+        // the loader's message lists the bundled names.
+        let located = crate::input::locate(name_or_path)?;
+        if located.format != crate::input::Format::Scenario {
+            return Err(AppError::Live(format!(
+                "{name_or_path}: live mode edits scenario files (.toml) only; \
+                 show other inputs with `posecov {name_or_path}`"
+            )));
         }
-        match bundled::find(name_or_path) {
-            Some(b) => Self::new(b.text, &format!("{}.toml (bundled)", b.name)),
-            // The loader's message lists the bundled names.
-            None => Err(crate::app::load(name_or_path)
-                .err()
-                .unwrap_or_else(|| AppError::Live(format!("{name_or_path}: not a scenario")))),
+        match &located.place {
+            crate::input::Place::Bundled(e) => {
+                Self::new(e.text, &format!("{}.toml (bundled)", e.name))
+            }
+            crate::input::Place::File(path) => {
+                let text = std::fs::read_to_string(path).map_err(|e| {
+                    crate::input::scenario::ScenarioError::Read {
+                        path: name_or_path.to_owned(),
+                        reason: e.to_string(),
+                    }
+                })?;
+                Self::new(&text, name_or_path)
+            }
         }
     }
 

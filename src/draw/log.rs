@@ -1,0 +1,486 @@
+//! A robot log's scene ([`LogEvaluation`] → [`Scene`]) on the `stamp` timeline: per topic
+//! (entity `world/<topic>/…`)
+//! - `trajectory`: every (bounded) position, static; `history/rviz` and `history/meaning`:
+//!   the position regions of every drawn message, faint, static;
+//! - at each drawn message's stamp: `pose` (its frame), **RViz's picture** under `rviz/`
+//!   (`position`: the ellipsoid of the parent-frame position block — an ellipse when RViz
+//!   takes the pose as 2-D, i.e. Σzz, Σroll, Σpitch ≤ 0; a placeholder axis clipped and
+//!   labelled; `orientation`: RViz's per-axis discs at the axis tips, tan of the angular
+//!   spread, or its yaw fan in 2-D), and **what the numbers mean** under `meaning/` (the
+//!   body-frame right-form Gaussian's Exp-mapped `banana`, its `ellipsoid` and a sampled
+//!   `cloud`; 3-D: the sampled axis tips `spray_x|y|z`); an unusable message is a red cross at
+//!   `invalid` and clears the rest (`bag/message.rs`);
+//! - `robot/…`: the same message at the origin, at the robot's scale, with its σ (`bag/robot.rs`);
+//! - plots over the stamp: σx σy σz, σroll σpitch σyaw and the position trace, in units and
+//!   ranges fitted to the data (`bag/plots.rs`); with `--reference`, each topic's NEES per
+//!   drawn message with its 95 % bound and ANEES band (`bag/nees.rs`).
+//!
+//! Views: one whole-log view per frame (`header.frame_id`: topics in different frames are
+//! never overlaid as if they were one — unless the log's `/tf` joins them, then they share
+//! the common frame's view, `eval::log::frames`, said in the panel), and one robot view per topic.
+//!
+//! All regions at the chosen confidence: χ²(d) with d = 2 / 3 (planar position, pose) or
+//! 3 / 6 (3-D), and d = 2 for RViz's discs, 1 for its yaw fan.
+
+use std::collections::BTreeMap;
+
+use nalgebra::Vector3;
+
+use super::{Painter, v3, views};
+use crate::eval::log::{LogEvaluation, TopicEvaluation};
+use crate::input::{About, Layout};
+use crate::lie::GroupKind;
+use crate::scene::layout::views_aspect;
+use crate::scene::{
+    Color, ItemKind, LineStrips, Scene, Swatch, Timeline, Timing, Vec3, View3d, WORLD,
+};
+use crate::uncertain::{Confidence, Method};
+
+mod frames;
+mod message;
+mod nees;
+mod plots;
+mod robot;
+mod rviz;
+mod text;
+
+pub use frames::frame_problem_sentence;
+pub use nees::verdict_word;
+pub use text::{description, issue_sentence, issue_word};
+
+/// RViz's default covariance colour (its position shape).
+const RVIZ: Color = Color::rgb(204, 51, 204);
+/// The meaning (right-form Gaussian) colour.
+const MEANING: Color = Method::FirstOrder.color();
+/// Unusable messages.
+const INVALID: Color = Color::rgb(230, 30, 30);
+
+/// What drawing a log needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogDrawSettings {
+    /// Title and description of the log (the text panel starts with it).
+    pub about: About,
+    /// Probability inside drawn regions, in (0, 1).
+    pub confidence: Confidence,
+    /// Length of the frames' axes (m); `None`: from the trajectory's size.
+    pub axis_length: Option<f64>,
+}
+
+/// The scene of a log's evaluation; `summary` is the health summary's Markdown
+/// ([`description`]), written by the caller from the plan.
+///
+/// ```
+/// use posecov::draw::log::{LogDrawSettings, draw_log, description};
+/// use posecov::eval::log::{LogEvalSettings, evaluate_log};
+/// use posecov::input::{About, Format, log::{LogOptions, read_log}};
+/// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
+/// let plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+/// let e = evaluate_log(&plan, &LogEvalSettings::default());
+/// let about = About { title: "test2.bag".into(), description: String::new(), source: String::new() };
+/// let settings = LogDrawSettings { about, confidence: posecov::uncertain::Confidence::DEFAULT, axis_length: None };
+/// let scene = draw_log(&e, &settings, &description(&plan, Format::Ros1Bag, &e, posecov::uncertain::Confidence::DEFAULT));
+/// assert!(scene.validate().is_ok());
+/// let topic = "world/jackal_velocity_controller/odom";
+/// assert!(scene.items.iter().any(|i| i.path == format!("{topic}/meaning/banana")));
+/// // Beside the whole trajectory (84 m), the selected message at the robot's scale.
+/// assert_eq!(scene.views.len(), 2);
+/// assert_eq!(scene.views[1].include, vec![format!("{topic}/robot")]);
+/// ```
+pub fn draw_log(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene {
+    super::counted(build(e, settings, summary))
+}
+
+/// [`draw_log`], uncounted.
+fn build(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene {
+    let extent = extent(e);
+    let axis_length = settings
+        .axis_length
+        .unwrap_or((0.08 * extent).clamp(0.05, 2.0));
+    let planar = !e.topics.is_empty() && e.topics.iter().all(|t| t.planar);
+    let mut p = Painter {
+        scene: Scene::new(settings.about.title.clone(), summary.to_owned()),
+        confidence: settings.confidence,
+        kind: if planar {
+            GroupKind::Se2
+        } else {
+            GroupKind::Se3
+        },
+        axis_length,
+        extent,
+        layout: Layout::Together,
+        methods: Vec::new(),
+    };
+    p.scene.planar = planar;
+    p.scene.plots_below = true;
+    p.scene.confidence = Some(settings.confidence);
+    let noting = rviz_noting(e);
+    for (k, topic) in e.topics.iter().enumerate() {
+        draw_topic(&mut p, k, topic, noting.contains(&topic.name.as_str()));
+    }
+    // Dates, or durations when the stamps are not dates (simulated time).
+    let stamps = p.scene.items.iter().filter_map(|i| match i.timing {
+        Timing::Stamp(ns) => Some(ns),
+        Timing::Static | Timing::Step(_) => None,
+    });
+    let series = p
+        .scene
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|q| q.0));
+    p.scene.timeline = Timeline::for_stamps(stamps.chain(series));
+    plots::plots(&mut p.scene, e);
+    nees::plots(&mut p.scene, e);
+    p.scene.views = log_views(&p.scene, e, planar);
+    p.scene
+}
+
+/// The entity path under which a topic is drawn: `world/` and its name's segments (`/a/b` →
+/// `world/a/b`; characters other than letters, digits, `_`, `-` and `.` → `_`).
+///
+/// ```
+/// assert_eq!(posecov::draw::log::topic_entity("/amcl pose"), "world/amcl_pose");
+/// ```
+pub fn topic_entity(name: &str) -> String {
+    format!("{WORLD}/{}", topic_path(name))
+}
+
+/// An entity path segment list for a topic name (`/a/b` → `a/b`; other characters → `_`).
+fn topic_path(name: &str) -> String {
+    let cleaned: Vec<String> = name
+        .split('/')
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            s.chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || "_-.".contains(c) {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    if cleaned.is_empty() {
+        "root".into()
+    } else {
+        cleaned.join("/")
+    }
+}
+
+/// The frame a topic's poses are in, as its view names it.
+fn frame_name(t: &TopicEvaluation) -> &str {
+    if t.frame_id.is_empty() {
+        "(no frame_id)"
+    } else {
+        &t.frame_id
+    }
+}
+
+/// The topics grouped by frame, in frame order: one whole-log view each.
+fn by_frame(e: &LogEvaluation) -> BTreeMap<&str, Vec<&TopicEvaluation>> {
+    let mut frames: BTreeMap<&str, Vec<&TopicEvaluation>> = BTreeMap::new();
+    for t in &e.topics {
+        frames.entry(frame_name(t)).or_default().push(t);
+    }
+    frames
+}
+
+/// The topics that say RViz's note on a clipped placeholder in their whole-log view: per view,
+/// the first whose RViz shape has a clipped axis. A view's topics are drawn at much the same
+/// place (an odometry, its EKF, AMCL: one robot), where the same note from each would be
+/// written over the others; every topic's own placeholder finding is in the text panel.
+fn rviz_noting(e: &LogEvaluation) -> Vec<&str> {
+    by_frame(e)
+        .into_values()
+        .filter_map(|topics| {
+            topics.into_iter().find(|t| {
+                t.poses.iter().any(|q| {
+                    q.rviz
+                        .as_ref()
+                        .is_some_and(|r| rviz::has_clipped_axis(r, t.planar))
+                })
+            })
+        })
+        .map(|t| t.name.as_str())
+        .collect()
+}
+
+/// The views: per frame the whole log of its topics (their robot views left out), then per
+/// topic with a drawn pose its robot view, the camera fitted to its last drawn message (where
+/// a recording opens). A planar log is seen from straight above.
+fn log_views(scene: &Scene, e: &LogEvaluation, planar: bool) -> Vec<View3d> {
+    let inputs = views::ViewInputs {
+        poses: &[],
+        rotation_only: false,
+        top: planar,
+        layout: Layout::Together,
+        camera: None,
+    };
+    let mut out = Vec::new();
+    for (frame, topics) in by_frame(e) {
+        let joined: Vec<String> = topics
+            .iter()
+            .filter_map(|t| {
+                let j = t.joined.as_ref()?;
+                Some(format!("{} from {}", t.name, j.from))
+            })
+            .collect();
+        let view = View3d {
+            name: if joined.is_empty() {
+                format!("frame {frame}: the whole log")
+            } else {
+                format!(
+                    "frame {frame} (+ /tf: {}): the whole log",
+                    joined.join(", ")
+                )
+            },
+            include: topics.iter().map(|t| topic_entity(&t.name)).collect(),
+            exclude: topics
+                .iter()
+                .map(|t| format!("{}/{}", topic_entity(&t.name), robot::ROBOT))
+                .collect(),
+            ..Default::default()
+        };
+        let points = views::points_of(scene, &view, |_| true);
+        out.push((view, points));
+    }
+    for t in &e.topics {
+        let Some(last) = t.poses.iter().rev().find(|q| q.mean.is_some()) else {
+            continue;
+        };
+        let view = View3d {
+            name: format!("robot scale: {} at the time cursor", t.name),
+            include: vec![format!("{}/{}", topic_entity(&t.name), robot::ROBOT)],
+            ..Default::default()
+        };
+        let at = Timing::Stamp(last.stamp_ns);
+        let points = views::points_of(scene, &view, |i| i.timing == at);
+        out.push((view, points));
+    }
+    // Each camera fitted to the shape its view has above the plots.
+    let aspect = views_aspect(scene, out.len());
+    out.into_iter()
+        .map(|(mut view, points)| {
+            view.camera = views::camera(&points, &inputs, aspect);
+            view
+        })
+        .collect()
+}
+
+fn extent(e: &LogEvaluation) -> f64 {
+    let points: Vec<Vector3<f64>> = e
+        .topics
+        .iter()
+        .flat_map(|t| t.trajectory.iter().map(|(_, p)| Vector3::from(*p)))
+        .filter(|p| p.iter().all(|v| v.is_finite()))
+        .collect();
+    super::extent_of(&points)
+}
+
+fn flat(planar: bool, v: &Vector3<f64>) -> Vec3 {
+    if planar { [v.x, v.y, 0.0] } else { v3(v) }
+}
+
+/// Draws topic `t` (number `k`, for its colour): its trajectory, the faint overview, each
+/// drawn message in the whole-log view (RViz's placeholder note on the shape when
+/// `rviz_note`, [`rviz_noting`]) and its robot view.
+fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation, rviz_note: bool) {
+    let base = topic_entity(&t.name);
+    let color = Method::ALL[k % Method::ALL.len()].color();
+    let strip: Vec<Vec3> = t
+        .trajectory
+        .iter()
+        .map(|(_, q)| flat(t.planar, &Vector3::from(*q)))
+        .filter(|q| q.iter().all(|v| v.is_finite()))
+        .collect();
+    if !strip.is_empty() {
+        p.legend(format!("{}: trajectory", t.name), color, Swatch::Line);
+        p.place(
+            format!("{base}/trajectory"),
+            Timing::Static,
+            ItemKind::LineStrips(LineStrips {
+                strips: vec![strip],
+                color: color.with_alpha(220),
+                radius: 0.003 * p.extent,
+            }),
+        );
+    }
+    message::history(p, &base, t);
+    let place = message::Placement {
+        base: &base,
+        shift: Vector3::zeros(),
+        label: None,
+        rviz_note,
+    };
+    for pose in &t.poses {
+        if let Some(mean) = pose.mean {
+            message::message(p, &place, t, pose, &mean);
+        }
+    }
+    robot::robot_view(p, &base, t);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::log::{LogEvalSettings, evaluate_log};
+    use crate::input::log::{LogOptions, read_log};
+    use crate::scene::Ellipsoid;
+
+    /// The scene's whole-log views (one per frame; the robot views left out).
+    fn whole_log_views(scene: &Scene) -> Vec<&View3d> {
+        scene
+            .views
+            .iter()
+            .filter(|v| v.name.starts_with("frame "))
+            .collect()
+    }
+
+    /// The scene of a log under `tests/data/`, drawn with the defaults.
+    fn scene_of(file: &str) -> Scene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(file);
+        let plan = read_log(&path, &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+        let e = evaluate_log(&plan, &LogEvalSettings::default());
+        let settings = LogDrawSettings {
+            about: About {
+                title: "t".into(),
+                description: String::new(),
+                source: String::new(),
+            },
+            confidence: Confidence::DEFAULT,
+            axis_length: None,
+        };
+        let scene = draw_log(&e, &settings, "");
+        scene.validate().unwrap();
+        scene
+    }
+
+    fn eye_distance(view: &View3d) -> f64 {
+        let c = view.camera.expect("a camera");
+        let d: Vector3<f64> = Vector3::from(c.position) - Vector3::from(c.target);
+        d.norm()
+    }
+
+    #[test]
+    fn the_robot_view_is_at_the_scale_of_the_covariance() {
+        // test2.bag: 84 m of driving, σx = σy = 31.6 mm, Σzz = 1e6 (a placeholder).
+        let scene = scene_of("robot_localization/test2.bag");
+        let [whole, robot] = scene.views.as_slice() else {
+            panic!("{:?}", scene.views);
+        };
+        assert_eq!(whole.name, "frame odom: the whole log");
+        // The 95 % position region is r σ = 2.448 × 31.6 mm = 77 mm wide each way: the robot
+        // view's eye stands well under a metre away, the whole log's tens of metres.
+        assert!(eye_distance(robot) < 1.0, "{:?}", robot.camera);
+        assert!(eye_distance(whole) > 20.0, "{:?}", whole.camera);
+        // RViz's ellipse is its 7.7 cm, not the 10–24 m an eigen solver gives with the 1e6 in
+        // place; the clipped z placeholder is 3 × that, and labelled in the whole-log view.
+        let rviz: Vec<&Ellipsoid> = scene
+            .items
+            .iter()
+            .filter(|i| i.path.ends_with("/rviz/position"))
+            .flat_map(|i| match &i.kind {
+                ItemKind::Ellipsoids(e) => e.shapes.iter().collect(),
+                _ => Vec::new(),
+            })
+            .collect();
+        assert!(!rviz.is_empty());
+        let xy = 2.4477 * 0.001f64.sqrt();
+        for shape in rviz {
+            let mut h = shape.half_sizes;
+            h.sort_by(f64::total_cmp);
+            assert!(
+                (h[0] - xy).abs() < 1e-3 && (h[1] - xy).abs() < 1e-3,
+                "{h:?}"
+            );
+            assert!((h[2] - 3.0 * h[1]).abs() < 1e-9, "{h:?}");
+        }
+        let labelled = scene.items.iter().any(|i| {
+            !i.path.contains("/robot/")
+                && matches!(&i.kind, ItemKind::Ellipsoids(e)
+                    if e.label.as_deref() == Some("RViz: z placeholder (σ² ≥ 1e6), clipped"))
+        });
+        assert!(labelled);
+        // The robot view's pose says the message's σ.
+        let label = scene.items.iter().rev().find_map(|i| match &i.kind {
+            ItemKind::Frame(f) if i.path.ends_with("/robot/pose") => f.label.clone(),
+            _ => None,
+        });
+        let label = label.expect("a labelled robot pose");
+        assert!(
+            label.ends_with(": σx 31.6 mm, σy 31.6 mm, σyaw 9.92°"),
+            "{label}"
+        );
+        // Plots in mm and degrees, fitted from 0 to just above the constant σ.
+        let plot = &scene.plots[0];
+        assert_eq!(plot.label(), "σ xy (mm)");
+        let [low, high] = plot.range.unwrap();
+        assert!(low == 0.0 && (high - 1.15 * 31.623).abs() < 0.01, "{high}");
+        assert_eq!(scene.plots[1].label(), "σ yaw (°)");
+    }
+
+    #[test]
+    fn topics_in_different_frames_are_never_overlaid() {
+        // The health-case MCAP: /planar/odom in `odom`, /amcl_pose in `map`, /bare without a
+        // header (no frame_id).
+        let scene = scene_of("mcap/health_cases.mcap");
+        let whole = whole_log_views(&scene);
+        assert_eq!(whole.len(), 3, "{:?}", scene.views);
+        for view in &whole {
+            // Each frame's view shows its own topics only, their robot views left out.
+            assert_eq!(view.include.len(), 1, "{view:?}");
+            assert_eq!(view.exclude, vec![format!("{}/robot", view.include[0])]);
+            assert!(view.camera.is_some());
+        }
+        let robot = scene.views.len() - whole.len();
+        assert_eq!(robot, 3, "one robot view per topic with a drawn pose");
+        // The robot view's items sit at the origin: its frame at each stamp.
+        let frames = scene.items.iter().filter(|i| {
+            i.path.ends_with("/robot/pose")
+                && matches!(&i.kind, ItemKind::Frame(f) if f.translation[..2] == [0.0, 0.0])
+        });
+        assert!(frames.count() > 0);
+    }
+
+    #[test]
+    fn rviz_s_placeholder_note_is_said_once_per_view() {
+        // amcl_tf.mcap: /amcl_pose and /odom (joined into `map` through /tf), one view, both
+        // with RViz's z placeholder, drawn at much the same place. The note is on one topic's
+        // shapes only; both shapes are still drawn clipped.
+        let scene = scene_of("mcap/amcl_tf.mcap");
+        let whole = whole_log_views(&scene);
+        assert_eq!(whole.len(), 1, "{:?}", scene.views);
+        assert_eq!(whole[0].include.len(), 2, "{:?}", whole[0]);
+        let shapes = |labelled: bool| -> BTreeMap<String, usize> {
+            let mut by_topic = BTreeMap::new();
+            for i in &scene.items {
+                if let ItemKind::Ellipsoids(e) = &i.kind
+                    && i.path.ends_with("/rviz/position")
+                    && !i.path.contains("/robot/")
+                    && e.label.is_some() == labelled
+                {
+                    *by_topic.entry(i.path.clone()).or_insert(0) += 1;
+                }
+            }
+            by_topic
+        };
+        let labelled = shapes(true);
+        assert_eq!(labelled.len(), 1, "{labelled:?}");
+        let (path, count) = labelled.iter().next().unwrap();
+        assert!(*count > 1, "{labelled:?}");
+        // The other topic's shapes are drawn, unlabelled.
+        let unlabelled = shapes(false);
+        assert!(unlabelled.keys().any(|p| p != path), "{unlabelled:?}");
+        let note = scene.items.iter().find_map(|i| match &i.kind {
+            ItemKind::Ellipsoids(e) if i.path == *path => e.label.clone(),
+            _ => None,
+        });
+        assert_eq!(
+            note.as_deref(),
+            Some("RViz: z placeholder (σ² ≥ 1e6), clipped")
+        );
+    }
+}

@@ -1,0 +1,133 @@
+//! A log's plots over the stamp: σ of position (parent axes), σ of rotation, and the position
+//! trace, one line per topic and axis. Each plot's unit fits its values — mm below 0.5 m, m
+//! above; degrees, or mrad below 1° — and its range is fitted to them from 0 (a constant σ is
+//! a flat line at its level, not lost in a ±1 default).
+
+use super::super::shapes::AXIS_COLORS;
+use super::{MEANING, topic_path};
+use crate::eval::log::LogEvaluation;
+use crate::plan::log::ROS_AXES;
+use crate::scene::{Corner, PLOTS, Plot, ScalarSeries, Scene};
+
+/// Room above the largest value.
+const HEADROOM: f64 = 1.15;
+
+/// A plot's unit for values whose largest is `max` (in SI `si`): its name and the factor
+/// from SI.
+fn unit_for(si: &str, max: f64) -> (&'static str, f64) {
+    match si {
+        "m" if max < 0.5 => ("mm", 1e3),
+        "m" => ("m", 1.0),
+        "rad" if max.to_degrees() < 1.0 => ("mrad", 1e3),
+        "rad" => ("°", 180.0 / std::f64::consts::PI),
+        "m²" if max < 0.25 => ("mm²", 1e6),
+        _ => ("m²", 1.0),
+    }
+}
+
+/// σ per axis and the position trace over the stamp, one line per topic and axis, each plot
+/// in its fitted unit and range.
+pub(super) fn plots(scene: &mut Scene, e: &LogEvaluation) {
+    let planar = scene.planar;
+    // (plot id, title, SI unit, lines: (path tail, name, colour, points in SI)).
+    type Line = (String, String, crate::scene::Color, Vec<(i64, f64)>);
+    let mut position: Vec<Line> = Vec::new();
+    let mut rotation: Vec<Line> = Vec::new();
+    let mut trace: Vec<Line> = Vec::new();
+    // A line's name: its axis, after its topic when several topics share the plot.
+    let several = e.topics.iter().filter(|t| !t.series.is_empty()).count() > 1;
+    let named = |topic: &str, what: &str| {
+        if several {
+            format!("{topic} {what}")
+        } else {
+            what.to_owned()
+        }
+    };
+    for t in &e.topics {
+        let topic = topic_path(&t.name);
+        for (axis, name) in ROS_AXES.iter().enumerate() {
+            let points: Vec<(i64, f64)> = t
+                .series
+                .iter()
+                .filter_map(|s| s.sigma[axis].map(|v| (s.stamp_ns, v)))
+                .collect();
+            if points.is_empty() || (planar && [2, 3, 4].contains(&axis)) {
+                continue;
+            }
+            let line = (
+                format!("{topic}/{name}"),
+                named(&t.name, &format!("σ{name}")),
+                AXIS_COLORS[axis % 3],
+                points,
+            );
+            if axis < 3 {
+                position.push(line);
+            } else {
+                rotation.push(line);
+            }
+        }
+        let points: Vec<(i64, f64)> = t
+            .series
+            .iter()
+            .filter_map(|s| s.position_trace.map(|v| (s.stamp_ns, v)))
+            .collect();
+        if !points.is_empty() {
+            trace.push((topic, named(&t.name, "tr Σ_position"), MEANING, points));
+        }
+    }
+    scene.plots.clear();
+    let titles = if planar {
+        ["σ xy", "σ yaw", "tr Σxy"]
+    } else {
+        ["σ xyz", "σ rpy", "tr Σxyz"]
+    };
+    for (id, title, si, lines) in [
+        // Short titles (at 1024 × 640 a plot's tab shows about 12 characters): the axes.
+        ("sigma_position", titles[0], "m", position),
+        ("sigma_rotation", titles[1], "rad", rotation),
+        ("position_trace", titles[2], "m²", trace),
+    ] {
+        let max = lines
+            .iter()
+            .flat_map(|l| l.3.iter().map(|p| p.1))
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        let (unit, factor) = unit_for(si, max);
+        let top = if max > 0.0 {
+            HEADROOM * max * factor
+        } else {
+            1.0
+        };
+        scene.plots.push(Plot {
+            id: id.into(),
+            title: title.into(),
+            unit: unit.into(),
+            range: Some([0.0, top]),
+            // Where the viewer puts it by default: these plots leave room below their lines.
+            legend: Corner::LeftBottom,
+        });
+        for (tail, name, color, points) in lines {
+            scene.series.push(ScalarSeries {
+                path: format!("{PLOTS}/{id}/{tail}"),
+                name,
+                color,
+                width: 1.5,
+                points: points.into_iter().map(|(t, v)| (t, v * factor)).collect(),
+            });
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_sigmas_are_plotted_in_mm_and_degrees() {
+        assert_eq!(unit_for("m", 0.0316), ("mm", 1e3));
+        assert_eq!(unit_for("m", 3.0), ("m", 1.0));
+        assert_eq!(unit_for("rad", 0.173).0, "°");
+        assert_eq!(unit_for("rad", 0.001), ("mrad", 1e3));
+        assert_eq!(unit_for("m²", 0.002), ("mm²", 1e6));
+    }
+}

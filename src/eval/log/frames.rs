@@ -1,0 +1,503 @@
+//! Topics in different frames joined by the log's own transforms (`/tf`, `/tf_static`): where
+//! a chain of transforms leads from a topic's `frame_id` to a frame another topic is drawn in
+//! (map → odom, as AMCL publishes it), the topic is drawn in that common frame; else each frame
+//! keeps its own view, and why is said ([`FrameProblem`]).
+//!
+//! - The tree: every child frame has one parent (tf's rule). A child with several parents, or
+//!   a chain of parents that comes back to itself (a cycle), is a broken tree: nothing is
+//!   joined through it.
+//! - The common frame of topics whose frames are in one tree is their lowest common ancestor:
+//!   the first frame on the way up from one topic's frame that every other's way up reaches
+//!   (`map` for topics in `map` and `odom`; a frame above it is never needed).
+//! - A message at stamp t is moved by common_from_frame(t), the product of the chain's edges,
+//!   each looked up at t ([`StampedPoses::at`]: interpolated on SE(3), never extrapolated; a
+//!   `/tf_static` edge is its latest value). A message outside the chain's span is left out of
+//!   the joined view, counted and said ([`FrameJoin::left_out`]).
+//! - The covariance moves with the pose in the ROS reading used: Σ' = B_T Σ B_Tᵀ,
+//!   B_T = blkdiag(R_T, R_T) in tf2's reading ([`ros_cov_moved`], CONVENTIONS §6); the
+//!   right-form Gaussian posecov draws is unchanged, its mean moved to T · X̂. `/tf` carries no
+//!   covariance: the transform is taken as exact.
+//! - A planar topic is joined only by transforms that keep its plane (roll and pitch below
+//!   [`PLANE_TOLERANCE`]).
+//!
+//! ```
+//! use posecov::eval::log::frames::{FrameProblemKind, join_plan};
+//! use posecov::plan::log::{ReferenceSample, TfEdge, TfTree};
+//! let s = ReferenceSample { stamp_ns: 0, position: [1.0, 0.0, 0.0], orientation_xyzw: [0.0, 0.0, 0.0, 1.0] };
+//! let edge = |p: &str, c: &str| TfEdge { samples: vec![s, ReferenceSample { stamp_ns: 10, ..s }], messages: 2, ..TfEdge::new(p, c, "/tf", 0) };
+//! let tf = TfTree { edges: vec![edge("map", "odom"), edge("odom", "base_link")], ..Default::default() };
+//! let plan = join_plan(&tf, &[("/odom", "odom", Some(0)), ("/amcl_pose", "map", Some(0)), ("/gps", "utm", Some(3))]);
+//! assert_eq!(plan.chains[0].as_deref(), Some(&["odom".to_owned(), "map".to_owned()][..]));
+//! assert!(plan.chains[1].is_none() && plan.chains[2].is_none());
+//! assert_eq!(plan.problems[0].kind, FrameProblemKind::NoTransform);
+//! let x = plan.lookup(&tf, plan.chains[0].as_deref().unwrap(), 5).unwrap();
+//! assert_eq!(x.translation().x, 1.0);
+//! assert!(plan.lookup(&tf, plan.chains[0].as_deref().unwrap(), 11).is_none()); // never extrapolated
+//! ```
+//!
+//! [`ros_cov_moved`]: crate::interop::ros_cov_moved
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use nalgebra::{Matrix6, Vector3};
+use serde::Serialize;
+
+use super::stamped::{Lookup, StampedPoses, pose_of_sample};
+use crate::interop::{RosReading, ros_cov_moved};
+use crate::lie::{LieGroup, Se3};
+use crate::plan::log::{Class, Issue, TfTree, TopicSummary};
+
+/// A transform keeps a planar topic's plane when its roll and pitch are below this (rad).
+pub const PLANE_TOLERANCE: f64 = 1e-6;
+
+/// A topic drawn in another frame than its own.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrameJoin {
+    /// Its own frame (`header.frame_id`).
+    pub from: String,
+    /// The common frame it is drawn in.
+    pub to: String,
+    /// The frames from its own up to the common one (both included).
+    pub chain: Vec<String>,
+    /// Drawn messages moved.
+    pub moved: u64,
+    /// Drawn messages left out: stamped outside the chain's transforms.
+    pub left_out: u64,
+    /// The first left-out message's stamp, ns.
+    pub first_left_out_ns: Option<i64>,
+    /// Trajectory points left out likewise.
+    pub trajectory_left_out: u64,
+}
+
+/// Why frames could not be joined.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrameProblemKind {
+    /// A chain of parents that comes back to itself (a defect of the log's `/tf`).
+    Cycle,
+    /// A child frame with several parents, where tf allows one (a defect of the log's `/tf`).
+    SeveralParents,
+    /// Topics' frames are in `/tf`, but in trees no transform joins (a note: drawn apart).
+    MissingLink,
+    /// A topic's frame never gets a transform in `/tf` or `/tf_static` (a note: drawn apart).
+    NoTransform,
+    /// A planar topic whose transform tilts its plane (a note: drawn apart).
+    TiltsPlane,
+}
+
+impl FrameProblemKind {
+    /// Its finding in the one table of findings ([`Issue`]): the word (`tf_cycle`) in the
+    /// panel, `report --json` and `check --allow`, and its class (a broken tree is a defect,
+    /// `posecov check` fails on it; a frame the log does not join is a note).
+    ///
+    /// ```
+    /// use posecov::eval::log::frames::FrameProblemKind;
+    /// use posecov::plan::log::{Class, Issue};
+    /// assert_eq!(FrameProblemKind::MissingLink.issue().name(), "tf_missing_link");
+    /// assert_eq!(FrameProblemKind::Cycle.issue(), Issue::TfCycle);
+    /// assert_eq!(FrameProblemKind::Cycle.class(), Class::Defect);
+    /// assert_eq!(FrameProblemKind::NoTransform.class(), Class::Note);
+    /// ```
+    pub fn issue(self) -> Issue {
+        match self {
+            FrameProblemKind::Cycle => Issue::TfCycle,
+            FrameProblemKind::SeveralParents => Issue::TfSeveralParents,
+            FrameProblemKind::MissingLink => Issue::TfMissingLink,
+            FrameProblemKind::NoTransform => Issue::TfNoTransform,
+            FrameProblemKind::TiltsPlane => Issue::TfTiltsPlane,
+        }
+    }
+
+    /// Defect or note, by [`Issue::class`] (see [`issue`](Self::issue) for an example).
+    pub fn class(self) -> Class {
+        // Whether the topic is dead-reckoned matters only to `constant`.
+        self.issue().class(false)
+    }
+}
+
+/// One reason frames were not joined, located: the frames, the topics concerned, where it was
+/// read and when.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrameProblem {
+    /// What is wrong.
+    pub kind: FrameProblemKind,
+    /// The frames: the cycle in order (its first again at the end); the child then its
+    /// parents; for a missing link, one frame per tree; the frame never transformed.
+    pub frames: Vec<String>,
+    /// A missing link only: the root of each tree in `frames`' order.
+    pub roots: Vec<String>,
+    /// The pose topics drawn apart because of it.
+    pub topics: Vec<String>,
+    /// Where it was read: `/tf`, `/tf_static`, or the pose topic.
+    pub source: String,
+    /// When it was first seen (ns): the transform that closed the cycle or gave the second
+    /// parent, or the topic's first message.
+    pub stamp_ns: Option<i64>,
+}
+
+/// Which topics join which frame: per topic its chain of frames up to the common one
+/// (`None`: drawn in its own frame), and the problems found.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FrameJoins {
+    /// Per topic, in the order given.
+    pub chains: Vec<Option<Vec<String>>>,
+    /// What kept frames apart.
+    pub problems: Vec<FrameProblem>,
+}
+
+/// What joining frames found: the log had transforms, and what kept frames apart.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct FrameFindings {
+    /// The log has `/tf` or `/tf_static` transforms.
+    pub has_tf: bool,
+    /// What kept frames apart.
+    pub problems: Vec<FrameProblem>,
+}
+
+/// The chain of frames from `frame` up to its root; `Err(cycle)` when it comes back.
+fn chain_up(parents: &BTreeMap<&str, &str>, frame: &str) -> Result<Vec<String>, Vec<String>> {
+    let mut out = vec![frame.to_owned()];
+    while let Some(p) = parents.get(out[out.len() - 1].as_str()) {
+        if let Some(i) = out.iter().position(|f| f == p) {
+            let mut cycle = out[i..].to_vec();
+            cycle.push((*p).to_owned());
+            return Err(cycle);
+        }
+        out.push((*p).to_owned());
+    }
+    Ok(out)
+}
+
+/// Decides which topics join (see the [module docs](self)): `topics` gives each topic's name,
+/// `frame_id` and first stamp.
+///
+/// See the [module docs](self) for an example.
+pub fn join_plan(tf: &TfTree, topics: &[(&str, &str, Option<i64>)]) -> FrameJoins {
+    let mut plan = FrameJoins {
+        chains: vec![None; topics.len()],
+        problems: Vec::new(),
+    };
+    if tf.edges.is_empty() {
+        return plan;
+    }
+    let frame = |f: &str| f.trim_start_matches('/').to_owned();
+    // tf's one-parent rule: a child with several parents keeps none.
+    let mut seen: BTreeMap<&str, Vec<&crate::plan::log::TfEdge>> = BTreeMap::new();
+    for e in &tf.edges {
+        seen.entry(e.child.as_str()).or_default().push(e);
+    }
+    let mut parents = BTreeMap::new();
+    let mut broken = BTreeSet::new();
+    for (child, edges) in &seen {
+        if let [one] = edges.as_slice() {
+            parents.insert(*child, one.parent.as_str());
+        } else {
+            broken.insert((*child).to_owned());
+            let second = edges.iter().max_by_key(|e| e.first_stamp_ns);
+            let mut frames = vec![(*child).to_owned()];
+            frames.extend(edges.iter().map(|e| e.parent.clone()));
+            plan.problems.push(FrameProblem {
+                kind: FrameProblemKind::SeveralParents,
+                frames,
+                roots: Vec::new(),
+                topics: Vec::new(),
+                source: second.map(|e| e.topic.clone()).unwrap_or_default(),
+                stamp_ns: second.map(|e| e.first_stamp_ns),
+            });
+        }
+    }
+    // One frame among the topics: nothing to join, nothing to say of frames /tf lacks.
+    let distinct: BTreeSet<String> = topics
+        .iter()
+        .map(|t| frame(t.1))
+        .filter(|f| !f.is_empty())
+        .collect();
+    if distinct.len() < 2 {
+        return plan;
+    }
+    let known: BTreeSet<&str> = tf
+        .edges
+        .iter()
+        .flat_map(|e| [e.parent.as_str(), e.child.as_str()])
+        .collect();
+    // Per topic its chain to the root; per root the topics under it.
+    let mut chains: Vec<Option<Vec<String>>> = vec![None; topics.len()];
+    let mut roots: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    for (i, (name, frame_id, first)) in topics.iter().enumerate() {
+        let f = frame(frame_id);
+        if f.is_empty() {
+            continue;
+        }
+        if !known.contains(f.as_str()) {
+            note_topic(
+                &mut plan.problems,
+                FrameProblemKind::NoTransform,
+                &f,
+                name,
+                *first,
+            );
+            continue;
+        }
+        match chain_up(&parents, &f) {
+            Ok(c) => {
+                if c.iter().any(|g| broken.contains(g)) {
+                    for p in &mut plan.problems {
+                        if p.kind == FrameProblemKind::SeveralParents && c.contains(&p.frames[0]) {
+                            p.topics.push((*name).to_owned());
+                        }
+                    }
+                }
+                roots.entry(c[c.len() - 1].clone()).or_default().push(i);
+                chains[i] = Some(c);
+            }
+            Err(cycle) => {
+                let mut sorted = cycle[..cycle.len() - 1].to_vec();
+                sorted.sort();
+                let same = |p: &FrameProblem| {
+                    let mut s = p.frames[..p.frames.len() - 1].to_vec();
+                    s.sort();
+                    p.kind == FrameProblemKind::Cycle && s == sorted
+                };
+                match plan.problems.iter_mut().find(|p| same(p)) {
+                    Some(p) => p.topics.push((*name).to_owned()),
+                    None => {
+                        let closing = cycle
+                            .windows(2)
+                            .filter_map(|w| tf.edge(&w[1], &w[0]))
+                            .max_by_key(|e| e.first_stamp_ns);
+                        plan.problems.push(FrameProblem {
+                            kind: FrameProblemKind::Cycle,
+                            frames: cycle.into_iter().rev().collect(),
+                            roots: Vec::new(),
+                            topics: vec![(*name).to_owned()],
+                            source: closing.map(|e| e.topic.clone()).unwrap_or_default(),
+                            stamp_ns: closing.map(|e| e.first_stamp_ns),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    // Per tree: the lowest common ancestor of its topics' frames.
+    for members in roots.values() {
+        let firsts: BTreeSet<&str> = members
+            .iter()
+            .filter_map(|&i| chains[i].as_ref().map(|c| c[0].as_str()))
+            .collect();
+        if firsts.len() < 2 {
+            continue;
+        }
+        let Some(first) = chains[members[0]].as_ref() else {
+            continue;
+        };
+        let common = first
+            .iter()
+            .find(|f| {
+                members
+                    .iter()
+                    .all(|&i| chains[i].as_ref().is_some_and(|c| c.contains(f)))
+            })
+            .cloned();
+        let Some(common) = common else { continue };
+        for &i in members {
+            if let Some(c) = &chains[i]
+                && let Some(end) = c.iter().position(|f| *f == common)
+                && end > 0
+            {
+                plan.chains[i] = Some(c[..=end].to_vec());
+            }
+        }
+    }
+    // Frames in /tf but in trees apart (not apart by a broken link, said above): a missing
+    // link.
+    roots.retain(|root, _| !broken.contains(root));
+    if roots.len() > 1 {
+        let (frames, trees): (Vec<String>, Vec<String>) = roots
+            .iter()
+            .filter_map(|(root, members)| {
+                let c = chains[members[0]].as_ref()?;
+                Some((c[0].clone(), root.clone()))
+            })
+            .unzip();
+        plan.problems.push(FrameProblem {
+            kind: FrameProblemKind::MissingLink,
+            frames,
+            roots: trees,
+            topics: roots
+                .values()
+                .flatten()
+                .map(|&i| topics[i].0.to_owned())
+                .collect(),
+            source: "/tf".to_owned(),
+            stamp_ns: None,
+        });
+    }
+    plan
+}
+
+/// Notes a topic's frame problem, one per frame (further topics added to it).
+fn note_topic(
+    problems: &mut Vec<FrameProblem>,
+    kind: FrameProblemKind,
+    frame: &str,
+    topic: &str,
+    stamp_ns: Option<i64>,
+) {
+    match problems
+        .iter_mut()
+        .find(|p| p.kind == kind && p.frames[0] == frame)
+    {
+        Some(p) => p.topics.push(topic.to_owned()),
+        None => problems.push(FrameProblem {
+            kind,
+            frames: vec![frame.to_owned()],
+            roots: Vec::new(),
+            topics: vec![topic.to_owned()],
+            source: topic.to_owned(),
+            stamp_ns,
+        }),
+    }
+}
+
+impl FrameJoins {
+    /// common_from_frame at `stamp_ns` along `chain` (a topic's frame first): the product of
+    /// the chain's edges, each looked up at the stamp; `None` outside an edge's span (never
+    /// extrapolated) or where an edge has no transform kept.
+    ///
+    /// See the [module docs](self) for an example.
+    pub fn lookup(&self, tf: &TfTree, chain: &[String], stamp_ns: i64) -> Option<Se3> {
+        EdgeLookup::new(tf, chain).at(stamp_ns)
+    }
+}
+
+/// A chain's edges, ready to be looked up at stamps.
+struct EdgeLookup {
+    /// Per edge from the topic's frame up: its `/tf` samples, or its `/tf_static` value.
+    edges: Vec<Result<StampedPoses, Option<Se3>>>,
+}
+
+impl EdgeLookup {
+    fn new(tf: &TfTree, chain: &[String]) -> Self {
+        let edges = chain
+            .windows(2)
+            .map(|w| match tf.edge(&w[1], &w[0]) {
+                Some(e) if !e.samples.is_empty() => {
+                    let mut poses = StampedPoses::default();
+                    for s in &e.samples {
+                        if let Some(x) = pose_of_sample(s) {
+                            poses.insert(s.stamp_ns, x);
+                        }
+                    }
+                    Ok(poses)
+                }
+                Some(e) => Err(e.static_value.as_ref().and_then(pose_of_sample)),
+                None => Err(None),
+            })
+            .collect();
+        Self { edges }
+    }
+
+    fn at(&self, stamp_ns: i64) -> Option<Se3> {
+        let mut x = Se3::identity();
+        for edge in &self.edges {
+            let e = match edge {
+                Ok(poses) => match poses.at(stamp_ns) {
+                    Lookup::At(e) => e,
+                    Lookup::Before | Lookup::After => return None,
+                },
+                Err(value) => (*value)?,
+            };
+            x = e.compose(&x);
+        }
+        Some(x)
+    }
+}
+
+/// Whether a transform keeps the plane z = 0's orientation (roll, pitch ≤ [`PLANE_TOLERANCE`]).
+fn keeps_plane(t: &Se3) -> bool {
+    let [roll, pitch, _] = t.rotation().to_rpy();
+    roll.abs() <= PLANE_TOLERANCE && pitch.abs() <= PLANE_TOLERANCE
+}
+
+/// `topic` moved into its chain's common frame: every drawn message and trajectory point moved
+/// by common_from_frame at its stamp (the covariance by [`ros_cov_moved`] in `reading`), those
+/// outside the transforms' span left out; the topic's `frame_id` becomes the common frame.
+/// `Err(stamp)`: a planar topic whose transform at `stamp` tilts its plane (nothing moved).
+///
+/// ```
+/// use posecov::eval::log::frames::move_topic;
+/// use posecov::input::{locate, log::{LogOptions, read_located}};
+/// use posecov::interop::RosReading;
+/// use posecov::plan::log::{ReferenceSample, TfEdge, TfTree};
+/// let s = ReferenceSample { stamp_ns: 0, position: [1.0, 0.0, 0.0], orientation_xyzw: [0.0, 0.0, 0.0, 1.0] };
+/// let edge = TfEdge { samples: vec![s, ReferenceSample { stamp_ns: 47_700_000_000, ..s }], messages: 2, ..TfEdge::new("map", "odom", "/tf", 0) };
+/// let tf = TfTree { edges: vec![edge], ..Default::default() };
+/// let log = read_located(&locate("jackal_odometry").unwrap(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+/// let topic = &log.topics[0]; // in `odom`, 47.584 s to 108.764 s
+/// let chain = ["odom".to_owned(), "map".to_owned()];
+/// let (moved, join) = move_topic(&tf, &chain, topic, RosReading::Tf2).unwrap();
+/// assert_eq!(moved.frame_id, "map");
+/// assert_eq!(moved.trajectory[0].1[0], topic.trajectory[0].1[0] + 1.0);
+/// assert!(join.moved >= 1 && join.left_out > 0); // after 47.7 s: never extrapolated
+/// ```
+pub fn move_topic(
+    tf: &TfTree,
+    chain: &[String],
+    topic: &TopicSummary,
+    reading: RosReading,
+) -> Result<(TopicSummary, FrameJoin), i64> {
+    let lookup = EdgeLookup::new(tf, chain);
+    let to = chain.last().cloned().unwrap_or_default();
+    let mut join = FrameJoin {
+        from: topic.frame_id.clone(),
+        to: to.clone(),
+        chain: chain.to_vec(),
+        moved: 0,
+        left_out: 0,
+        first_left_out_ns: None,
+        trajectory_left_out: 0,
+    };
+    let mut drawn = Vec::with_capacity(topic.drawn.len());
+    for d in &topic.drawn {
+        let stamp = d.message.stamp_ns;
+        let Some(t) = lookup.at(stamp) else {
+            join.left_out += 1;
+            join.first_left_out_ns.get_or_insert(stamp);
+            continue;
+        };
+        if topic.planar && !keeps_plane(&t) {
+            return Err(stamp);
+        }
+        let mut d = d.clone();
+        let m = &mut d.message;
+        if let Ok(r) = crate::lie::So3::try_from_quaternion_xyzw(m.orientation_xyzw) {
+            let x = t.compose(&Se3::from_parts(m.position.into(), r));
+            m.position = (*x.translation()).into();
+            m.orientation_xyzw = x.rotation().to_quaternion_xyzw();
+        }
+        let cov = Matrix6::from_row_slice(&m.covariance);
+        if cov.iter().all(|v| v.is_finite()) {
+            let moved = ros_cov_moved(&cov, t.rotation(), reading);
+            for (i, v) in m.covariance.iter_mut().enumerate() {
+                *v = moved[(i / 6, i % 6)];
+            }
+        }
+        join.moved += 1;
+        drawn.push(d);
+    }
+    let mut trajectory = Vec::with_capacity(topic.trajectory.len());
+    for (stamp, p) in &topic.trajectory {
+        match lookup.at(*stamp) {
+            Some(t) if topic.planar && !keeps_plane(&t) => return Err(*stamp),
+            Some(t) => trajectory.push((*stamp, t.act(&Vector3::from(*p)).into())),
+            None => join.trajectory_left_out += 1,
+        }
+    }
+    let moved = TopicSummary {
+        frame_id: to,
+        drawn,
+        trajectory,
+        ..topic.clone()
+    };
+    Ok((moved, join))
+}

@@ -1,0 +1,585 @@
+//! The numbers of a robot log ([`LogSummary`]): per drawn message, what its covariance means in
+//! posecov's body-frame right form (through the one ROS conversion,
+//! [`ros_cov_to_right`]), a seeded sample cloud, and the numbers RViz draws from
+//! the same message. Planar topics become SE(2) (x, y, yaw), others SE(3).
+//!
+//! Confidence regions: a planar topic's position region has d = 2 degrees of freedom and its
+//! pose region d = 3; a 3-D topic's d = 3 and d = 6 ([CONVENTIONS §7](crate::conventions)).
+//!
+//! ```
+//! use posecov::eval::log::{LogEvalSettings, evaluate_log};
+//! use posecov::input::log::{LogOptions, read_log};
+//! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
+//! let plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+//! let e = evaluate_log(&plan, &LogEvalSettings::default());
+//! let odom = &e.topics[0];
+//! assert_eq!((odom.position_dof, odom.pose_dof), (2, 3));
+//! assert!(odom.poses.iter().all(|p| p.state.is_drawable()));
+//! ```
+
+pub mod frames;
+pub mod nees;
+pub mod stamped;
+
+use nalgebra::{Matrix3, Matrix6, Vector2};
+
+use crate::interop::{RosReading, ros_cov_to_right};
+use crate::lie::{Se2, Se3, So2, So3};
+use serde::Serialize;
+
+use self::frames::{
+    FrameFindings, FrameJoin, FrameProblem, FrameProblemKind, join_plan, move_topic,
+};
+use crate::plan::log::{AxisStats, DrawnMessage, Issue, LogSummary, SeriesPoint, TopicSummary};
+use crate::sample::{Sampler, chunk_rng};
+use crate::uncertain::{Side, UncertainPose};
+
+/// Samples drawn per message by default (a cloud per drawn message).
+pub const DEFAULT_CLOUD_SAMPLES: usize = 100;
+
+/// What evaluating a log needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogEvalSettings {
+    /// Seed of every cloud (topic k, message i draw from stream (seed, k, i)).
+    pub seed: u64,
+    /// Samples per drawn message.
+    pub cloud_samples: usize,
+    /// How each message's 6×6 covariance is read ([`RosReading`], CONVENTIONS §6).
+    pub reading: RosReading,
+}
+
+impl Default for LogEvalSettings {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            cloud_samples: DEFAULT_CLOUD_SAMPLES,
+            reading: RosReading::default(),
+        }
+    }
+}
+
+/// What RViz draws from one message (its `CovarianceVisual`): the position block in the parent
+/// frame's axes, the rotation block, and whether it decides the pose is 2-D (Σzz, Σroll,
+/// Σpitch all ≤ 0 — placeholders make it draw in 3-D).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RvizNumbers {
+    /// Σ of (x, y, z), parent axes.
+    pub position_cov: Matrix3<f64>,
+    /// Σ of (roll, pitch, yaw), body axes.
+    pub rotation_cov: Matrix3<f64>,
+    /// RViz's 2-D rule.
+    pub pose_2d: bool,
+}
+
+/// One drawn message's meaning.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PoseState {
+    /// Planar: x, y, yaw as SE(2), body-frame right form, with its cloud.
+    Planar {
+        /// The Gaussian.
+        pose: UncertainPose<Se2, 3>,
+        /// Samples μ · Exp(ε).
+        cloud: Vec<Se2>,
+    },
+    /// 3-D: SE(3), body-frame right form, with its cloud.
+    Spatial {
+        /// The Gaussian (boxed: 6 × 6).
+        pose: Box<UncertainPose<Se3, 6>>,
+        /// Samples μ · Exp(ε).
+        cloud: Vec<Se3>,
+    },
+    /// Not a Gaussian posecov can draw: why.
+    Invalid {
+        /// The issues (or a placeholder in a 3-D topic).
+        issues: Vec<Issue>,
+    },
+}
+
+impl PoseState {
+    /// Whether it is drawn as a Gaussian.
+    pub fn is_drawable(&self) -> bool {
+        !matches!(self, PoseState::Invalid { .. })
+    }
+}
+
+/// One drawn message.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseEvaluation {
+    /// Index on the topic.
+    pub index: u64,
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// The message's pose as published (`None`: not finite / not a rotation).
+    pub mean: Option<Se3>,
+    /// What the covariance means.
+    pub state: PoseState,
+    /// RViz's numbers (`None` when the covariance is not finite).
+    pub rviz: Option<RvizNumbers>,
+    /// σ = √Σᵢᵢ per ROS axis (x, y, z in the parent's axes, m; roll, pitch, yaw, rad) where
+    /// the axis is estimated: finite, neither a placeholder (≥ 1e6) nor zero. As published: in
+    /// the topic's own frame's axes, also when it is drawn joined to another frame.
+    pub sigma: [Option<f64>; 6],
+}
+
+/// One axis's σ over a topic: first, last, smallest and largest over every message where the
+/// axis is estimated (streamed while reading, [`AxisStats`]), and the median over the kept
+/// series (the values a median needs are only kept there, bounded).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SigmaSummary {
+    /// Messages counted (every message where the axis is estimated).
+    pub messages: u64,
+    /// σ of the first such message.
+    pub first: f64,
+    /// σ of the last.
+    pub last: f64,
+    /// Smallest σ.
+    pub min: f64,
+    /// The median σ of the kept series (`None` when none of its points estimates the axis).
+    pub median_of_kept: Option<f64>,
+    /// Largest σ.
+    pub max: f64,
+}
+
+/// The σ summary of ROS axis `axis` (0..6) of a topic: its streamed statistics and the median
+/// of the kept series (the mean of the two middle values for an even count).
+///
+/// ```
+/// use posecov::eval::log::sigma_summary;
+/// use posecov::plan::log::{AxisStats, SeriesPoint};
+/// let mut stats = None;
+/// let series: Vec<SeriesPoint> = [0.3, 0.1, 0.2, 0.4]
+///     .into_iter()
+///     .map(|s| {
+///         AxisStats::add(&mut stats, s);
+///         SeriesPoint { stamp_ns: 0, sigma: [Some(s), None, None, None, None, None], position_trace: None }
+///     })
+///     .collect();
+/// let x = sigma_summary(stats, &series, 0).unwrap();
+/// assert_eq!((x.first, x.last, x.min, x.max), (0.3, 0.4, 0.1, 0.4));
+/// assert!((x.median_of_kept.unwrap() - 0.25).abs() < 1e-15);
+/// assert_eq!(sigma_summary(None, &series, 1), None);
+/// ```
+pub fn sigma_summary(
+    stats: Option<AxisStats>,
+    series: &[SeriesPoint],
+    axis: usize,
+) -> Option<SigmaSummary> {
+    let stats = stats?;
+    let mut kept: Vec<f64> = series.iter().filter_map(|p| p.sigma[axis]).collect();
+    kept.sort_by(f64::total_cmp);
+    let n = kept.len();
+    let median_of_kept = match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(kept[n / 2]),
+        _ => Some(0.5 * (kept[n / 2 - 1] + kept[n / 2])),
+    };
+    Some(SigmaSummary {
+        messages: stats.messages,
+        first: stats.first,
+        last: stats.last,
+        min: stats.min,
+        median_of_kept,
+        max: stats.max,
+    })
+}
+
+/// One topic's numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicEvaluation {
+    /// Topic name.
+    pub name: String,
+    /// The frame its poses are in (`header.frame_id` of its first message; may be empty).
+    pub frame_id: String,
+    /// Drawn as SE(2) in the x–y plane.
+    pub planar: bool,
+    /// Degrees of freedom of the position region (2 planar, 3 otherwise).
+    pub position_dof: usize,
+    /// Degrees of freedom of the pose region (3 planar, 6 otherwise).
+    pub pose_dof: usize,
+    /// Drawn messages.
+    pub poses: Vec<PoseEvaluation>,
+    /// How far apart the two ROS readings put the drawn messages' right-form covariances:
+    /// the largest ‖Σ_tf2 − Σ_body‖_F / ‖Σ_tf2‖_F (0 for planar topics, where they coincide).
+    pub reading_difference: f64,
+    /// Trajectory (stamp ns, position).
+    pub trajectory: Vec<(i64, [f64; 3])>,
+    /// Time series.
+    pub series: Vec<SeriesPoint>,
+    /// σ per ROS axis (x, y, z, roll, pitch, yaw; m and rad), `None` where never estimated.
+    pub sigma: [Option<SigmaSummary>; 6],
+    /// NEES against the reference (`--reference`), streamed over every message
+    /// ([`crate::eval::log::nees`]); `None` without a reference, or for the reference topic itself.
+    pub consistency: Option<crate::eval::log::nees::TopicConsistency>,
+    /// Drawn in another frame than its own, joined through the log's `/tf`
+    /// ([`crate::eval::log::frames`]): `frame_id` is then the common frame.
+    pub joined: Option<FrameJoin>,
+}
+
+/// A log's numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogEvaluation {
+    /// Per topic, in the plan's order.
+    pub topics: Vec<TopicEvaluation>,
+    /// The ROS reading every covariance was read in.
+    pub reading: RosReading,
+    /// What kept topics in different frames apart ([`crate::eval::log::frames`]).
+    pub frames: FrameFindings,
+}
+
+impl LogEvaluation {
+    /// Attaches each topic's NEES ([`crate::eval::log::nees::NeesObserver::finish`]) by name.
+    pub fn with_consistency(
+        mut self,
+        results: Vec<(String, crate::eval::log::nees::TopicConsistency)>,
+    ) -> Self {
+        for (name, c) in results {
+            if let Some(t) = self.topics.iter_mut().find(|t| t.name == name) {
+                t.consistency = Some(c);
+            }
+        }
+        self
+    }
+}
+
+/// Evaluates every topic of a log.
+///
+/// See the [module docs](self) for an example.
+pub fn evaluate_log(plan: &LogSummary, settings: &LogEvalSettings) -> LogEvaluation {
+    let named: Vec<(&str, &str, Option<i64>)> = plan
+        .topics
+        .iter()
+        .map(|t| {
+            (
+                t.name.as_str(),
+                t.frame_id.as_str(),
+                t.stamp_range.map(|r| r.0),
+            )
+        })
+        .collect();
+    let joins = join_plan(&plan.tf, &named);
+    let mut problems = joins.problems;
+    let topics = plan
+        .topics
+        .iter()
+        .zip(joins.chains)
+        .enumerate()
+        .map(|(k, (t, chain))| {
+            let moved = chain.map(|c| move_topic(&plan.tf, &c, t, settings.reading));
+            match moved {
+                Some(Ok((moved, join))) => {
+                    let mut e = evaluate_topic(k as u64, &moved, settings);
+                    // σ per axis as published, in the topic's own frame's axes (as its plots,
+                    // report and check give them).
+                    for p in &mut e.poses {
+                        if let Some(d) = t.drawn.iter().find(|d| d.index == p.index) {
+                            p.sigma = message_sigma(d);
+                        }
+                    }
+                    TopicEvaluation {
+                        joined: Some(join),
+                        ..e
+                    }
+                }
+                Some(Err(stamp)) => {
+                    problems.push(FrameProblem {
+                        kind: FrameProblemKind::TiltsPlane,
+                        frames: vec![t.frame_id.clone()],
+                        roots: Vec::new(),
+                        topics: vec![t.name.clone()],
+                        source: "/tf".to_owned(),
+                        stamp_ns: Some(stamp),
+                    });
+                    evaluate_topic(k as u64, t, settings)
+                }
+                None => evaluate_topic(k as u64, t, settings),
+            }
+        })
+        .collect();
+    LogEvaluation {
+        topics,
+        reading: settings.reading,
+        frames: FrameFindings {
+            has_tf: !plan.tf.edges.is_empty(),
+            problems,
+        },
+    }
+}
+
+fn evaluate_topic(
+    family: u64,
+    topic: &TopicSummary,
+    settings: &LogEvalSettings,
+) -> TopicEvaluation {
+    let mut reading_difference: f64 = 0.0;
+    let poses = topic
+        .drawn
+        .iter()
+        .map(|d| {
+            let m = &d.message;
+            let finite = m.covariance.iter().all(|v| v.is_finite());
+            let cov_ros = Matrix6::from_row_slice(&m.covariance);
+            let rotation = So3::try_from_quaternion_xyzw(m.orientation_xyzw).ok();
+            let mean = rotation
+                .filter(|_| m.position.iter().all(|v| v.is_finite()))
+                .map(|r| Se3::from_parts(m.position.into(), r));
+            let rviz = finite.then(|| RvizNumbers {
+                position_cov: cov_ros.fixed_view::<3, 3>(0, 0).into_owned(),
+                rotation_cov: cov_ros.fixed_view::<3, 3>(3, 3).into_owned(),
+                pose_2d: m.covariance[14] <= 0.0
+                    && m.covariance[21] <= 0.0
+                    && m.covariance[28] <= 0.0,
+            });
+            let state = match (mean, d.unusable.is_empty()) {
+                (Some(mean), true) => {
+                    if !topic.planar && finite {
+                        reading_difference =
+                            reading_difference.max(readings_apart(&mean, &cov_ros));
+                    }
+                    meaning(
+                        &mean,
+                        &cov_ros,
+                        &d.unestimated,
+                        topic.planar,
+                        settings.reading,
+                    )
+                    .map_or_else(
+                        |issues| PoseState::Invalid { issues },
+                        |state| with_cloud(state, settings, family, d.index),
+                    )
+                }
+                _ => PoseState::Invalid {
+                    issues: if d.unusable.is_empty() {
+                        vec![Issue::BadOrientation]
+                    } else {
+                        d.unusable.clone()
+                    },
+                },
+            };
+            let sigma = message_sigma(d);
+            PoseEvaluation {
+                index: d.index,
+                stamp_ns: m.stamp_ns,
+                mean,
+                state,
+                rviz,
+                sigma,
+            }
+        })
+        .collect();
+    TopicEvaluation {
+        name: topic.name.clone(),
+        frame_id: topic.frame_id.clone(),
+        planar: topic.planar,
+        position_dof: if topic.planar { 2 } else { 3 },
+        pose_dof: if topic.planar { 3 } else { 6 },
+        poses,
+        reading_difference,
+        trajectory: topic.trajectory.clone(),
+        series: topic.series.clone(),
+        sigma: std::array::from_fn(|axis| {
+            sigma_summary(topic.sigma_stats[axis], &topic.series, axis)
+        }),
+        consistency: None,
+        joined: None,
+    }
+}
+
+/// σ = √Σᵢᵢ per ROS axis of a message where the axis is estimated.
+fn message_sigma(d: &DrawnMessage) -> [Option<f64>; 6] {
+    std::array::from_fn(|i| {
+        let v = d.message.covariance[i * 7];
+        (v.is_finite() && v >= 0.0 && !d.unestimated[i]).then(|| v.sqrt())
+    })
+}
+
+/// The right-form Gaussian of a usable message. Planar: the unestimated z / roll / pitch rows
+/// and columns are dropped (they are placeholders or zero, not variances), the pose is
+/// projected to (x, y, yaw), and the one ROS conversion is applied at R = Rz(yaw); the
+/// (ρx, ρy, θz) block is SE(2)'s tangent. A placeholder (≥ 1e6, "not estimated") on an axis
+/// the motion uses — x, y or yaw when planar, any axis in 3-D — is no variance: such a message
+/// cannot be drawn as a Gaussian (RViz's clipped picture and a cross say it instead).
+pub(super) fn meaning(
+    mean: &Se3,
+    cov_ros: &Matrix6<f64>,
+    unestimated: &[bool; 6],
+    planar: bool,
+    reading: RosReading,
+) -> Result<PoseState, Vec<Issue>> {
+    let invalid = |_| vec![Issue::NotPsd];
+    match right_form(mean, cov_ros, unestimated, planar, reading)? {
+        RightForm::Planar(mean, cov) => UncertainPose::try_new(mean, cov, Side::Right)
+            .map(|pose| PoseState::Planar {
+                pose,
+                cloud: Vec::new(),
+            })
+            .map_err(invalid),
+        RightForm::Spatial(mean, cov) => UncertainPose::try_new(mean, cov, Side::Right)
+            .map(|pose| PoseState::Spatial {
+                pose: Box::new(pose),
+                cloud: Vec::new(),
+            })
+            .map_err(invalid),
+    }
+}
+
+/// A message's mean and right-form covariance, not validated yet.
+// Handed straight to its validation: boxing the 6 × 6 would allocate once per message.
+#[allow(clippy::large_enum_variant)]
+pub(super) enum RightForm {
+    /// (x, y, yaw).
+    Planar(Se2, Matrix3<f64>),
+    /// SE(3).
+    Spatial(Se3, Matrix6<f64>),
+}
+
+/// The conversion of [`meaning`], before Σ is validated (which the NEES does with the
+/// decomposition that also inverts it).
+pub(super) fn right_form(
+    mean: &Se3,
+    cov_ros: &Matrix6<f64>,
+    unestimated: &[bool; 6],
+    planar: bool,
+    reading: RosReading,
+) -> Result<RightForm, Vec<Issue>> {
+    let used: &[usize] = if planar {
+        &[0, 1, 5]
+    } else {
+        &[0, 1, 2, 3, 4, 5]
+    };
+    if used
+        .iter()
+        .any(|&i| unestimated[i] && cov_ros[(i, i)] != 0.0)
+    {
+        return Err(vec![Issue::PlaceholderUsedAxis]);
+    }
+    if !planar {
+        let right = ros_cov_to_right(cov_ros, mean.rotation(), reading);
+        return Ok(RightForm::Spatial(*mean, right));
+    }
+    let yaw = mean.rotation().to_rpy()[2];
+    let mut cov = *cov_ros;
+    for i in [2, 3, 4] {
+        cov.row_mut(i).fill(0.0);
+        cov.column_mut(i).fill(0.0);
+    }
+    let right = ros_cov_to_right(&cov, &So3::from_rpy(0.0, 0.0, yaw), reading);
+    let keep = [0, 1, 5];
+    let cov2 = Matrix3::from_fn(|r, c| right[(keep[r], keep[c])]);
+    let t = mean.translation();
+    let mean2 = Se2::from_parts(Vector2::new(t.x, t.y), So2::from_angle(yaw));
+    Ok(RightForm::Planar(mean2, cov2))
+}
+
+/// ‖Σ_tf2 − Σ_body‖_F / ‖Σ_tf2‖_F of one message's right-form covariances (0 for Σ = 0).
+fn readings_apart(mean: &Se3, cov_ros: &Matrix6<f64>) -> f64 {
+    let tf2 = ros_cov_to_right(cov_ros, mean.rotation(), RosReading::Tf2);
+    let body = ros_cov_to_right(cov_ros, mean.rotation(), RosReading::Body);
+    let scale = tf2.norm();
+    if scale > 0.0 {
+        (tf2 - body).norm() / scale
+    } else {
+        0.0
+    }
+}
+
+fn with_cloud(state: PoseState, settings: &LogEvalSettings, family: u64, index: u64) -> PoseState {
+    let mut rng = chunk_rng(settings.seed, family, index);
+    let n = settings.cloud_samples;
+    match state {
+        PoseState::Planar { pose, .. } => match Sampler::new(&pose) {
+            Ok(s) => PoseState::Planar {
+                cloud: s.draw_many(&mut rng, n),
+                pose,
+            },
+            Err(_) => PoseState::Invalid {
+                issues: vec![Issue::NonFinite],
+            },
+        },
+        PoseState::Spatial { pose, .. } => match Sampler::new(&pose) {
+            Ok(s) => PoseState::Spatial {
+                cloud: s.draw_many(&mut rng, n),
+                pose,
+            },
+            Err(_) => PoseState::Invalid {
+                issues: vec![Issue::NonFinite],
+            },
+        },
+        invalid => invalid,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::interop::RosPoseWithCovariance;
+    use crate::lie::LieGroup;
+
+    #[test]
+    fn planar_meaning_is_the_ros_conversion_restricted_to_the_plane() {
+        let yaw: f64 = 0.7;
+        let mean = Se3::from_xyz_rpy([1.0, 2.0, 0.0], [0.0, 0.0, yaw]);
+        let mut cov = Matrix6::zeros();
+        cov[(0, 0)] = 0.04;
+        cov[(1, 1)] = 0.01;
+        cov[(0, 1)] = 0.005;
+        cov[(1, 0)] = 0.005;
+        cov[(5, 5)] = 0.02;
+        let mut with_placeholders = cov;
+        for i in [2, 3, 4] {
+            with_placeholders[(i, i)] = 1e6;
+        }
+        let un = [false, false, true, true, true, false];
+        let PoseState::Planar { pose, .. } =
+            meaning(&mean, &with_placeholders, &un, true, RosReading::Tf2).unwrap()
+        else {
+            panic!()
+        };
+        // The same numbers through the one public conversion of a full message.
+        let mut full = cov;
+        for i in [2, 3, 4] {
+            full[(i, i)] = 1.0;
+        }
+        let msg = RosPoseWithCovariance {
+            position: [1.0, 2.0, 0.0],
+            orientation_xyzw: mean.rotation().to_quaternion_xyzw(),
+            covariance: full.transpose().iter().copied().collect(),
+        };
+        let right = msg.try_to_uncertain(RosReading::Tf2).unwrap().cov_right();
+        let keep = [0, 1, 5];
+        for r in 0..3 {
+            for c in 0..3 {
+                assert!((pose.cov()[(r, c)] - right[(keep[r], keep[c])]).abs() < 1e-15);
+            }
+        }
+        // Body x is the parent's direction at yaw: its variance mixes parent x and y.
+        let (s, c) = yaw.sin_cos();
+        let expect = c * c * 0.04 + s * s * 0.01 + 2.0 * s * c * 0.005;
+        assert!((pose.cov()[(0, 0)] - expect).abs() < 1e-15);
+        assert!((pose.mean().rotation().angle() - yaw).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_placeholder_on_a_planar_axis_in_use_is_not_drawn() {
+        // σ² = 4.5e153 on x: no variance (and its banana would overflow the viewer's f32).
+        let mut cov = Matrix6::identity() * 0.01;
+        cov[(0, 0)] = 4.5e153;
+        let un = [true, false, true, true, true, false];
+        assert_eq!(
+            meaning(&Se3::identity(), &cov, &un, true, RosReading::Tf2).unwrap_err(),
+            vec![Issue::PlaceholderUsedAxis]
+        );
+    }
+
+    #[test]
+    fn a_placeholder_in_3d_is_not_drawn() {
+        let mean = Se3::identity();
+        let mut cov = Matrix6::identity() * 0.01;
+        cov[(3, 3)] = 1.79e308;
+        let mut un = [false; 6];
+        un[3] = true;
+        assert_eq!(
+            meaning(&mean, &cov, &un, false, RosReading::Tf2).unwrap_err(),
+            vec![Issue::PlaceholderUsedAxis]
+        );
+    }
+}

@@ -1,0 +1,225 @@
+//! One topic's streaming state: every message of a pose topic passes through
+//! [`TopicState::add`] (stamps, health, constancy, σ statistics, decimated drawn messages and
+//! series); [`TopicState::into_plan`] reduces it to a [`TopicSummary`]. Memory is bounded by the
+//! decimators, whatever the log's length.
+
+use crate::plan::log::{
+    Decimator, DrawnMessage, Issue, IssueCount, PoseMessage, PoseMessageKind, SeriesPoint,
+    TopicSummary, is_odom_frame,
+};
+
+use super::decode::{DecodeError, Decoded};
+use super::health::TopicHealth;
+use super::{DEFAULT_MAX_DRAWN, MAX_DRAWN_LIMIT, MAX_SERIES};
+
+/// A message [`TopicState::add`] took: what an observer of every message needs.
+pub(super) struct Added {
+    pub(super) index: u64,
+    pub(super) stamp_ns: i64,
+    pub(super) usable: bool,
+    pub(super) unestimated: [bool; 6],
+    pub(super) decoded: Decoded,
+}
+
+/// The per-topic streaming state.
+pub(super) struct TopicState {
+    pub(super) kind: PoseMessageKind,
+    frame_id: Option<String>,
+    child_frame_id: Option<String>,
+    count: u64,
+    from_log: u64,
+    out_of_order: u64,
+    last_stamp: Option<i64>,
+    range: Option<(i64, i64)>,
+    /// Health classes and σ statistics.
+    pub(super) checks: TopicHealth,
+    drawn: Decimator<DrawnMessage>,
+    trajectory: Decimator<(i64, [f64; 3])>,
+    /// The series, with each axis's variance in place of its σ: the square roots are taken
+    /// for the points kept only ([`Self::into_plan`]).
+    series: Decimator<SeriesPoint>,
+}
+
+impl TopicState {
+    pub(super) fn new(kind: PoseMessageKind, every: Option<u64>) -> Self {
+        TopicState {
+            kind,
+            frame_id: None,
+            child_frame_id: None,
+            count: 0,
+            from_log: 0,
+            out_of_order: 0,
+            last_stamp: None,
+            range: None,
+            checks: TopicHealth::default(),
+            drawn: match every {
+                Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
+                None => Decimator::new(1, DEFAULT_MAX_DRAWN),
+            },
+            trajectory: Decimator::new(1, MAX_SERIES),
+            series: Decimator::new(1, MAX_SERIES),
+        }
+    }
+
+    /// Takes the next message (`None` back when it could not be decoded).
+    pub(super) fn add(
+        &mut self,
+        decoded: Result<Decoded, DecodeError>,
+        log_time_ns: i64,
+    ) -> Option<Added> {
+        let index = self.count;
+        self.count += 1;
+        let d = match decoded {
+            Ok(d) => d,
+            Err(_) => {
+                self.checks
+                    .health
+                    .note(Issue::Undecodable, log_time_ns, index);
+                return None;
+            }
+        };
+        let (stamp_ns, from_log_time) = match d.stamp_ns {
+            Some(s) => (s, false),
+            None => (log_time_ns, true),
+        };
+        let headed = self.kind != PoseMessageKind::PoseWithCovariance;
+        if from_log_time && headed {
+            self.from_log += 1;
+            self.checks
+                .health
+                .note(Issue::StampFallback, stamp_ns, index);
+        }
+        if self.last_stamp.is_some_and(|last| stamp_ns < last) {
+            self.out_of_order += 1;
+            self.checks.health.note(Issue::StampOrder, stamp_ns, index);
+        }
+        if headed && !from_log_time && self.last_stamp == Some(stamp_ns) {
+            self.checks.health.note(Issue::FrozenStamp, stamp_ns, index);
+        }
+        self.last_stamp = Some(stamp_ns);
+        self.range = Some(match self.range {
+            Some((a, b)) => (a.min(stamp_ns), b.max(stamp_ns)),
+            None => (stamp_ns, stamp_ns),
+        });
+        if self.frame_id.is_none() && !d.frame_id.is_empty() {
+            self.frame_id = Some(d.frame_id.clone());
+        }
+        if self.child_frame_id.is_none() && !d.child_frame_id.is_empty() {
+            self.child_frame_id = Some(d.child_frame_id.clone());
+        }
+        let dead_reckoned = self.kind == PoseMessageKind::Odometry
+            && self.frame_id.as_deref().is_some_and(is_odom_frame);
+        let (h, variance) = self.checks.add(index, stamp_ns, &d, dead_reckoned);
+        let usable = h.usable();
+        if usable && d.position.iter().all(|v| v.is_finite()) {
+            self.trajectory.push(index, (stamp_ns, d.position));
+        }
+        self.series.push(
+            index,
+            SeriesPoint {
+                stamp_ns,
+                sigma: variance,
+                position_trace: h.position_trace,
+            },
+        );
+        if self.drawn.wants(index) {
+            let unusable = h.issues.iter().filter(|i| i.unusable()).collect();
+            self.drawn.push(
+                index,
+                DrawnMessage {
+                    index,
+                    message: PoseMessage {
+                        stamp_ns,
+                        from_log_time,
+                        position: d.position,
+                        orientation_xyzw: d.orientation_xyzw,
+                        covariance: d.covariance,
+                        twist_covariance: d.twist_covariance,
+                    },
+                    unusable,
+                    unestimated: h.unestimated,
+                },
+            );
+        }
+        Some(Added {
+            index,
+            stamp_ns,
+            usable,
+            unestimated: h.unestimated,
+            decoded: d,
+        })
+    }
+
+    /// A message of another type on this topic (`type_name`, logged at `log_time_ns`): not
+    /// read, counted as a [`Issue::TypeChange`] after the messages read so far.
+    pub(super) fn other_type(&mut self, type_name: &str, log_time_ns: i64) {
+        let health = &mut self.checks.health;
+        if !health.other_types.iter().any(|t| t == type_name) {
+            health.other_types.push(type_name.to_owned());
+        }
+        health.note(Issue::TypeChange, log_time_ns, self.count);
+    }
+
+    /// `count` messages of another type (`type_name`, the first logged at `first_log_ns`)
+    /// seen on this topic before it was known as a pose topic.
+    pub(super) fn other_type_before(&mut self, type_name: String, count: u64, first_log_ns: i64) {
+        if count == 0 {
+            return;
+        }
+        let health = &mut self.checks.health;
+        health.other_types.push(type_name);
+        let first = IssueCount {
+            count,
+            first_stamp_ns: first_log_ns,
+            first_index: 0,
+        };
+        health.add(Issue::TypeChange, first);
+    }
+
+    pub(super) fn into_plan(self, name: String) -> TopicSummary {
+        let stride = self.drawn.stride();
+        let mut trajectory = self.trajectory.into_items();
+        trajectory.sort_by_key(|p| p.0);
+        let mut series = self.series.into_items();
+        for p in &mut series {
+            p.sigma = p.sigma.map(|v| v.map(f64::sqrt));
+        }
+        series.sort_by_key(|p| p.stamp_ns);
+        let checks = self.checks;
+        let sigma_stats = checks.sigma_stats();
+        let planar = checks.planar && checks.usable > 0;
+        let (mut health, constant) = checks.into_findings();
+        if !planar && let Some(on_used_axes) = health.issues.remove(&Issue::Placeholder) {
+            // z, roll and pitch are axes a 3-D topic uses.
+            health.add(Issue::PlaceholderUsedAxis, on_used_axes);
+        }
+        if let Some(stretch) = constant {
+            health.add(
+                Issue::Constant,
+                IssueCount {
+                    count: stretch.messages,
+                    first_stamp_ns: stretch.first_stamp_ns,
+                    first_index: stretch.first_index,
+                },
+            );
+            health.constant = Some(stretch);
+        }
+        TopicSummary {
+            name,
+            kind: self.kind,
+            frame_id: self.frame_id.unwrap_or_default(),
+            child_frame_id: self.child_frame_id.unwrap_or_default(),
+            count: self.count,
+            stamps_from_log_time: self.from_log,
+            stamps_out_of_order: self.out_of_order,
+            stamp_range: self.range,
+            health,
+            planar,
+            drawn: self.drawn.into_items(),
+            stride,
+            trajectory,
+            series,
+            sigma_stats,
+        }
+    }
+}

@@ -1,0 +1,597 @@
+//! The typed plan of a robot log (ROS 1 bag or ROS 2 MCAP): what `input::log` read, reduced
+//! to bounded plain data — per topic its messages' facts, its covariance health, a decimated
+//! set of messages to draw and bounded time series. Evaluation (`eval::log`) turns it into
+//! numbers; nothing here reads a file.
+//!
+//! ```
+//! use posecov::plan::log::{LogSummary, Health, Issue};
+//! let mut health = Health::default();
+//! health.note(Issue::Placeholder, 1_500_000_000, 0);
+//! health.note(Issue::Placeholder, 1_000_000_000, 1);
+//! assert_eq!(health.count(Issue::Placeholder), 2);
+//! assert_eq!(health.first(Issue::Placeholder), Some(1_000_000_000));
+//! assert!(LogSummary::default().topics.is_empty());
+//! ```
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+mod decimate;
+mod reference;
+pub use decimate::Decimator;
+pub use reference::{EstimateMessage, LogObserver, ReferenceInLog, ReferenceRead, ReferenceSample};
+mod cut;
+pub use cut::LogCut;
+mod tf;
+pub use tf::{MAX_TF_EDGES, MAX_TF_SAMPLES, TfEdge, TfTree};
+
+/// A variance at or above this is a placeholder ("not estimated"), not a measurement.
+pub const PLACEHOLDER: f64 = 1e6;
+
+/// Default number of messages drawn per topic (at most; evenly spaced).
+pub const DEFAULT_MAX_DRAWN: usize = 200;
+/// However `--every` is set, at most this many messages per topic are drawn (the stride is
+/// doubled beyond, and the text panel says so).
+pub const MAX_DRAWN_LIMIT: usize = 5000;
+
+/// Number of entries of a ROS 6 × 6 covariance (row-major).
+pub const COV_LEN: usize = 36;
+
+/// Names of the six ROS covariance axes, in order (position in the parent frame's axes,
+/// rotation about the body's axes).
+pub const ROS_AXES: [&str; 6] = ["x", "y", "z", "roll", "pitch", "yaw"];
+
+/// The message types posecov reads a pose with covariance from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseMessageKind {
+    /// `nav_msgs/Odometry` (pose part; the twist covariance is kept too).
+    Odometry,
+    /// `geometry_msgs/PoseWithCovarianceStamped`.
+    PoseWithCovarianceStamped,
+    /// `geometry_msgs/PoseWithCovariance` (no header: stamps are the log time).
+    PoseWithCovariance,
+}
+
+impl PoseMessageKind {
+    /// The ROS 1 type name (`nav_msgs/Odometry`).
+    ///
+    /// ```
+    /// use posecov::plan::log::PoseMessageKind;
+    /// assert_eq!(PoseMessageKind::Odometry.ros1_name(), "nav_msgs/Odometry");
+    /// ```
+    pub fn ros1_name(self) -> &'static str {
+        match self {
+            PoseMessageKind::Odometry => "nav_msgs/Odometry",
+            PoseMessageKind::PoseWithCovarianceStamped => "geometry_msgs/PoseWithCovarianceStamped",
+            PoseMessageKind::PoseWithCovariance => "geometry_msgs/PoseWithCovariance",
+        }
+    }
+
+    /// The ROS 2 type name (`nav_msgs/msg/Odometry`).
+    ///
+    /// ```
+    /// use posecov::plan::log::PoseMessageKind;
+    /// assert_eq!(PoseMessageKind::PoseWithCovariance.ros2_name(), "geometry_msgs/msg/PoseWithCovariance");
+    /// ```
+    pub fn ros2_name(self) -> &'static str {
+        match self {
+            PoseMessageKind::Odometry => "nav_msgs/msg/Odometry",
+            PoseMessageKind::PoseWithCovarianceStamped => {
+                "geometry_msgs/msg/PoseWithCovarianceStamped"
+            }
+            PoseMessageKind::PoseWithCovariance => "geometry_msgs/msg/PoseWithCovariance",
+        }
+    }
+
+    /// Every kind.
+    pub const ALL: [PoseMessageKind; 3] = [
+        PoseMessageKind::Odometry,
+        PoseMessageKind::PoseWithCovarianceStamped,
+        PoseMessageKind::PoseWithCovariance,
+    ];
+}
+
+/// A decoded pose with covariance, in ROS's own layout and meaning
+/// ([CONVENTIONS §6](crate::conventions#6-ros-posewithcovariance)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseMessage {
+    /// When: the header stamp, or the log time when the header has none (see `from_log_time`),
+    /// nanoseconds since the epoch (or since the simulation's start).
+    pub stamp_ns: i64,
+    /// The header stamp was zero or missing and the log (receive) time is used instead.
+    pub from_log_time: bool,
+    /// `pose.position` (x, y, z) in the parent frame.
+    pub position: [f64; 3],
+    /// `pose.orientation` (x, y, z, w).
+    pub orientation_xyzw: [f64; 4],
+    /// `pose.covariance`, row-major (x, y, z, rotX, rotY, rotZ).
+    pub covariance: [f64; COV_LEN],
+    /// `twist.covariance` of an Odometry message (body frame), if any.
+    pub twist_covariance: Option<[f64; COV_LEN]>,
+}
+
+/// Whether a health finding makes a log's covariance untrustworthy (`posecov check` fails on
+/// it unless `--allow`ed) or is worth knowing only. Defects sort first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Class {
+    /// The covariance cannot be trusted as published.
+    Defect,
+    /// A fact about the covariance or the stamps, not an error.
+    Note,
+}
+
+/// A health finding: of a topic's covariance and stamps (a message can have several), or of
+/// the log's `/tf` tree (the `Tf…` kinds, found when frames are joined:
+/// [`crate::eval::log::frames::FrameProblemKind`]). This is the one table of findings: its
+/// `--allow` name and JSON word is [`Issue::name`], its class [`Issue::class`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Issue {
+    /// An entry is NaN or ±∞.
+    NonFinite,
+    /// Σ ≠ Σᵀ beyond the tolerance.
+    Asymmetric,
+    /// The smallest eigenvalue (over the estimated axes) is below −tolerance.
+    NotPsd,
+    /// The bytes could not be decoded as the message type (truncated or another definition).
+    Undecodable,
+    /// The orientation is not a unit quaternion (or not finite).
+    BadOrientation,
+    /// `covariance[0] = -1`: ROS's marker for "this covariance is unknown".
+    UnknownMarker,
+    /// Every entry is 0 on the estimated axes (placeholder axes aside): the publisher does not
+    /// know, or never filled it in.
+    AllZero,
+    /// A variance ≥ 1e6 on an axis the motion uses (x, y, yaw; all six on a 3-D topic).
+    PlaceholderUsedAxis,
+    /// The covariance stays identical (or, dead-reckoned, does not grow) while the pose moves.
+    Constant,
+    /// The same header stamp on consecutive messages.
+    FrozenStamp,
+    /// Messages of another type on the topic (another publisher, a changed definition): not
+    /// read; the types are [`Health::other_types`].
+    TypeChange,
+    /// The log's `/tf` has a chain of parents that comes back to itself: nothing is joined
+    /// through it.
+    TfCycle,
+    /// The log's `/tf` gives a child frame several parents, where tf allows one: nothing is
+    /// joined through that frame.
+    TfSeveralParents,
+    /// A variance ≥ 1e6 on an axis planar motion does not use (z, roll, pitch): "not
+    /// estimated".
+    Placeholder,
+    /// A zero header stamp, replaced by the log time.
+    StampFallback,
+    /// A stamp earlier than the message before.
+    StampOrder,
+    /// The position trace divided by ≥ 5 from one usable message to the next: a
+    /// relocalisation, a loop closure or a reset.
+    Drop,
+    /// The position trace ≥ 100 × its smallest value since the last drop: dead reckoning
+    /// without correction.
+    Growth,
+    /// Topics' frames are in `/tf`, but in trees no transform joins: drawn apart.
+    TfMissingLink,
+    /// A topic's frame never gets a transform in `/tf` or `/tf_static`: drawn apart.
+    TfNoTransform,
+    /// A planar topic whose transform tilts its plane: drawn apart.
+    TfTiltsPlane,
+}
+
+impl Issue {
+    /// Every finding, defects first.
+    pub const ALL: [Issue; 21] = [
+        Issue::NonFinite,
+        Issue::Asymmetric,
+        Issue::NotPsd,
+        Issue::Undecodable,
+        Issue::BadOrientation,
+        Issue::UnknownMarker,
+        Issue::AllZero,
+        Issue::PlaceholderUsedAxis,
+        Issue::Constant,
+        Issue::FrozenStamp,
+        Issue::TypeChange,
+        Issue::TfCycle,
+        Issue::TfSeveralParents,
+        Issue::Placeholder,
+        Issue::StampFallback,
+        Issue::StampOrder,
+        Issue::Drop,
+        Issue::Growth,
+        Issue::TfMissingLink,
+        Issue::TfNoTransform,
+        Issue::TfTiltsPlane,
+    ];
+
+    /// The `--allow` name and JSON key.
+    ///
+    /// ```
+    /// use posecov::plan::log::Issue;
+    /// assert_eq!(Issue::PlaceholderUsedAxis.name(), "placeholder_used_axis");
+    /// assert_eq!(Issue::from_name("not_psd"), Some(Issue::NotPsd));
+    /// ```
+    pub fn name(self) -> &'static str {
+        match self {
+            Issue::NonFinite => "non_finite",
+            Issue::Asymmetric => "asymmetric",
+            Issue::NotPsd => "not_psd",
+            Issue::Undecodable => "undecodable",
+            Issue::BadOrientation => "bad_orientation",
+            Issue::UnknownMarker => "unknown_marker",
+            Issue::AllZero => "all_zero",
+            Issue::PlaceholderUsedAxis => "placeholder_used_axis",
+            Issue::Constant => "constant",
+            Issue::FrozenStamp => "frozen_stamp",
+            Issue::TypeChange => "type_change",
+            Issue::TfCycle => "tf_cycle",
+            Issue::TfSeveralParents => "tf_several_parents",
+            Issue::Placeholder => "placeholder",
+            Issue::StampFallback => "stamp_fallback",
+            Issue::StampOrder => "stamp_order",
+            Issue::Drop => "drop",
+            Issue::Growth => "growth",
+            Issue::TfMissingLink => "tf_missing_link",
+            Issue::TfNoTransform => "tf_no_transform",
+            Issue::TfTiltsPlane => "tf_tilts_plane",
+        }
+    }
+
+    /// The finding of an `--allow` name, if any.
+    pub fn from_name(name: &str) -> Option<Issue> {
+        Issue::ALL.into_iter().find(|i| i.name() == name)
+    }
+
+    /// Defect or note; `constant` is a defect on a dead-reckoned topic (its covariance must
+    /// grow) and a note elsewhere.
+    ///
+    /// ```
+    /// use posecov::plan::log::{Class, Issue};
+    /// assert_eq!(Issue::Constant.class(true), Class::Defect);
+    /// assert_eq!(Issue::Constant.class(false), Class::Note);
+    /// assert_eq!(Issue::Placeholder.class(true), Class::Note);
+    /// assert_eq!(Issue::TfCycle.class(false), Class::Defect);
+    /// ```
+    pub fn class(self, dead_reckoned: bool) -> Class {
+        match self {
+            Issue::Constant if !dead_reckoned => Class::Note,
+            Issue::Placeholder
+            | Issue::StampFallback
+            | Issue::StampOrder
+            | Issue::Drop
+            | Issue::Growth
+            | Issue::TfMissingLink
+            | Issue::TfNoTransform
+            | Issue::TfTiltsPlane => Class::Note,
+            _ => Class::Defect,
+        }
+    }
+
+    /// Whether a message with this issue cannot be drawn as a Gaussian (it is drawn as an
+    /// invalid marker instead). Placeholders, stamps, drops, growth and constancy are facts
+    /// about a drawable covariance.
+    ///
+    /// ```
+    /// use posecov::plan::log::Issue;
+    /// assert!(Issue::NotPsd.unusable() && !Issue::Placeholder.unusable());
+    /// ```
+    pub const fn unusable(self) -> bool {
+        matches!(
+            self,
+            Issue::NonFinite
+                | Issue::Asymmetric
+                | Issue::NotPsd
+                | Issue::Undecodable
+                | Issue::BadOrientation
+                | Issue::UnknownMarker
+                | Issue::AllZero
+        )
+    }
+}
+
+/// How often an issue was seen, and where first.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct IssueCount {
+    /// Messages with the issue.
+    pub count: u64,
+    /// Stamp (ns) of the earliest such message.
+    pub first_stamp_ns: i64,
+    /// That message's number on its topic (0-based).
+    pub first_index: u64,
+}
+
+/// The longest stretch of messages over which a topic's covariance stayed identical (or, on a
+/// dead-reckoned topic, did not grow) while the pose moved.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Stretch {
+    /// Messages in it.
+    pub messages: u64,
+    /// The first one's number on the topic.
+    pub first_index: u64,
+    /// Its first stamp, ns.
+    pub first_stamp_ns: i64,
+    /// Its last stamp, ns.
+    pub last_stamp_ns: i64,
+    /// The distance the position travelled over it, m (sum of the steps).
+    pub distance_m: f64,
+}
+
+/// A topic's covariance health: per issue, the count and first stamp; the worst smallest
+/// eigenvalue of a not-PSD covariance; the longest constant stretch.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct Health {
+    /// Per issue.
+    pub issues: BTreeMap<Issue, IssueCount>,
+    /// The most negative smallest eigenvalue seen (only when some message is not PSD).
+    pub min_eigenvalue: Option<f64>,
+    /// The longest stretch without growth while moving (when it makes a `constant` finding).
+    pub constant: Option<Stretch>,
+    /// The other message types seen on the topic (a `type_change` finding), in order seen.
+    pub other_types: Vec<String>,
+}
+
+impl Health {
+    /// Counts message number `index` with `issue` at `stamp_ns`.
+    pub fn note(&mut self, issue: Issue, stamp_ns: i64, index: u64) {
+        self.add(
+            issue,
+            IssueCount {
+                count: 1,
+                first_stamp_ns: stamp_ns,
+                first_index: index,
+            },
+        );
+    }
+
+    /// Adds `counted` messages with `issue` (the earliest stamp is kept as the first).
+    pub fn add(&mut self, issue: Issue, counted: IssueCount) {
+        let entry = self.issues.entry(issue).or_insert(IssueCount {
+            count: 0,
+            ..counted
+        });
+        entry.count += counted.count;
+        if counted.first_stamp_ns < entry.first_stamp_ns {
+            entry.first_stamp_ns = counted.first_stamp_ns;
+            entry.first_index = counted.first_index;
+        }
+    }
+
+    /// Messages with `issue`.
+    pub fn count(&self, issue: Issue) -> u64 {
+        self.issues.get(&issue).map_or(0, |c| c.count)
+    }
+
+    /// Stamp of the first message with `issue`.
+    pub fn first(&self, issue: Issue) -> Option<i64> {
+        self.issues.get(&issue).map(|c| c.first_stamp_ns)
+    }
+}
+
+/// One point of a topic's time series: σ of each ROS axis (NaN-free: `None` where the axis is
+/// a placeholder, unknown or the message unusable) and the position trace.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeriesPoint {
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// √Σᵢᵢ per ROS axis (x, y, z in the parent's axes; roll, pitch, yaw), where meaningful.
+    pub sigma: [Option<f64>; 6],
+    /// Trace of the estimated position block (m²).
+    pub position_trace: Option<f64>,
+}
+
+/// Statistics of one axis's σ, streamed over every message where the axis is estimated (a
+/// usable message, the axis neither a placeholder nor zero): memory does not grow with the
+/// log. The median needs the values, so it is taken over the kept series in `eval::log`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AxisStats {
+    /// Messages counted.
+    pub messages: u64,
+    /// σ of the first such message (in file order).
+    pub first: f64,
+    /// σ of the last.
+    pub last: f64,
+    /// Smallest σ.
+    pub min: f64,
+    /// Largest σ.
+    pub max: f64,
+}
+
+impl AxisStats {
+    /// Adds the next message's σ to `stats` (starting them with the first).
+    ///
+    /// ```
+    /// use posecov::plan::log::AxisStats;
+    /// let mut s = None;
+    /// for sigma in [0.2, 0.1, 0.3] {
+    ///     AxisStats::add(&mut s, sigma);
+    /// }
+    /// let s = s.unwrap();
+    /// assert_eq!((s.messages, s.first, s.last, s.min, s.max), (3, 0.2, 0.3, 0.1, 0.3));
+    /// ```
+    pub fn add(stats: &mut Option<AxisStats>, sigma: f64) {
+        match stats {
+            Some(s) => {
+                s.messages += 1;
+                s.last = sigma;
+                s.min = s.min.min(sigma);
+                s.max = s.max.max(sigma);
+            }
+            None => {
+                *stats = Some(AxisStats {
+                    messages: 1,
+                    first: sigma,
+                    last: sigma,
+                    min: sigma,
+                    max: sigma,
+                })
+            }
+        }
+    }
+
+    /// The statistics of the square roots (statistics kept over variances, σ²: `√` keeps
+    /// their order, so the smallest and largest root are the roots of the smallest and
+    /// largest, to the bit).
+    ///
+    /// ```
+    /// use posecov::plan::log::AxisStats;
+    /// let mut s = None;
+    /// for variance in [0.25, 0.0625, 0.5625] {
+    ///     AxisStats::add(&mut s, variance);
+    /// }
+    /// let s = s.unwrap().sqrt();
+    /// assert_eq!((s.first, s.last, s.min, s.max), (0.5, 0.75, 0.25, 0.75));
+    /// ```
+    pub fn sqrt(self) -> AxisStats {
+        AxisStats {
+            messages: self.messages,
+            first: self.first.sqrt(),
+            last: self.last.sqrt(),
+            min: self.min.sqrt(),
+            max: self.max.sqrt(),
+        }
+    }
+}
+
+/// A message kept for drawing: its number on the topic (0-based), the message, and whether
+/// it can be drawn as a Gaussian (else the issues that prevent it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DrawnMessage {
+    /// Index among the topic's messages.
+    pub index: u64,
+    /// The message.
+    pub message: PoseMessage,
+    /// Issues that make it unusable (empty: usable).
+    pub unusable: Vec<Issue>,
+    /// Axes whose variance is a placeholder (≥ 1e6) or exactly zero, per ROS axis.
+    pub unestimated: [bool; 6],
+}
+
+/// What a topic's messages were, reduced to bounded data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicSummary {
+    /// Topic name as in the log.
+    pub name: String,
+    /// Message type.
+    pub kind: PoseMessageKind,
+    /// `header.frame_id` of the first message (the parent frame), if any.
+    pub frame_id: String,
+    /// `child_frame_id` of the first Odometry message, if any.
+    pub child_frame_id: String,
+    /// Messages read.
+    pub count: u64,
+    /// Messages whose header stamp was missing or zero (log time used).
+    pub stamps_from_log_time: u64,
+    /// Messages whose stamp is earlier than the one before (kept; series are sorted).
+    pub stamps_out_of_order: u64,
+    /// Earliest and latest stamp (ns), if any message.
+    pub stamp_range: Option<(i64, i64)>,
+    /// Covariance health.
+    pub health: Health,
+    /// Every usable message has z, roll and pitch unestimated (zero or placeholder): the
+    /// topic is drawn in the x–y plane as SE(2).
+    pub planar: bool,
+    /// Messages kept for drawing (at most the configured count; evenly spaced by `stride`).
+    pub drawn: Vec<DrawnMessage>,
+    /// One kept message in `stride`.
+    pub stride: u64,
+    /// Positions along the trajectory (bounded, in stamp order), with their stamps.
+    pub trajectory: Vec<(i64, [f64; 3])>,
+    /// Time series (bounded, in stamp order).
+    pub series: Vec<SeriesPoint>,
+    /// σ statistics per ROS axis (x, y, z, roll, pitch, yaw) over every message where the
+    /// axis is estimated; `None` where it never is.
+    pub sigma_stats: [Option<AxisStats>; 6],
+}
+
+/// Whether `frame_id` names an odometry frame as REP 105 does (`odom`, or a namespaced
+/// `robot1/odom`, `odom_combined`): poses in it are dead-reckoned, so their covariance grows.
+///
+/// ```
+/// use posecov::plan::log::is_odom_frame;
+/// assert!(is_odom_frame("odom") && is_odom_frame("/robot1/odom") && !is_odom_frame("map"));
+/// ```
+pub fn is_odom_frame(frame_id: &str) -> bool {
+    frame_id
+        .rsplit('/')
+        .next()
+        .is_some_and(|last| last.starts_with("odom"))
+}
+
+impl TopicSummary {
+    /// An Odometry topic in an odometry frame ([`is_odom_frame`]): dead reckoning, whose
+    /// covariance must grow while the robot moves.
+    pub fn dead_reckoned(&self) -> bool {
+        self.kind == PoseMessageKind::Odometry && is_odom_frame(&self.frame_id)
+    }
+
+    /// The class of `issue` on this topic ([`Issue::class`]).
+    pub fn class(&self, issue: Issue) -> Class {
+        issue.class(self.dead_reckoned())
+    }
+
+    /// The defects found, with their counts, in the order of [`Issue::ALL`].
+    pub fn defects(&self) -> impl Iterator<Item = (Issue, IssueCount)> + '_ {
+        self.health
+            .issues
+            .iter()
+            .filter(|(i, _)| self.class(**i) == Class::Defect)
+            .map(|(i, c)| (*i, *c))
+    }
+
+    /// √ of the twist covariance's diagonal (vx vy vz ωx ωy ωz, in the child frame) of the last
+    /// drawn Odometry message, where finite and not a placeholder (`None` per entry otherwise;
+    /// `None` for other types).
+    ///
+    /// ```
+    /// use posecov::input::log::{LogOptions, read_log};
+    /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
+    /// let plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+    /// let sigma = plan.topics[0].twist_sigmas().unwrap();
+    /// assert!((sigma[0].unwrap() - 0.001f64.sqrt()).abs() < 1e-12);
+    /// assert_eq!(sigma[3], None); // a 1e6 placeholder
+    /// ```
+    pub fn twist_sigmas(&self) -> Option<[Option<f64>; 6]> {
+        let twist = self.drawn.last()?.message.twist_covariance?;
+        Some(std::array::from_fn(|i| {
+            let v = twist[i * 7];
+            (v.is_finite() && (0.0..PLACEHOLDER).contains(&v)).then(|| v.sqrt())
+        }))
+    }
+}
+
+/// A topic of another message type, skipped.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SkippedTopic {
+    /// Topic name.
+    pub name: String,
+    /// Its message type (and why it was skipped, when not simply another type).
+    pub message_type: String,
+    /// Messages on it.
+    pub count: u64,
+}
+
+/// A whole log, reduced: the pose topics and what was skipped.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LogSummary {
+    /// The pose-with-covariance topics read (filtered by `--topic`), in name order.
+    pub topics: Vec<TopicSummary>,
+    /// Other topics, in name order.
+    pub skipped: Vec<SkippedTopic>,
+    /// Pose topics present but not asked for with `--topic`.
+    pub not_selected: Vec<String>,
+    /// Messages in the whole log.
+    pub messages_total: u64,
+    /// The read stopped early (Ctrl-C): everything before was read.
+    pub cancelled: bool,
+    /// What the reader saw of the reference asked for in the log (`--reference`), if any.
+    pub reference: Option<ReferenceRead>,
+    /// The read stopped at a cut or a damage before the file's end: everything before was
+    /// read.
+    pub cut: Option<LogCut>,
+    /// The log's `/tf` and `/tf_static` transforms, bounded ([`TfTree`]): what joins topics
+    /// in different frames (`eval::log::frames`).
+    pub tf: TfTree,
+}

@@ -1,0 +1,76 @@
+//! Bounded, even thinning of a log's per-message series: the drawn messages and series the
+//! reader keeps (`input::log`), and the NEES series kept at the same messages (`eval::log::nees`).
+
+/// Keeps items at indices that are multiples of `stride`; when more than `cap` are kept, the
+/// stride doubles and every other one is dropped. Memory stays bounded by `cap`.
+///
+/// ```
+/// use posecov::plan::log::Decimator;
+/// let mut d = Decimator::new(1, 4);
+/// for i in 0..10u64 {
+///     if d.wants(i) {
+///         d.push(i, i * 10);
+///     }
+/// }
+/// assert_eq!(d.stride(), 4);
+/// assert_eq!(d.into_items(), [0, 40, 80]);
+/// ```
+#[derive(Debug, Clone)]
+pub struct Decimator<T> {
+    items: Vec<(u64, T)>,
+    stride: u64,
+    cap: usize,
+}
+
+impl<T> Decimator<T> {
+    /// Keeps every `stride`-th index, at most `cap` items (see the type's example).
+    pub fn new(stride: u64, cap: usize) -> Self {
+        Self {
+            items: Vec::new(),
+            stride: stride.max(1),
+            cap: cap.max(1),
+        }
+    }
+    /// The current stride: every `stride`-th index is kept.
+    pub fn stride(&self) -> u64 {
+        self.stride
+    }
+    /// Whether item `index` would be kept now.
+    pub fn wants(&self, index: u64) -> bool {
+        index.is_multiple_of(self.stride)
+    }
+    /// Keeps item `index` if [`wants`](Self::wants) it (indices in increasing order).
+    pub fn push(&mut self, index: u64, item: T) {
+        if !self.wants(index) {
+            return;
+        }
+        self.items.push((index, item));
+        while self.items.len() > self.cap {
+            self.stride *= 2;
+            let stride = self.stride;
+            self.items.retain(|(i, _)| i.is_multiple_of(stride));
+        }
+    }
+    /// The kept items, in the order pushed.
+    pub fn into_items(self) -> Vec<T> {
+        self.items.into_iter().map(|(_, t)| t).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimation_is_bounded_and_even() {
+        let mut d = Decimator::new(1, 200);
+        for i in 0..100_000u64 {
+            d.push(i, i);
+        }
+        let kept = d.into_items();
+        assert!(kept.len() <= 200 && kept.len() > 100, "{}", kept.len());
+        let stride = kept[1] - kept[0];
+        assert!(kept.windows(2).all(|w| w[1] - w[0] == stride));
+        assert_eq!(kept[0], 0);
+    }
+}

@@ -1,0 +1,102 @@
+//! A log's reference (ground truth) as the reader hands it on: where it comes from
+//! ([`ReferenceInLog`]: a topic of the log or a child frame in `/tf`), its samples
+//! ([`ReferenceSample`]), and the [`LogObserver`] that receives every reference sample and
+//! every estimate message while the log streams by (`eval::log::nees` is the one that computes NEES
+//! from them). Nothing here reads a file or computes.
+//!
+//! ```
+//! use posecov::plan::log::{ReferenceInLog, ReferenceSample};
+//! let tf = ReferenceInLog::Tf { child: "base_link".into() };
+//! assert_eq!(tf.to_string(), "tf:base_link");
+//! let s = ReferenceSample { stamp_ns: 1, position: [0.0; 3], orientation_xyzw: [0.0, 0.0, 0.0, 1.0] };
+//! assert_eq!(s.stamp_ns, 1);
+//! ```
+
+use std::fmt;
+
+use super::COV_LEN;
+
+/// Where in a log the reference is.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ReferenceInLog {
+    /// A topic of pose messages (`PoseStamped`, `PoseWithCovarianceStamped`, `Odometry`,
+    /// `TransformStamped`).
+    Topic(String),
+    /// The transforms in `/tf` whose `child_frame_id` is `child` (their parent must be the
+    /// estimate's `frame_id`).
+    Tf {
+        /// The child frame.
+        child: String,
+    },
+}
+
+impl fmt::Display for ReferenceInLog {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ReferenceInLog::Topic(name) => write!(f, "topic:{name}"),
+            ReferenceInLog::Tf { child } => write!(f, "tf:{child}"),
+        }
+    }
+}
+
+/// One pose of the reference trajectory: parent_from_child at `stamp_ns`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReferenceSample {
+    /// Stamp, ns (the header stamp; a TUM file's seconds).
+    pub stamp_ns: i64,
+    /// Position (x, y, z) in the parent frame.
+    pub position: [f64; 3],
+    /// Orientation (x, y, z, w).
+    pub orientation_xyzw: [f64; 4],
+}
+
+/// One pose-with-covariance message of an estimate topic, as read (every message that
+/// decodes, usable or not).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EstimateMessage<'a> {
+    /// The topic.
+    pub topic: &'a str,
+    /// Its `header.frame_id` (the parent frame).
+    pub frame_id: &'a str,
+    /// Its number on the topic (0-based).
+    pub index: u64,
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// Position (x, y, z).
+    pub position: [f64; 3],
+    /// Orientation (x, y, z, w).
+    pub orientation_xyzw: [f64; 4],
+    /// The ROS covariance, row-major.
+    pub covariance: &'a [f64; COV_LEN],
+    /// The covariance is usable as a Gaussian (no health defect that forbids it).
+    pub usable: bool,
+    /// Per ROS axis: a placeholder (≥ 1e6) or zero variance, "not estimated".
+    pub unestimated: [bool; 6],
+}
+
+/// Receives, in file order, every reference sample and every estimate message of a log while
+/// it is read: what a streamed computation over every message (NEES) needs.
+pub trait LogObserver {
+    /// A reference sample whose parent frame is `frame_id` (empty when the message has none).
+    fn reference(&mut self, frame_id: &str, sample: ReferenceSample);
+    /// A message of a pose-with-covariance topic (the reference topic's own included: the
+    /// observer leaves it out).
+    fn estimate(&mut self, message: &EstimateMessage<'_>);
+}
+
+/// What the reader saw of the reference in the log.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ReferenceRead {
+    /// The log declares the reference topic (or `/tf`).
+    pub found: bool,
+    /// Its message type as the log names it, if found.
+    pub message_type: Option<String>,
+    /// The type is one a reference can be read from.
+    pub readable: bool,
+    /// Samples handed on (a `/tf` message can hold several transforms, others none).
+    pub samples: u64,
+    /// Messages that could not be decoded.
+    pub undecodable: u64,
+    /// `/tf` only: the parent frames seen for the child.
+    pub parents: Vec<String>,
+}
