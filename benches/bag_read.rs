@@ -24,9 +24,10 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use posecov::input::log::decode::{Decoded, decode_ros1, ros1_kind};
+use posecov::input::log::decode::{decode_ros1, ros1_kind};
 use posecov::input::log::health::TopicHealth;
 use posecov::input::log::{LogOptions, read_log};
+use posecov::plan::log::PoseMessage;
 use rayon::prelude::*;
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
@@ -145,7 +146,7 @@ fn bag_libbz2(c: &mut Criterion, name: &str, path: &str) {
 }
 
 /// Every pose message of a ROS 1 log, decoded.
-fn decoded(path: &str) -> Vec<(i64, Decoded)> {
+fn decoded(path: &str) -> Vec<(i64, PoseMessage)> {
     let bag = RosBag::new(path).unwrap();
     let mut kinds = std::collections::HashMap::new();
     let mut out = Vec::new();
@@ -189,7 +190,7 @@ fn bag_health(c: &mut Criterion, name: &str, path: &str) {
     // message and classifies it at once, in cache). So each block of messages is copied into
     // a small buffer first, outside the time measured: the same messages in the same order,
     // in cache as in the read.
-    let mut buffer: Vec<(i64, Decoded)> = Vec::with_capacity(HEALTH_BLOCK);
+    let mut buffer: Vec<(i64, PoseMessage)> = Vec::with_capacity(HEALTH_BLOCK);
     group.bench_function(name, |b| {
         b.iter_custom(|iterations| {
             let mut spent = Duration::ZERO;

@@ -8,7 +8,7 @@
 //! This crate is the library behind the `posecov` binary. Data flows one way, through five
 //! stages, each getting only its own settings and handing plain data to the next:
 //!
-//! 1. [`input`]: a file (TOML scenario, g2o / GTSAM / TORO pose graph, ROS 1 log, MCAP) or a
+//! 1. [`input`]: a file (TOML scenario, g2o / GTSAM / TORO pose graph, ROS 1 bag, MCAP) or a
 //!    bundled example, its format decided once, read and checked with every error at its
 //!    `file:line:column` → a typed [`plan`] ([`plan::Plan`]; a robot log:
 //!    [`plan::log::LogSummary`]).

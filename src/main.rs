@@ -12,7 +12,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use posecov::app::live::{self, LiveOptions};
 use posecov::app::sinks::{EXIT_INTERRUPTED, ServeOptions, ViewOptions};
 use posecov::app::view::view;
@@ -217,16 +217,34 @@ struct EvalArgs {
     /// Pose graphs: how the file's information matrices are read. `g2o` (default) as g2o
     /// defines them; `gtsam` as GTSAM's readG2o does (3-D edges without the half-angle
     /// factor), for a like-for-like comparison with GTSAM.
-    #[arg(long, value_name = "READING", value_parser = ["g2o", "gtsam"])]
-    graph_reading: Option<String>,
+    #[arg(long, value_name = "READING", value_enum)]
+    graph_reading: Option<GraphReadingArg>,
     /// Pose graphs: the optimiser, `lm` (Levenberg–Marquardt, default) or `gn` (Gauss–Newton).
-    #[arg(long, value_name = "NAME", value_parser = ["lm", "gn"])]
-    optimizer: Option<String>,
+    #[arg(long, value_name = "NAME", value_enum)]
+    optimizer: Option<OptimizerArg>,
     /// Pose graphs: the joint marginal of vertices A and B (ids), e.g. `--joint 5,9`
     /// (repeatable): reported in `report --json` (`optimized.joints`) and drawn as the
     /// relative pose's uncertainty, B as A sees it.
     #[arg(long = "joint", value_name = "A,B", value_parser = parse_joint)]
     joints: Vec<(u64, u64)>,
+}
+
+/// `--graph-reading`'s values (the flag's words for [`GraphReading`]).
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum GraphReadingArg {
+    /// As g2o defines the information matrices.
+    G2o,
+    /// As GTSAM's readG2o reads them.
+    Gtsam,
+}
+
+/// `--optimizer`'s values (the flag's words for [`Optimizer`]).
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum OptimizerArg {
+    /// Levenberg–Marquardt.
+    Lm,
+    /// Gauss–Newton.
+    Gn,
 }
 
 /// `A,B`: two vertex ids.
@@ -258,13 +276,13 @@ impl EvalArgs {
             reference: None,
             align: None,
             steps: None,
-            graph_reading: self.graph_reading.as_deref().map(|r| match r {
-                "gtsam" => GraphReading::Gtsam,
-                _ => GraphReading::G2o,
+            graph_reading: self.graph_reading.map(|r| match r {
+                GraphReadingArg::G2o => GraphReading::G2o,
+                GraphReadingArg::Gtsam => GraphReading::Gtsam,
             }),
-            optimizer: self.optimizer.as_deref().map(|o| match o {
-                "gn" => Optimizer::GaussNewton,
-                _ => Optimizer::LevenbergMarquardt,
+            optimizer: self.optimizer.map(|o| match o {
+                OptimizerArg::Lm => Optimizer::LevenbergMarquardt,
+                OptimizerArg::Gn => Optimizer::GaussNewton,
             }),
             joints: self.joints.clone(),
         }

@@ -267,7 +267,7 @@ fn topics_types_and_skips() {
 fn planar_odometry_numbers_are_exact() {
     let plan = read(&write_example(), &LogOptions::default());
     let odom = &plan.topics[2];
-    assert!(odom.planar);
+    assert!(odom.group.is_planar());
     assert_eq!(
         (odom.frame_id.as_str(), odom.child_frame_id.as_str()),
         ("odom", "base_link")
@@ -311,7 +311,7 @@ fn every_health_case_is_counted_once() {
     let plan = read(&write_example(), &LogOptions::default());
     let amcl = &plan.topics[0];
     assert_eq!(amcl.count, 12);
-    assert!(!amcl.planar);
+    assert!(!amcl.group.is_planar());
     let h = &amcl.health;
     let s = 1_000_000_000;
     for (issue, stamp) in [
@@ -494,11 +494,11 @@ fn a_topic_without_messages_is_drawn() {
         err.contains("pose topics without messages: /empty"),
         "{err}"
     );
-    let plan = read(&log(true), &LogOptions::default());
+    let mut plan = read(&log(true), &LogOptions::default());
     assert_eq!(plan.topics.len(), 2);
     let empty = plan.topics.iter().find(|t| t.name == "/empty").unwrap();
     assert_eq!(empty.count, 0);
-    let e = evaluate_log(&plan, &Default::default());
+    let e = evaluate_log(&mut plan, &Default::default());
     let text = description(&plan, Format::Mcap, &e, Confidence::DEFAULT);
     assert!(text.contains("0 messages"), "{text}");
     let settings = LogDrawSettings {

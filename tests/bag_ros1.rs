@@ -15,7 +15,7 @@ fn test2_bag_reads_with_its_placeholders() {
     let odom = &plan.topics[0];
     assert_eq!(odom.kind, PoseMessageKind::Odometry);
     assert_eq!(odom.health.count(Issue::Placeholder), odom.count);
-    assert!(odom.planar);
+    assert!(odom.group.is_planar());
     assert_eq!(odom.name, "/jackal_velocity_controller/odom");
     assert_eq!(
         (odom.frame_id.as_str(), odom.child_frame_id.as_str()),
@@ -126,7 +126,7 @@ fn ctrl_c_keeps_what_was_read_and_draws_it() {
     use std::sync::atomic::{AtomicBool, Ordering};
     let cancel = AtomicBool::new(false);
     // Raise the flag after the first chunk, as Ctrl-C would mid-read.
-    let plan = read_log(
+    let mut plan = read_log(
         TEST2.as_ref(),
         &LogOptions::default(),
         &mut |_, _| cancel.store(true, Ordering::Relaxed),
@@ -136,7 +136,7 @@ fn ctrl_c_keeps_what_was_read_and_draws_it() {
     assert!(plan.cancelled);
     let odom = &plan.topics[0];
     assert!(odom.count > 0 && odom.count < 3060, "{}", odom.count);
-    let e = posecov::eval::log::evaluate_log(&plan, &Default::default());
+    let e = posecov::eval::log::evaluate_log(&mut plan, &Default::default());
     let about = posecov::input::About {
         title: "t".into(),
         description: String::new(),

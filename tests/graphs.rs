@@ -451,7 +451,7 @@ fn formats_are_decided_by_content_and_extension() {
         (
             "b.bag",
             b"\x89MCAP0\r\nrest".as_slice(),
-            "the extension .bag says ROS 1 log, but its content is a MCAP file (ROS 2 bag)",
+            "the extension .bag says ROS 1 bag, but its content is a MCAP file (ROS 2 bag)",
         ),
         (
             "m.mcap",
@@ -461,7 +461,7 @@ fn formats_are_decided_by_content_and_extension() {
         (
             "e.bag",
             b"".as_slice(),
-            "the extension .bag says ROS 1 log, but it is empty",
+            "the extension .bag says ROS 1 bag, but it is empty",
         ),
         (
             "x.g2o",

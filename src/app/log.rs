@@ -71,8 +71,8 @@ pub(super) fn run(
     let observer = reference
         .as_mut()
         .map(|r| &mut r.observer as &mut dyn LogObserver);
-    let plan = read(located, &options, cancel, bar, observer)?;
-    let mut evaluation = evaluate_log(&plan, &settings.eval);
+    let mut plan = read(located, &options, cancel, bar, observer)?;
+    let mut evaluation = evaluate_log(&mut plan, &settings.eval);
     if let Some(reference) = reference {
         evaluation = evaluation.with_consistency(nees::finish(reference, &plan, &file)?);
     }
@@ -272,9 +272,9 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                     "from_log_time": t.stamps_from_log_time,
                     "out_of_order": t.stamps_out_of_order,
                 },
-                "planar": t.planar,
-                "position_dof": e.position_dof,
-                "pose_dof": e.pose_dof,
+                "planar": t.group.is_planar(),
+                "position_dof": e.group.position_dims(),
+                "pose_dof": e.group.dof(),
                 "drawn": e.poses.len(),
                 "drawn_invalid": e.poses.iter().filter(|p| !p.state.is_drawable()).count(),
                 "every": t.stride,

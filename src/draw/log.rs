@@ -74,8 +74,8 @@ pub struct LogDrawSettings {
 /// use posecov::eval::log::{LogEvalSettings, evaluate_log};
 /// use posecov::input::{About, Format, log::{LogOptions, read_log}};
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
-/// let plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
-/// let e = evaluate_log(&plan, &LogEvalSettings::default());
+/// let mut plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+/// let e = evaluate_log(&mut plan, &LogEvalSettings::default());
 /// let about = About { title: "test2.bag".into(), description: String::new(), source: String::new() };
 /// let settings = LogDrawSettings { about, confidence: posecov::uncertain::Confidence::DEFAULT, axis_length: None };
 /// let scene = draw_log(&e, &settings, &description(&plan, Format::Ros1Bag, &e, posecov::uncertain::Confidence::DEFAULT));
@@ -96,7 +96,7 @@ fn build(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene 
     let axis_length = settings
         .axis_length
         .unwrap_or((0.08 * extent).clamp(0.05, 2.0));
-    let planar = !e.topics.is_empty() && e.topics.iter().all(|t| t.planar);
+    let planar = !e.topics.is_empty() && e.topics.iter().all(|t| t.group.is_planar());
     let mut p = Painter {
         scene: Scene::new(settings.about.title.clone(), summary.to_owned()),
         confidence: settings.confidence,
@@ -198,7 +198,7 @@ fn rviz_noting(e: &LogEvaluation) -> Vec<&str> {
                 t.poses.iter().any(|q| {
                     q.rviz
                         .as_ref()
-                        .is_some_and(|r| rviz::has_clipped_axis(r, t.planar))
+                        .is_some_and(|r| rviz::has_clipped_axis(r, t.group.is_planar()))
                 })
             })
         })
@@ -291,7 +291,7 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation, rviz_note: bool) {
     let strip: Vec<Vec3> = t
         .trajectory
         .iter()
-        .map(|(_, q)| flat(t.planar, &Vector3::from(*q)))
+        .map(|(_, q)| flat(t.group.is_planar(), &Vector3::from(*q)))
         .filter(|q| q.iter().all(|v| v.is_finite()))
         .collect();
     if !strip.is_empty() {
@@ -342,8 +342,8 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/data")
             .join(file);
-        let plan = read_log(&path, &LogOptions::default(), &mut |_, _| {}, None).unwrap();
-        let e = evaluate_log(&plan, &LogEvalSettings::default());
+        let mut plan = read_log(&path, &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+        let e = evaluate_log(&mut plan, &LogEvalSettings::default());
         let settings = LogDrawSettings {
             about: About {
                 title: "t".into(),

@@ -38,7 +38,7 @@ pub enum InputKind {
     /// A scenario or a pose graph: read whole into a [`Plan`](crate::plan::Plan), evaluated
     /// with Monte Carlo and the analytic methods.
     Plan,
-    /// A robot log (ROS 1 log, MCAP): streamed, message by message, into a bounded log
+    /// A robot log (ROS 1 bag, MCAP): streamed, message by message, into a bounded log
     /// summary ([`crate::plan::log`]).
     Log,
 }
@@ -253,7 +253,7 @@ fn expected() -> String {
 /// assert_eq!(detect("a.g2o", b"VERTEX2 0 0 0 0\n").unwrap(), Format::Graph);
 /// assert_eq!(detect("noext", b"EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n").unwrap(), Format::Graph);
 /// let e = detect("a.bag", b"\x89MCAP0\r\n").unwrap_err().to_string();
-/// assert!(e.starts_with("a.bag: the extension .bag says ROS 1 log, but its content is a MCAP file"), "{e}");
+/// assert!(e.starts_with("a.bag: the extension .bag says ROS 1 bag, but its content is a MCAP file"), "{e}");
 /// let e = detect("run_0.db3", b"SQLite format 3\0...").unwrap_err().to_string();
 /// assert!(e.contains("ros2 bag convert"), "{e}");
 /// let e = detect("notes.csv", b"1,2,3\n").unwrap_err().to_string();

@@ -17,6 +17,8 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+use crate::lie::GroupKind;
+
 mod decimate;
 mod reference;
 pub use decimate::Decimator;
@@ -94,14 +96,20 @@ impl PoseMessageKind {
 }
 
 /// A decoded pose with covariance, in ROS's own layout and meaning
-/// ([CONVENTIONS §6](crate::conventions#6-ros-posewithcovariance)).
+/// ([CONVENTIONS §6](crate::conventions#6-ros-posewithcovariance)): the one message struct of
+/// the log wing, from the decoders ([`crate::input::log::decode`]) to the drawn messages.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PoseMessage {
     /// When: the header stamp, or the log time when the header has none (see `from_log_time`),
-    /// nanoseconds since the epoch (or since the simulation's start).
+    /// nanoseconds since the epoch (or since the simulation's start). A decoder that finds no
+    /// header stamp sets 0 and `from_log_time`; the log reader puts the log time in.
     pub stamp_ns: i64,
     /// The header stamp was zero or missing and the log (receive) time is used instead.
     pub from_log_time: bool,
+    /// `header.frame_id` (empty when the message has no header).
+    pub frame_id: String,
+    /// `child_frame_id` (Odometry; else empty).
+    pub child_frame_id: String,
     /// `pose.position` (x, y, z) in the parent frame.
     pub position: [f64; 3],
     /// `pose.orientation` (x, y, z, w).
@@ -490,9 +498,10 @@ pub struct TopicSummary {
     pub stamp_range: Option<(i64, i64)>,
     /// Covariance health.
     pub health: Health,
-    /// Every usable message has z, roll and pitch unestimated (zero or placeholder): the
-    /// topic is drawn in the x–y plane as SE(2).
-    pub planar: bool,
+    /// The topic's group, which gives its degrees of freedom ([`GroupKind::dof`],
+    /// [`GroupKind::position_dims`]): SE(2) when every usable message has z, roll and pitch
+    /// unestimated (zero or placeholder), so the topic is drawn in the x–y plane; else SE(3).
+    pub group: GroupKind,
     /// Messages kept for drawing (at most the configured count; evenly spaced by `stride`).
     pub drawn: Vec<DrawnMessage>,
     /// One kept message in `stride`.

@@ -42,9 +42,9 @@ pub(super) fn message(
 ) {
     let base = place.base;
     let at = Timing::Stamp(pose.stamp_ns);
-    let origin = flat(t.planar, &(mean.translation() - place.shift));
+    let origin = flat(t.group.is_planar(), &(mean.translation() - place.shift));
     let radii = (
-        p.confidence().radius(t.position_dof),
+        p.confidence().radius(t.group.position_dims()),
         p.confidence().radius(2),
         p.confidence().radius(1),
     );
@@ -60,12 +60,12 @@ pub(super) fn message(
             origin,
             rviz,
             radii,
-            t.planar,
+            t.group.is_planar(),
             label_shape,
         );
     }
     let label = place.label.clone();
-    let frame_rotation = if t.planar {
+    let frame_rotation = if t.group.is_planar() {
         UnitQuaternion::from_euler_angles(0.0, 0.0, mean.rotation().to_rpy()[2])
     } else {
         let [x, y, z, w] = mean.rotation().to_quaternion_xyzw();
@@ -124,7 +124,7 @@ pub(super) fn message(
 /// The faint static overview: RViz's position region and the meaning's banana outline of
 /// every drawn message.
 pub(super) fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
-    let r = p.confidence().radius(t.position_dof);
+    let r = p.confidence().radius(t.group.position_dims());
     let axis_length = p.axis_length;
     let shapes_rviz: Vec<Ellipsoid> = t
         .poses
@@ -133,12 +133,12 @@ pub(super) fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
         .filter_map(|q| {
             let rviz = q.rviz.as_ref()?;
             let mean = q.mean?;
-            let c = Vector3::from(flat(t.planar, mean.translation()));
+            let c = Vector3::from(flat(t.group.is_planar(), mean.translation()));
             // A planar topic's overview shows RViz's ellipse in the plane (its 3-D shape of a
             // placeholder is drawn, clipped, at the current stamp only).
             let mut flat_rviz = *rviz;
-            flat_rviz.pose_2d |= t.planar;
-            Some(rviz_position(&flat_rviz, &c, r, axis_length, t.planar).0)
+            flat_rviz.pose_2d |= t.group.is_planar();
+            Some(rviz_position(&flat_rviz, &c, r, axis_length, t.group.is_planar()).0)
         })
         .collect();
     let region = p.confidence().to_string();

@@ -33,7 +33,7 @@ fn sigma_words(axis: usize, sigma: f64) -> String {
 /// The label of a message in the robot view: its number and σ per estimated axis (x, y, yaw
 /// when planar), "placeholder" for an axis that is one.
 fn label(t: &TopicEvaluation, pose: &PoseEvaluation) -> String {
-    let axes: &[usize] = if t.planar {
+    let axes: &[usize] = if t.group.is_planar() {
         &[0, 1, 5]
     } else {
         &[0, 1, 2, 3, 4, 5]
@@ -66,7 +66,7 @@ fn scale(pose: &PoseEvaluation, r: f64) -> Option<f64> {
 /// Draws topic `t`'s robot view under `base/robot` (see the [module docs](self)).
 pub(super) fn robot_view(p: &mut Painter, base: &str, t: &TopicEvaluation) {
     let world_axis = p.axis_length;
-    let r = p.confidence().radius(t.position_dof);
+    let r = p.confidence().radius(t.group.position_dims());
     let robot_base = format!("{base}/{ROBOT}");
     let mut last_scale = None;
     for pose in &t.poses {
@@ -80,7 +80,7 @@ pub(super) fn robot_view(p: &mut Painter, base: &str, t: &TopicEvaluation) {
         let shift: Vector3<f64> = *mean.translation();
         let place = Placement {
             base: &robot_base,
-            shift: if t.planar {
+            shift: if t.group.is_planar() {
                 Vector3::new(shift.x, shift.y, 0.0)
             } else {
                 shift

@@ -54,7 +54,7 @@ pub fn issue_word(issue: Issue) -> &'static str {
 /// use posecov::{draw::log::issue_sentence, plan::log::{Issue, TopicSummary, PoseMessageKind}};
 /// # let t = TopicSummary { name: "/odom".into(), kind: PoseMessageKind::Odometry, frame_id: "odom".into(),
 /// #     child_frame_id: String::new(), count: 0, stamps_from_log_time: 0, stamps_out_of_order: 0,
-/// #     stamp_range: None, health: Default::default(), planar: true, drawn: vec![], stride: 1,
+/// #     stamp_range: None, health: Default::default(), group: posecov::lie::GroupKind::Se2, drawn: vec![], stride: 1,
 /// #     trajectory: vec![], series: vec![], sigma_stats: [None; 6] };
 /// assert!(issue_sentence(Issue::AllZero, &t).starts_with("every estimated entry is 0"));
 /// ```
@@ -78,7 +78,7 @@ pub fn issue_sentence(issue: Issue, t: &TopicSummary) -> String {
             "every estimated entry is 0: no uncertainty claimed (or never filled in).".to_owned()
         }
         Issue::PlaceholderUsedAxis => {
-            let axes = if t.planar {
+            let axes = if t.group.is_planar() {
                 "x, y or yaw"
             } else {
                 "an axis of a 3-D topic"
@@ -339,7 +339,7 @@ fn topic(
         .filter(|q| matches!(&q.state, PoseState::Invalid { issues } if issues == &[Issue::PlaceholderUsedAxis]))
         .count();
     let r2 = |d| p.radius(d);
-    let shape = if t.planar {
+    let shape = if t.group.is_planar() {
         format!(
             "**planar** (z, roll and pitch are zero or placeholders in every usable message): \
              drawn in the x–y plane as SE(2) — position region χ²(2), r = {:.3}; pose region \

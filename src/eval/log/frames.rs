@@ -42,10 +42,11 @@ use std::collections::{BTreeMap, BTreeSet};
 use nalgebra::{Matrix6, Vector3};
 use serde::Serialize;
 
+use super::TopicMessages;
 use super::stamped::{Lookup, StampedPoses, pose_of_sample};
 use crate::interop::{RosReading, ros_cov_moved};
-use crate::lie::{LieGroup, Se3};
-use crate::plan::log::{Class, Issue, TfTree, TopicSummary};
+use crate::lie::{GroupKind, LieGroup, Se3};
+use crate::plan::log::{Class, Issue, TfTree};
 
 /// A transform keeps a planar topic's plane when its roll and pitch are below this (rad).
 pub const PLANE_TOLERANCE: f64 = 1e-6;
@@ -419,56 +420,73 @@ fn keeps_plane(t: &Se3) -> bool {
     roll.abs() <= PLANE_TOLERANCE && pitch.abs() <= PLANE_TOLERANCE
 }
 
-/// `topic` moved into its chain's common frame: every drawn message and trajectory point moved
-/// by common_from_frame at its stamp (the covariance by [`ros_cov_moved`] in `reading`), those
-/// outside the transforms' span left out; the topic's `frame_id` becomes the common frame.
-/// `Err(stamp)`: a planar topic whose transform at `stamp` tilts its plane (nothing moved).
+/// A topic's messages moved into its chain's common frame, in place: every drawn message and
+/// trajectory point moved by common_from_frame at its stamp (the covariance by
+/// [`ros_cov_moved`] in `reading`), those outside the transforms' span left out; `frame_id`
+/// becomes the common frame. `Err(stamp)`: an SE(2) topic whose transform at `stamp` tilts its
+/// plane; nothing is moved then.
 ///
 /// ```
-/// use posecov::eval::log::frames::move_topic;
+/// use posecov::eval::log::{TopicMessages, frames::move_topic};
 /// use posecov::input::{locate, log::{LogOptions, read_located}};
 /// use posecov::interop::RosReading;
 /// use posecov::plan::log::{ReferenceSample, TfEdge, TfTree};
 /// let s = ReferenceSample { stamp_ns: 0, position: [1.0, 0.0, 0.0], orientation_xyzw: [0.0, 0.0, 0.0, 1.0] };
 /// let edge = TfEdge { samples: vec![s, ReferenceSample { stamp_ns: 47_700_000_000, ..s }], messages: 2, ..TfEdge::new("map", "odom", "/tf", 0) };
 /// let tf = TfTree { edges: vec![edge], ..Default::default() };
-/// let log = read_located(&locate("jackal_odometry").unwrap(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
-/// let topic = &log.topics[0]; // in `odom`, 47.584 s to 108.764 s
+/// let mut log = read_located(&locate("jackal_odometry").unwrap(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+/// let topic = &mut log.topics[0]; // in `odom`, 47.584 s to 108.764 s
+/// let (group, x0) = (topic.group, topic.trajectory[0].1[0]);
+/// let mut messages = TopicMessages::take(topic);
 /// let chain = ["odom".to_owned(), "map".to_owned()];
-/// let (moved, join) = move_topic(&tf, &chain, topic, RosReading::Tf2).unwrap();
-/// assert_eq!(moved.frame_id, "map");
-/// assert_eq!(moved.trajectory[0].1[0], topic.trajectory[0].1[0] + 1.0);
+/// let join = move_topic(&tf, &chain, group, &mut messages, RosReading::Tf2).unwrap();
+/// assert_eq!(messages.frame_id, "map");
+/// assert_eq!(messages.trajectory[0].1[0], x0 + 1.0);
 /// assert!(join.moved >= 1 && join.left_out > 0); // after 47.7 s: never extrapolated
 /// ```
 pub fn move_topic(
     tf: &TfTree,
     chain: &[String],
-    topic: &TopicSummary,
+    group: GroupKind,
+    messages: &mut TopicMessages,
     reading: RosReading,
-) -> Result<(TopicSummary, FrameJoin), i64> {
+) -> Result<FrameJoin, i64> {
     let lookup = EdgeLookup::new(tf, chain);
+    let planar = group.is_planar();
+    // First every transform, so that a tilted plane leaves the messages as they were.
+    let at = |stamp: i64| -> Result<Option<Se3>, i64> {
+        match lookup.at(stamp) {
+            Some(t) if planar && !keeps_plane(&t) => Err(stamp),
+            t => Ok(t),
+        }
+    };
+    let drawn_at: Vec<Option<Se3>> = messages
+        .drawn
+        .iter()
+        .map(|d| at(d.message.stamp_ns))
+        .collect::<Result<_, _>>()?;
+    let trajectory_at: Vec<Option<Se3>> = messages
+        .trajectory
+        .iter()
+        .map(|(stamp, _)| at(*stamp))
+        .collect::<Result<_, _>>()?;
     let to = chain.last().cloned().unwrap_or_default();
     let mut join = FrameJoin {
-        from: topic.frame_id.clone(),
-        to: to.clone(),
+        from: std::mem::replace(&mut messages.frame_id, to.clone()),
+        to,
         chain: chain.to_vec(),
         moved: 0,
         left_out: 0,
         first_left_out_ns: None,
         trajectory_left_out: 0,
     };
-    let mut drawn = Vec::with_capacity(topic.drawn.len());
-    for d in &topic.drawn {
-        let stamp = d.message.stamp_ns;
-        let Some(t) = lookup.at(stamp) else {
+    let drawn = std::mem::take(&mut messages.drawn);
+    for (mut d, t) in drawn.into_iter().zip(drawn_at) {
+        let Some(t) = t else {
             join.left_out += 1;
-            join.first_left_out_ns.get_or_insert(stamp);
+            join.first_left_out_ns.get_or_insert(d.message.stamp_ns);
             continue;
         };
-        if topic.planar && !keeps_plane(&t) {
-            return Err(stamp);
-        }
-        let mut d = d.clone();
         let m = &mut d.message;
         if let Ok(r) = crate::lie::So3::try_from_quaternion_xyzw(m.orientation_xyzw) {
             let x = t.compose(&Se3::from_parts(m.position.into(), r));
@@ -483,21 +501,16 @@ pub fn move_topic(
             }
         }
         join.moved += 1;
-        drawn.push(d);
+        messages.drawn.push(d);
     }
-    let mut trajectory = Vec::with_capacity(topic.trajectory.len());
-    for (stamp, p) in &topic.trajectory {
-        match lookup.at(*stamp) {
-            Some(t) if topic.planar && !keeps_plane(&t) => return Err(*stamp),
-            Some(t) => trajectory.push((*stamp, t.act(&Vector3::from(*p)).into())),
+    let trajectory = std::mem::take(&mut messages.trajectory);
+    for ((stamp, p), t) in trajectory.into_iter().zip(trajectory_at) {
+        match t {
+            Some(t) => messages
+                .trajectory
+                .push((stamp, t.act(&Vector3::from(p)).into())),
             None => join.trajectory_left_out += 1,
         }
     }
-    let moved = TopicSummary {
-        frame_id: to,
-        drawn,
-        trajectory,
-        ..topic.clone()
-    };
-    Ok((moved, join))
+    Ok(join)
 }

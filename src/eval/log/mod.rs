@@ -10,10 +10,10 @@
 //! use posecov::eval::log::{LogEvalSettings, evaluate_log};
 //! use posecov::input::log::{LogOptions, read_log};
 //! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
-//! let plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
-//! let e = evaluate_log(&plan, &LogEvalSettings::default());
+//! let mut plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+//! let e = evaluate_log(&mut plan, &LogEvalSettings::default());
 //! let odom = &e.topics[0];
-//! assert_eq!((odom.position_dof, odom.pose_dof), (2, 3));
+//! assert_eq!((odom.group.position_dims(), odom.group.dof()), (2, 3));
 //! assert!(odom.poses.iter().all(|p| p.state.is_drawable()));
 //! ```
 
@@ -24,7 +24,7 @@ pub mod stamped;
 use nalgebra::{Matrix3, Matrix6, Vector2};
 
 use crate::interop::{RosReading, ros_cov_to_right};
-use crate::lie::{Se2, Se3, So2, So3};
+use crate::lie::{GroupKind, Se2, Se3, So2, So3};
 use serde::Serialize;
 
 use self::frames::{
@@ -190,12 +190,10 @@ pub struct TopicEvaluation {
     pub name: String,
     /// The frame its poses are in (`header.frame_id` of its first message; may be empty).
     pub frame_id: String,
-    /// Drawn as SE(2) in the x–y plane.
-    pub planar: bool,
-    /// Degrees of freedom of the position region (2 planar, 3 otherwise).
-    pub position_dof: usize,
-    /// Degrees of freedom of the pose region (3 planar, 6 otherwise).
-    pub pose_dof: usize,
+    /// The topic's group: SE(2) drawn in the x–y plane, or SE(3). The position region has
+    /// [`GroupKind::position_dims`] degrees of freedom (2 or 3), the pose region
+    /// [`GroupKind::dof`] (3 or 6).
+    pub group: GroupKind,
     /// Drawn messages.
     pub poses: Vec<PoseEvaluation>,
     /// How far apart the two ROS readings put the drawn messages' right-form covariances:
@@ -241,10 +239,48 @@ impl LogEvaluation {
     }
 }
 
-/// Evaluates every topic of a log.
+/// A topic's measured messages, as the evaluation takes them: moved out of its
+/// [`TopicSummary`] (whose counts, health and stamps stay), never copied.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TopicMessages {
+    /// The frame they are in (the topic's `frame_id`; the common frame once joined).
+    pub frame_id: String,
+    /// The drawn messages.
+    pub drawn: Vec<DrawnMessage>,
+    /// The trajectory (stamp ns, position).
+    pub trajectory: Vec<(i64, [f64; 3])>,
+    /// The σ time series.
+    pub series: Vec<SeriesPoint>,
+}
+
+impl TopicMessages {
+    /// Moves `topic`'s drawn messages, trajectory and series out (they are empty in `topic`
+    /// afterwards).
+    ///
+    /// ```
+    /// use posecov::eval::log::TopicMessages;
+    /// use posecov::input::{locate, log::{LogOptions, read_located}};
+    /// let mut log = read_located(&locate("jackal_odometry").unwrap(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+    /// let n = log.topics[0].drawn.len();
+    /// let m = TopicMessages::take(&mut log.topics[0]);
+    /// assert!(m.drawn.len() == n && n > 0 && log.topics[0].drawn.is_empty());
+    /// ```
+    pub fn take(topic: &mut TopicSummary) -> Self {
+        TopicMessages {
+            frame_id: topic.frame_id.clone(),
+            drawn: std::mem::take(&mut topic.drawn),
+            trajectory: std::mem::take(&mut topic.trajectory),
+            series: std::mem::take(&mut topic.series),
+        }
+    }
+}
+
+/// Evaluates every topic of a log. Each topic's drawn messages, trajectory and series move
+/// into its evaluation ([`TopicMessages::take`]): `plan` keeps the counts, health, stamps and
+/// `/tf` that the report and the text panel read, and those three are empty afterwards.
 ///
 /// See the [module docs](self) for an example.
-pub fn evaluate_log(plan: &LogSummary, settings: &LogEvalSettings) -> LogEvaluation {
+pub fn evaluate_log(plan: &mut LogSummary, settings: &LogEvalSettings) -> LogEvaluation {
     let named: Vec<(&str, &str, Option<i64>)> = plan
         .topics
         .iter()
@@ -258,41 +294,46 @@ pub fn evaluate_log(plan: &LogSummary, settings: &LogEvalSettings) -> LogEvaluat
         .collect();
     let joins = join_plan(&plan.tf, &named);
     let mut problems = joins.problems;
+    let tf = &plan.tf;
     let topics = plan
         .topics
-        .iter()
+        .iter_mut()
         .zip(joins.chains)
         .enumerate()
         .map(|(k, (t, chain))| {
-            let moved = chain.map(|c| move_topic(&plan.tf, &c, t, settings.reading));
-            match moved {
-                Some(Ok((moved, join))) => {
-                    let mut e = evaluate_topic(k as u64, &moved, settings);
-                    // σ per axis as published, in the topic's own frame's axes (as its plots,
-                    // report and check give them).
-                    for p in &mut e.poses {
-                        if let Some(d) = t.drawn.iter().find(|d| d.index == p.index) {
-                            p.sigma = message_sigma(d);
-                        }
+            let mut messages = TopicMessages::take(t);
+            // σ per axis as published, in the topic's own frame's axes (as its plots, report
+            // and check give them), taken before the messages move.
+            let published: Vec<(u64, [Option<f64>; 6])> = messages
+                .drawn
+                .iter()
+                .map(|d| (d.index, message_sigma(d)))
+                .collect();
+            let joined =
+                match chain.map(|c| move_topic(tf, &c, t.group, &mut messages, settings.reading)) {
+                    Some(Ok(join)) => Some(join),
+                    Some(Err(stamp)) => {
+                        problems.push(FrameProblem {
+                            kind: FrameProblemKind::TiltsPlane,
+                            frames: vec![t.frame_id.clone()],
+                            roots: Vec::new(),
+                            topics: vec![t.name.clone()],
+                            source: "/tf".to_owned(),
+                            stamp_ns: Some(stamp),
+                        });
+                        None
                     }
-                    TopicEvaluation {
-                        joined: Some(join),
-                        ..e
+                    None => None,
+                };
+            let mut e = evaluate_topic(k as u64, t, messages, settings);
+            if joined.is_some() {
+                for p in &mut e.poses {
+                    if let Ok(at) = published.binary_search_by_key(&p.index, |(i, _)| *i) {
+                        p.sigma = published[at].1;
                     }
                 }
-                Some(Err(stamp)) => {
-                    problems.push(FrameProblem {
-                        kind: FrameProblemKind::TiltsPlane,
-                        frames: vec![t.frame_id.clone()],
-                        roots: Vec::new(),
-                        topics: vec![t.name.clone()],
-                        source: "/tf".to_owned(),
-                        stamp_ns: Some(stamp),
-                    });
-                    evaluate_topic(k as u64, t, settings)
-                }
-                None => evaluate_topic(k as u64, t, settings),
             }
+            TopicEvaluation { joined, ..e }
         })
         .collect();
     LogEvaluation {
@@ -308,10 +349,12 @@ pub fn evaluate_log(plan: &LogSummary, settings: &LogEvalSettings) -> LogEvaluat
 fn evaluate_topic(
     family: u64,
     topic: &TopicSummary,
+    messages: TopicMessages,
     settings: &LogEvalSettings,
 ) -> TopicEvaluation {
     let mut reading_difference: f64 = 0.0;
-    let poses = topic
+    let planar = topic.group.is_planar();
+    let poses = messages
         .drawn
         .iter()
         .map(|d| {
@@ -331,18 +374,11 @@ fn evaluate_topic(
             });
             let state = match (mean, d.unusable.is_empty()) {
                 (Some(mean), true) => {
-                    if !topic.planar && finite {
+                    if !planar && finite {
                         reading_difference =
                             reading_difference.max(readings_apart(&mean, &cov_ros));
                     }
-                    meaning(
-                        &mean,
-                        &cov_ros,
-                        &d.unestimated,
-                        topic.planar,
-                        settings.reading,
-                    )
-                    .map_or_else(
+                    meaning(&mean, &cov_ros, &d.unestimated, planar, settings.reading).map_or_else(
                         |issues| PoseState::Invalid { issues },
                         |state| with_cloud(state, settings, family, d.index),
                     )
@@ -368,17 +404,15 @@ fn evaluate_topic(
         .collect();
     TopicEvaluation {
         name: topic.name.clone(),
-        frame_id: topic.frame_id.clone(),
-        planar: topic.planar,
-        position_dof: if topic.planar { 2 } else { 3 },
-        pose_dof: if topic.planar { 3 } else { 6 },
+        frame_id: messages.frame_id,
+        group: topic.group,
         poses,
         reading_difference,
-        trajectory: topic.trajectory.clone(),
-        series: topic.series.clone(),
         sigma: std::array::from_fn(|axis| {
-            sigma_summary(topic.sigma_stats[axis], &topic.series, axis)
+            sigma_summary(topic.sigma_stats[axis], &messages.series, axis)
         }),
+        trajectory: messages.trajectory,
+        series: messages.series,
         consistency: None,
         joined: None,
     }

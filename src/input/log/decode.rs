@@ -1,4 +1,4 @@
-//! Message bytes → [`Decoded`]: ROS 1 serialization (little-endian, packed, strings as u32
+//! Message bytes → [`PoseMessage`]: ROS 1 serialization (little-endian, packed, strings as u32
 //! length + bytes; wiki.ros.org/msg "Serialization") and ROS 2 CDR (through `re_cdr`'s serde
 //! deserializer, after the 4-byte encapsulation header). Never panics: truncated or garbage
 //! bytes are an error naming what was being read.
@@ -7,7 +7,7 @@ use std::borrow::Cow;
 
 use serde::{Deserialize, Serialize};
 
-use crate::plan::log::{COV_LEN, PoseMessageKind};
+use crate::plan::log::{COV_LEN, PoseMessage, PoseMessageKind};
 
 /// MD5 sums of the ROS 1 definitions posecov decodes (what `rosmsg md5` prints).
 pub const ROS1_MD5: [(PoseMessageKind, &str); 3] = [
@@ -24,25 +24,6 @@ pub const ROS1_MD5: [(PoseMessageKind, &str); 3] = [
         "c23e848cf1b7533a8d7c259073a97e6f",
     ),
 ];
-
-/// One decoded message, before stamps are resolved.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Decoded {
-    /// Header stamp in ns (`None`: no header, or a zero stamp).
-    pub stamp_ns: Option<i64>,
-    /// `header.frame_id`.
-    pub frame_id: String,
-    /// `child_frame_id` (Odometry).
-    pub child_frame_id: String,
-    /// Position (x, y, z).
-    pub position: [f64; 3],
-    /// Orientation (x, y, z, w).
-    pub orientation_xyzw: [f64; 4],
-    /// Pose covariance, row-major.
-    pub covariance: [f64; COV_LEN],
-    /// Twist covariance (Odometry).
-    pub twist_covariance: Option<[f64; COV_LEN]>,
-}
 
 /// Why bytes did not decode.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -157,7 +138,7 @@ fn stamp(secs: i64, nsecs: u32) -> Option<i64> {
 /// let e = decode_ros1(PoseMessageKind::Odometry, &[1, 2, 3]).unwrap_err();
 /// assert!(e.to_string().starts_with("truncated: header.seq"), "{e}");
 /// ```
-pub fn decode_ros1(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, DecodeError> {
+pub fn decode_ros1(kind: PoseMessageKind, bytes: &[u8]) -> Result<PoseMessage, DecodeError> {
     let mut r = Ros1 { bytes, at: 0 };
     let (stamp_ns, frame_id) = match kind {
         PoseMessageKind::PoseWithCovariance => (None, String::new()),
@@ -177,8 +158,9 @@ pub fn decode_ros1(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, Decod
         }
         _ => None,
     };
-    within_reach(Decoded {
-        stamp_ns,
+    within_reach(PoseMessage {
+        stamp_ns: stamp_ns.unwrap_or(0),
+        from_log_time: stamp_ns.is_none(),
         frame_id,
         child_frame_id,
         position,
@@ -191,7 +173,7 @@ pub fn decode_ros1(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, Decod
 /// A message whose position lies beyond ±[`MAX_COORDINATE`](crate::plan::limits::MAX_COORDINATE)
 /// (1e12 m, as in a scenario file) cannot be drawn or evaluated: it is refused as a decoding
 /// error (the `undecodable` defect), not handed on.
-fn within_reach(d: Decoded) -> Result<Decoded, DecodeError> {
+fn within_reach(d: PoseMessage) -> Result<PoseMessage, DecodeError> {
     let limit = crate::plan::limits::MAX_COORDINATE;
     if d.position.iter().any(|v| v.is_finite() && v.abs() > limit) {
         return Err(DecodeError(format!(
@@ -328,10 +310,10 @@ pub(super) fn header_stamp(t: Time) -> Option<i64> {
 /// let mut bytes = vec![0, 1, 0, 0];
 /// bytes.extend(re_cdr::to_vec::<_, re_cdr::LittleEndian>(&PoseWithCovariance::default()).unwrap());
 /// let d = decode_cdr(PoseMessageKind::PoseWithCovariance, &bytes).unwrap();
-/// assert_eq!(d.stamp_ns, None);
+/// assert!(d.from_log_time && d.stamp_ns == 0);
 /// assert!(decode_cdr(PoseMessageKind::Odometry, &bytes[..20]).is_err());
 /// ```
-pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, DecodeError> {
+pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<PoseMessage, DecodeError> {
     let what = kind.ros2_name();
     let (stamp_ns, frame_id, child_frame_id, pose, twist) = match kind {
         PoseMessageKind::Odometry => {
@@ -355,8 +337,9 @@ pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<Decoded, Decode
             (None, String::new(), String::new(), m, None)
         }
     };
-    within_reach(Decoded {
-        stamp_ns,
+    within_reach(PoseMessage {
+        stamp_ns: stamp_ns.unwrap_or(0),
+        from_log_time: stamp_ns.is_none(),
         frame_id,
         child_frame_id,
         position: pose.pose.position,
@@ -396,7 +379,7 @@ mod tests {
     fn ros1_odometry_decodes_exactly() {
         let cov: [f64; 36] = std::array::from_fn(|i| i as f64 * 0.5);
         let d = decode_ros1(PoseMessageKind::Odometry, &ros1_odometry(&cov, 0)).unwrap();
-        assert_eq!(d.stamp_ns, Some(12_000_000_500));
+        assert_eq!((d.stamp_ns, d.from_log_time), (12_000_000_500, false));
         assert_eq!(
             (d.frame_id.as_str(), d.child_frame_id.as_str()),
             ("map", "base")
@@ -445,7 +428,7 @@ mod tests {
                 bytes.extend(re_cdr::to_vec::<_, re_cdr::LittleEndian>(&msg).unwrap());
             }
             let d = decode_cdr(PoseMessageKind::Odometry, &bytes).unwrap();
-            assert_eq!(d.stamp_ns, Some(3_000_000_007));
+            assert_eq!((d.stamp_ns, d.from_log_time), (3_000_000_007, false));
             assert_eq!(d.child_frame_id, "base_link");
             assert_eq!(d.covariance, cov);
             assert_eq!(d.orientation_xyzw, [0.0, 0.0, 0.6, 0.8]);

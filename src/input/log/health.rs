@@ -2,8 +2,7 @@
 //! growth and a covariance that stays constant while the pose moves. Names, classes and
 //! thresholds are the README's ("Covariance health").
 
-use super::decode::Decoded;
-use crate::plan::log::{AxisStats, COV_LEN, Health, Issue, IssueCount, Stretch};
+use crate::plan::log::{AxisStats, COV_LEN, Health, Issue, IssueCount, PoseMessage, Stretch};
 
 mod classify;
 mod issues;
@@ -171,12 +170,11 @@ impl Constancy {
 /// (`benches/bag_read.rs` measures its share).
 ///
 /// ```
-/// use posecov::input::log::decode::Decoded;
 /// use posecov::input::log::health::TopicHealth;
-/// use posecov::plan::log::Issue;
+/// use posecov::plan::log::{Issue, PoseMessage};
 /// let mut covariance = [0.0; 36];
 /// for (i, v) in [0.001, 0.001, 1e6, 1e6, 1e6, 0.03].iter().enumerate() { covariance[i * 7] = *v; }
-/// let d = Decoded { stamp_ns: Some(1), frame_id: "odom".into(), child_frame_id: String::new(),
+/// let d = PoseMessage { stamp_ns: 1, from_log_time: false, frame_id: "odom".into(), child_frame_id: String::new(),
 ///     position: [0.0; 3], orientation_xyzw: [0.0, 0.0, 0.0, 1.0], covariance, twist_covariance: None };
 /// let mut topic = TopicHealth::default();
 /// let (h, variance) = topic.add(0, 1, &d, true);
@@ -320,7 +318,7 @@ impl TopicHealth {
         &mut self,
         index: u64,
         stamp_ns: i64,
-        d: &Decoded,
+        d: &PoseMessage,
         dead_reckoned: bool,
     ) -> (MessageHealth, [Option<f64>; 6]) {
         let cov = &d.covariance;

@@ -13,7 +13,7 @@
 //! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
 //! let plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
 //! assert_eq!(plan.topics[0].name, "/jackal_velocity_controller/odom");
-//! assert!(plan.topics[0].planar);
+//! assert!(plan.topics[0].group.is_planar());
 //! ```
 
 use std::collections::BTreeMap;
@@ -40,7 +40,6 @@ mod ros1_linear;
 mod tf;
 mod topic;
 
-use decode::{DecodeError, Decoded};
 use reference::ReferenceType;
 use topic::TopicState;
 
@@ -455,24 +454,26 @@ impl<'a, 'o> Collector<'a, 'o> {
             state.other_type(type_name, log_time_ns);
             return;
         }
-        let decoded: Result<Decoded, DecodeError> = match codec {
+        let decoded = match codec {
             Codec::Ros1 => decode::decode_ros1(state.kind, bytes),
             Codec::Cdr => decode::decode_cdr(state.kind, bytes),
         };
-        let added = state.add(decoded, log_time_ns);
-        if let (Some(observer), Some(a)) = (self.observer.as_deref_mut(), added) {
-            observer.estimate(&EstimateMessage {
-                topic,
-                frame_id: &a.decoded.frame_id,
-                index: a.index,
-                stamp_ns: a.stamp_ns,
-                position: a.decoded.position,
-                orientation_xyzw: a.decoded.orientation_xyzw,
-                covariance: &a.decoded.covariance,
-                usable: a.usable,
-                unestimated: a.unestimated,
-            });
-        }
+        let observer = self.observer.as_deref_mut();
+        state.add(decoded, log_time_ns, |a, m| {
+            if let Some(observer) = observer {
+                observer.estimate(&EstimateMessage {
+                    topic,
+                    frame_id: &m.frame_id,
+                    index: a.index,
+                    stamp_ns: m.stamp_ns,
+                    position: m.position,
+                    orientation_xyzw: m.orientation_xyzw,
+                    covariance: &m.covariance,
+                    usable: a.usable,
+                    unestimated: a.unestimated,
+                });
+            }
+        });
     }
 
     fn finish(mut self, path: &Path) -> Result<LogSummary, InputError> {
@@ -592,7 +593,7 @@ mod tests {
             (plan.topics[0].name.as_str(), plan.topics[0].count),
             ("/empty", 0)
         );
-        assert!(!plan.topics[0].planar);
+        assert!(!plan.topics[0].group.is_planar());
         assert_eq!(plan.skipped[0].count, 0);
         // Evaluating and drawing it: tests/bag_mcap.rs (`a_topic_without_messages_is_drawn`).
     }

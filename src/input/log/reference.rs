@@ -15,9 +15,9 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::Codec;
 use super::decode::{
-    DecodeError, Decoded, Header, Ros1, Time, cdr, decode_cdr, decode_ros1, header_stamp, ros2_kind,
+    DecodeError, Header, Ros1, Time, cdr, decode_cdr, decode_ros1, header_stamp, ros2_kind,
 };
-use crate::plan::log::{PoseMessageKind, ReferenceSample};
+use crate::plan::log::{PoseMessage, PoseMessageKind, ReferenceSample};
 
 /// A message type a reference pose is read from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -120,13 +120,13 @@ pub struct ReferencePose<'a> {
     pub orientation_xyzw: [f64; 4],
 }
 
-impl From<Decoded> for ReferencePose<'_> {
+impl From<PoseMessage> for ReferencePose<'_> {
     /// The pose of a pose-with-covariance message (its covariance left out).
-    fn from(d: Decoded) -> Self {
+    fn from(d: PoseMessage) -> Self {
         ReferencePose {
             frame_id: d.frame_id.into(),
             child_frame_id: d.child_frame_id.into(),
-            stamp_ns: d.stamp_ns,
+            stamp_ns: (!d.from_log_time).then_some(d.stamp_ns),
             position: d.position,
             orientation_xyzw: d.orientation_xyzw,
         }

@@ -3,22 +3,22 @@
 //! series); [`TopicState::into_plan`] reduces it to a [`TopicSummary`]. Memory is bounded by the
 //! decimators, whatever the log's length.
 
+use crate::lie::GroupKind;
 use crate::plan::log::{
     Decimator, DrawnMessage, Issue, IssueCount, PoseMessage, PoseMessageKind, SeriesPoint,
     TopicSummary, is_odom_frame,
 };
 
-use super::decode::{DecodeError, Decoded};
+use super::decode::DecodeError;
 use super::health::TopicHealth;
 use super::{DEFAULT_MAX_DRAWN, MAX_DRAWN_LIMIT, MAX_SERIES};
 
-/// A message [`TopicState::add`] took: what an observer of every message needs.
+/// A message [`TopicState::add`] took: what an observer of every message needs beside the
+/// message itself.
 pub(super) struct Added {
     pub(super) index: u64,
-    pub(super) stamp_ns: i64,
     pub(super) usable: bool,
     pub(super) unestimated: [bool; 6],
-    pub(super) decoded: Decoded,
 }
 
 /// The per-topic streaming state.
@@ -61,27 +61,29 @@ impl TopicState {
         }
     }
 
-    /// Takes the next message (`None` back when it could not be decoded).
+    /// Takes the next message: `observe` sees it once its stamp is resolved (not when it
+    /// could not be decoded); then it moves into the drawn set when drawn.
     pub(super) fn add(
         &mut self,
-        decoded: Result<Decoded, DecodeError>,
+        decoded: Result<PoseMessage, DecodeError>,
         log_time_ns: i64,
-    ) -> Option<Added> {
+        observe: impl FnOnce(&Added, &PoseMessage),
+    ) {
         let index = self.count;
         self.count += 1;
-        let d = match decoded {
+        let mut d = match decoded {
             Ok(d) => d,
             Err(_) => {
                 self.checks
                     .health
                     .note(Issue::Undecodable, log_time_ns, index);
-                return None;
+                return;
             }
         };
-        let (stamp_ns, from_log_time) = match d.stamp_ns {
-            Some(s) => (s, false),
-            None => (log_time_ns, true),
-        };
+        if d.from_log_time {
+            d.stamp_ns = log_time_ns;
+        }
+        let (stamp_ns, from_log_time) = (d.stamp_ns, d.from_log_time);
         let headed = self.kind != PoseMessageKind::PoseWithCovariance;
         if from_log_time && headed {
             self.from_log += 1;
@@ -122,32 +124,24 @@ impl TopicState {
                 position_trace: h.position_trace,
             },
         );
+        let added = Added {
+            index,
+            usable,
+            unestimated: h.unestimated,
+        };
+        observe(&added, &d);
         if self.drawn.wants(index) {
             let unusable = h.issues.iter().filter(|i| i.unusable()).collect();
             self.drawn.push(
                 index,
                 DrawnMessage {
                     index,
-                    message: PoseMessage {
-                        stamp_ns,
-                        from_log_time,
-                        position: d.position,
-                        orientation_xyzw: d.orientation_xyzw,
-                        covariance: d.covariance,
-                        twist_covariance: d.twist_covariance,
-                    },
+                    message: d,
                     unusable,
                     unestimated: h.unestimated,
                 },
             );
         }
-        Some(Added {
-            index,
-            stamp_ns,
-            usable,
-            unestimated: h.unestimated,
-            decoded: d,
-        })
     }
 
     /// A message of another type on this topic (`type_name`, logged at `log_time_ns`): not
@@ -214,7 +208,11 @@ impl TopicState {
             stamps_out_of_order: self.out_of_order,
             stamp_range: self.range,
             health,
-            planar,
+            group: if planar {
+                GroupKind::Se2
+            } else {
+                GroupKind::Se3
+            },
             drawn: self.drawn.into_items(),
             stride,
             trajectory,

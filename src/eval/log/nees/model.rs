@@ -111,7 +111,7 @@ impl Verdict {
     /// The verdict of an ANEES.
     ///
     /// ```
-    /// use posecov::eval::{Anees, nees::Verdict};
+    /// use posecov::eval::{Anees, log::nees::Verdict};
     /// let a = Anees { value: 60.0, dof: 6, band: [5.5, 6.5] };
     /// assert_eq!(Verdict::of(&a), Verdict::Overconfident);
     /// ```
