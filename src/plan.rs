@@ -26,6 +26,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+pub mod choices;
 pub mod graph;
 pub mod log;
 

@@ -499,7 +499,7 @@ fn a_topic_without_messages_is_drawn() {
     let empty = plan.topics.iter().find(|t| t.name == "/empty").unwrap();
     assert_eq!(empty.count, 0);
     let e = evaluate_log(&mut plan, &Default::default());
-    let text = description(&plan, Format::Mcap, &e, Confidence::DEFAULT);
+    let text = description(&plan, Format::Mcap.name(), &e, Confidence::DEFAULT);
     assert!(text.contains("0 messages"), "{text}");
     let settings = LogDrawSettings {
         about: About {

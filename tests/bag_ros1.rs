@@ -149,7 +149,7 @@ fn ctrl_c_keeps_what_was_read_and_draws_it() {
     };
     let text = posecov::draw::log::description(
         &plan,
-        posecov::input::Format::Ros1Bag,
+        posecov::input::Format::Ros1Bag.name(),
         &e,
         posecov::uncertain::Confidence::DEFAULT,
     );

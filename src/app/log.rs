@@ -89,7 +89,12 @@ pub(super) fn run(
         confidence: settings.confidence,
         axis_length: None,
     };
-    let summary = description(&plan, located.format, &evaluation, settings.confidence);
+    let summary = description(
+        &plan,
+        located.format.name(),
+        &evaluation,
+        settings.confidence,
+    );
     let scene = if drawn {
         let scene = draw_log(&evaluation, &draw, &summary);
         scene

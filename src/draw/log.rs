@@ -28,8 +28,8 @@ use nalgebra::Vector3;
 
 use super::{Painter, v3, views};
 use crate::eval::log::{LogEvaluation, TopicEvaluation};
-use crate::input::{About, Layout};
 use crate::lie::GroupKind;
+use crate::plan::choices::{About, Layout};
 use crate::scene::layout::views_aspect;
 use crate::scene::{
     Color, ItemKind, LineStrips, Scene, Swatch, Timeline, Timing, Vec3, View3d, WORLD,
@@ -72,13 +72,13 @@ pub struct LogDrawSettings {
 /// ```
 /// use posecov::draw::log::{LogDrawSettings, draw_log, description};
 /// use posecov::eval::log::{LogEvalSettings, evaluate_log};
-/// use posecov::input::{About, Format, log::{LogOptions, read_log}};
+/// use posecov::input::{About, log::{LogOptions, read_log}};
 /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
 /// let mut plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
 /// let e = evaluate_log(&mut plan, &LogEvalSettings::default());
 /// let about = About { title: "test2.bag".into(), description: String::new(), source: String::new() };
 /// let settings = LogDrawSettings { about, confidence: posecov::uncertain::Confidence::DEFAULT, axis_length: None };
-/// let scene = draw_log(&e, &settings, &description(&plan, Format::Ros1Bag, &e, posecov::uncertain::Confidence::DEFAULT));
+/// let scene = draw_log(&e, &settings, &description(&plan, "ROS 1 bag", &e, posecov::uncertain::Confidence::DEFAULT));
 /// assert!(scene.validate().is_ok());
 /// let topic = "world/jackal_velocity_controller/odom";
 /// assert!(scene.items.iter().any(|i| i.path == format!("{topic}/meaning/banana")));
@@ -319,168 +319,4 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation, rviz_note: bool) {
         }
     }
     robot::robot_view(p, &base, t);
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::eval::log::{LogEvalSettings, evaluate_log};
-    use crate::input::log::{LogOptions, read_log};
-    use crate::scene::Ellipsoid;
-
-    /// The scene's whole-log views (one per frame; the robot views left out).
-    fn whole_log_views(scene: &Scene) -> Vec<&View3d> {
-        scene
-            .views
-            .iter()
-            .filter(|v| v.name.starts_with("frame "))
-            .collect()
-    }
-
-    /// The scene of a log under `tests/data/`, drawn with the defaults.
-    fn scene_of(file: &str) -> Scene {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data")
-            .join(file);
-        let mut plan = read_log(&path, &LogOptions::default(), &mut |_, _| {}, None).unwrap();
-        let e = evaluate_log(&mut plan, &LogEvalSettings::default());
-        let settings = LogDrawSettings {
-            about: About {
-                title: "t".into(),
-                description: String::new(),
-                source: String::new(),
-            },
-            confidence: Confidence::DEFAULT,
-            axis_length: None,
-        };
-        let scene = draw_log(&e, &settings, "");
-        scene.validate().unwrap();
-        scene
-    }
-
-    fn eye_distance(view: &View3d) -> f64 {
-        let c = view.camera.expect("a camera");
-        let d: Vector3<f64> = Vector3::from(c.position) - Vector3::from(c.target);
-        d.norm()
-    }
-
-    #[test]
-    fn the_robot_view_is_at_the_scale_of_the_covariance() {
-        // test2.bag: 84 m of driving, σx = σy = 31.6 mm, Σzz = 1e6 (a placeholder).
-        let scene = scene_of("robot_localization/test2.bag");
-        let [whole, robot] = scene.views.as_slice() else {
-            panic!("{:?}", scene.views);
-        };
-        assert_eq!(whole.name, "frame odom: the whole log");
-        // The 95 % position region is r σ = 2.448 × 31.6 mm = 77 mm wide each way: the robot
-        // view's eye stands well under a metre away, the whole log's tens of metres.
-        assert!(eye_distance(robot) < 1.0, "{:?}", robot.camera);
-        assert!(eye_distance(whole) > 20.0, "{:?}", whole.camera);
-        // RViz's ellipse is its 7.7 cm, not the 10–24 m an eigen solver gives with the 1e6 in
-        // place; the clipped z placeholder is 3 × that, and labelled in the whole-log view.
-        let rviz: Vec<&Ellipsoid> = scene
-            .items
-            .iter()
-            .filter(|i| i.path.ends_with("/rviz/position"))
-            .flat_map(|i| match &i.kind {
-                ItemKind::Ellipsoids(e) => e.shapes.iter().collect(),
-                _ => Vec::new(),
-            })
-            .collect();
-        assert!(!rviz.is_empty());
-        let xy = 2.4477 * 0.001f64.sqrt();
-        for shape in rviz {
-            let mut h = shape.half_sizes;
-            h.sort_by(f64::total_cmp);
-            assert!(
-                (h[0] - xy).abs() < 1e-3 && (h[1] - xy).abs() < 1e-3,
-                "{h:?}"
-            );
-            assert!((h[2] - 3.0 * h[1]).abs() < 1e-9, "{h:?}");
-        }
-        let labelled = scene.items.iter().any(|i| {
-            !i.path.contains("/robot/")
-                && matches!(&i.kind, ItemKind::Ellipsoids(e)
-                    if e.label.as_deref() == Some("RViz: z placeholder (σ² ≥ 1e6), clipped"))
-        });
-        assert!(labelled);
-        // The robot view's pose says the message's σ.
-        let label = scene.items.iter().rev().find_map(|i| match &i.kind {
-            ItemKind::Frame(f) if i.path.ends_with("/robot/pose") => f.label.clone(),
-            _ => None,
-        });
-        let label = label.expect("a labelled robot pose");
-        assert!(
-            label.ends_with(": σx 31.6 mm, σy 31.6 mm, σyaw 9.92°"),
-            "{label}"
-        );
-        // Plots in mm and degrees, fitted from 0 to just above the constant σ.
-        let plot = &scene.plots[0];
-        assert_eq!(plot.label(), "σ xy (mm)");
-        let [low, high] = plot.range.unwrap();
-        assert!(low == 0.0 && (high - 1.15 * 31.623).abs() < 0.01, "{high}");
-        assert_eq!(scene.plots[1].label(), "σ yaw (°)");
-    }
-
-    #[test]
-    fn topics_in_different_frames_are_never_overlaid() {
-        // The health-case MCAP: /planar/odom in `odom`, /amcl_pose in `map`, /bare without a
-        // header (no frame_id).
-        let scene = scene_of("mcap/health_cases.mcap");
-        let whole = whole_log_views(&scene);
-        assert_eq!(whole.len(), 3, "{:?}", scene.views);
-        for view in &whole {
-            // Each frame's view shows its own topics only, their robot views left out.
-            assert_eq!(view.include.len(), 1, "{view:?}");
-            assert_eq!(view.exclude, vec![format!("{}/robot", view.include[0])]);
-            assert!(view.camera.is_some());
-        }
-        let robot = scene.views.len() - whole.len();
-        assert_eq!(robot, 3, "one robot view per topic with a drawn pose");
-        // The robot view's items sit at the origin: its frame at each stamp.
-        let frames = scene.items.iter().filter(|i| {
-            i.path.ends_with("/robot/pose")
-                && matches!(&i.kind, ItemKind::Frame(f) if f.translation[..2] == [0.0, 0.0])
-        });
-        assert!(frames.count() > 0);
-    }
-
-    #[test]
-    fn rviz_s_placeholder_note_is_said_once_per_view() {
-        // amcl_tf.mcap: /amcl_pose and /odom (joined into `map` through /tf), one view, both
-        // with RViz's z placeholder, drawn at much the same place. The note is on one topic's
-        // shapes only; both shapes are still drawn clipped.
-        let scene = scene_of("mcap/amcl_tf.mcap");
-        let whole = whole_log_views(&scene);
-        assert_eq!(whole.len(), 1, "{:?}", scene.views);
-        assert_eq!(whole[0].include.len(), 2, "{:?}", whole[0]);
-        let shapes = |labelled: bool| -> BTreeMap<String, usize> {
-            let mut by_topic = BTreeMap::new();
-            for i in &scene.items {
-                if let ItemKind::Ellipsoids(e) = &i.kind
-                    && i.path.ends_with("/rviz/position")
-                    && !i.path.contains("/robot/")
-                    && e.label.is_some() == labelled
-                {
-                    *by_topic.entry(i.path.clone()).or_insert(0) += 1;
-                }
-            }
-            by_topic
-        };
-        let labelled = shapes(true);
-        assert_eq!(labelled.len(), 1, "{labelled:?}");
-        let (path, count) = labelled.iter().next().unwrap();
-        assert!(*count > 1, "{labelled:?}");
-        // The other topic's shapes are drawn, unlabelled.
-        let unlabelled = shapes(false);
-        assert!(unlabelled.keys().any(|p| p != path), "{unlabelled:?}");
-        let note = scene.items.iter().find_map(|i| match &i.kind {
-            ItemKind::Ellipsoids(e) if i.path == *path => e.label.clone(),
-            _ => None,
-        });
-        assert_eq!(
-            note.as_deref(),
-            Some("RViz: z placeholder (σ² ≥ 1e6), clipped")
-        );
-    }
 }

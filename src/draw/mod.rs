@@ -22,7 +22,7 @@
 //! use posecov::draw::{DrawSettings, scene};
 //! let loaded = load_text("[scenario]\ntitle='t'\ngroup='se2'\nmethods=['first_order']\n[[pose]]\nname='a'\nmean={xy_theta=[1,2,0]}\ncov={std=[0.1,0.1,0.3]}\n", "t.toml").unwrap();
 //! let (evaluation, _) = pipeline(&loaded, &Overrides::default(), None).unwrap();
-//! let s = scene(&evaluation, &DrawSettings::from_input(&loaded.input, posecov::uncertain::Confidence::DEFAULT));
+//! let s = scene(&evaluation, &DrawSettings::new(loaded.input.about.clone(), loaded.input.draw.clone(), posecov::uncertain::Confidence::DEFAULT));
 //! assert!(s.items.iter().any(|i| i.path == "world/a/given/banana"));
 //! assert!(s.validate().is_ok());
 //! ```
@@ -34,9 +34,9 @@ use std::sync::atomic::{AtomicU64, Ordering as AtomicOrdering};
 use nalgebra::Vector3;
 
 use crate::eval::{AnyEvaluation, Evaluation, Node, PathKind, Role};
-use crate::input::{About, DrawChoices, Input, Layout};
 use crate::lie::{GroupKind, LieGroup, Se3};
 use crate::plan::StepPolicy;
+use crate::plan::choices::{About, DrawChoices, Layout};
 use crate::scene::WORLD;
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, Scene,
@@ -74,7 +74,7 @@ pub struct DrawSettings {
 }
 
 impl DrawSettings {
-    /// The settings an input asks for, at `confidence`, with the default step policy.
+    /// What an input is about and asks to draw, at `confidence`, with the default step policy.
     ///
     /// ```
     /// use posecov::draw::DrawSettings;
@@ -82,13 +82,13 @@ impl DrawSettings {
     /// use posecov::uncertain::Confidence;
     /// let input = lower(&Scenario::load_any("camera_on_robot").unwrap()).unwrap();
     /// let p = Confidence::new(0.9).unwrap();
-    /// assert_eq!(DrawSettings::from_input(&input, p).confidence, p);
+    /// assert_eq!(DrawSettings::new(input.about, input.draw, p).confidence, p);
     /// ```
-    pub fn from_input(input: &Input, confidence: Confidence) -> Self {
+    pub fn new(about: About, choices: DrawChoices, confidence: Confidence) -> Self {
         Self {
-            about: input.about.clone(),
+            about,
             confidence,
-            choices: input.draw.clone(),
+            choices,
             steps: StepPolicy::default(),
         }
     }

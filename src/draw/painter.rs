@@ -6,9 +6,9 @@ use nalgebra::Vector3;
 
 use super::{DrawSettings, legend, scene_extent, views};
 use crate::eval::{Evaluation, Node};
-use crate::input::Layout;
 use crate::lie::{GroupKind, LieGroup};
 use crate::plan::StepPolicy;
+use crate::plan::choices::Layout;
 use crate::scene::{
     Color, Ellipsoids, FillMode, ItemKind, LineStrips, Scene, SceneItem, Surface, Swatch, Timing,
 };

@@ -18,7 +18,7 @@
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
-use crate::input::{CameraChoice, Layout};
+use crate::plan::choices::{CameraChoice, Layout};
 use crate::scene::WORLD;
 use crate::scene::layout::views_aspect;
 use crate::scene::{Camera, ItemKind, Scene, SceneItem, Vec3, View3d, rotate};

@@ -97,7 +97,7 @@ impl PoseMessageKind {
 
 /// A decoded pose with covariance, in ROS's own layout and meaning
 /// ([CONVENTIONS §6](crate::conventions#6-ros-posewithcovariance)): the one message struct of
-/// the log wing, from the decoders ([`crate::input::log::decode`]) to the drawn messages.
+/// the log wing, from the decoders (`input::log::decode`) to the drawn messages.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PoseMessage {
     /// When: the header stamp, or the log time when the header has none (see `from_log_time`),

@@ -25,6 +25,8 @@ pub(super) struct Prepared {
     value: String,
     /// A bare value read as a file.
     either_file: bool,
+    /// The value was bare ([`ReferenceArg::Either`]): a topic or a file, not said which.
+    bare: bool,
 }
 
 /// Reads the reference's file, if it is one, and sets up the observer.
@@ -50,6 +52,7 @@ pub(super) fn prepare(
             in_log: None,
             value: value.to_owned(),
             either_file: false,
+            bare: false,
         })
     };
     Ok(match &reference.arg {
@@ -59,6 +62,7 @@ pub(super) fn prepare(
             in_log: Some(ReferenceInLog::Topic(name.clone())),
             value: format!("topic:{name}"),
             either_file: false,
+            bare: false,
         },
         ReferenceArg::Tf(child) => Prepared {
             observer: NeesObserver::new(settings(format!("tf:{child}"), None, true)),
@@ -67,11 +71,13 @@ pub(super) fn prepare(
             }),
             value: format!("tf:{child}"),
             either_file: false,
+            bare: false,
         },
         ReferenceArg::Either(value) if Path::new(value).is_file() => {
             let mut p = tum(value, value)?;
             p.in_log = Some(ReferenceInLog::Topic(value.clone()));
             p.either_file = true;
+            p.bare = true;
             p
         }
         ReferenceArg::Either(value) => Prepared {
@@ -79,6 +85,7 @@ pub(super) fn prepare(
             in_log: Some(ReferenceInLog::Topic(value.clone())),
             value: value.clone(),
             either_file: false,
+            bare: true,
         },
     })
 }
@@ -112,8 +119,7 @@ pub(super) fn finish(
             )));
         }
         (Some(ReferenceInLog::Topic(name)), false) if !read.found => {
-            let bare = !value.starts_with("topic:");
-            return Err(error(if bare {
+            return Err(error(if prepared.bare {
                 format!(
                     "neither a topic of this log nor a file; say `topic:NAME` or `file:PATH` (its topics: {})",
                     topics.join(", ")

@@ -4,7 +4,6 @@
 use std::fmt::Write;
 
 use crate::eval::log::{LogEvaluation, PoseState};
-use crate::input::Format;
 use crate::interop::RosReading;
 use crate::plan::log::{Class, Issue, LogSummary, TopicSummary};
 use crate::uncertain::Confidence;
@@ -155,19 +154,18 @@ pub fn issue_sentence(issue: Issue, t: &TopicSummary) -> String {
     }
 }
 
-/// The Markdown summary of a log (a `format` file): per topic its type, frames, counts, stamps, health (count
+/// The Markdown summary of a log (a `format` file, its format's name, e.g. `ROS 1 bag`): per topic its type, frames, counts, stamps, health (count
 /// and first stamp per issue), what is drawn (planar or 3-D, χ² dimensions), then the skipped
 /// topics.
 ///
 /// See [`draw_log`](super::draw_log) for an example.
 pub fn description(
     plan: &LogSummary,
-    format: Format,
+    format: &str,
     e: &LogEvaluation,
     confidence: Confidence,
 ) -> String {
     let mut s = String::new();
-    let format = format.name();
     let defects: u64 = plan
         .topics
         .iter()

@@ -1,0 +1,103 @@
+//! What an input asks to be drawn, typed and free of file places: the input stage checks a
+//! file's `[draw]` table (and a log's or graph's defaults) into these, and the draw stage reads
+//! them (`draw` never imports `input`).
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+/// What an input describes, for the text panel and `posecov list`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct About {
+    /// One-line title.
+    pub title: String,
+    /// Markdown: what the picture teaches.
+    pub description: String,
+    /// Where the example comes from (lecture, paper, figure), or empty.
+    pub source: String,
+}
+
+/// What an input file asks to draw (validated).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DrawChoices {
+    /// Mean frames as axis triads.
+    pub axes: bool,
+    /// Monte Carlo sample positions.
+    pub clouds: bool,
+    /// Axis triads (or headings) on a subsample of the samples.
+    pub sample_axes: bool,
+    /// Cartesian position ellipsoids.
+    pub ellipsoids: bool,
+    /// Exp-mapped banana surfaces.
+    pub bananas: bool,
+    /// Orientation sprays and their Exp-mapped ellipses.
+    pub orientation: bool,
+    /// Nominal and sampled trajectories.
+    pub trajectories: bool,
+    /// Length of the mean frames' axes (m), if given.
+    pub axis_length: Option<f64>,
+    /// Face the x–y plane from above (`Some(true)`), or not; `None`: by group.
+    pub top_view: Option<bool>,
+    /// Per pose name, whether to draw it (overrides the default rule).
+    pub shown: BTreeMap<String, bool>,
+    /// Pairs of pose names joined by a line (a pose graph's loop closures).
+    pub links: Vec<(String, String)>,
+    /// Whether frames carry their names (off for a graph's many vertices).
+    pub labels: bool,
+    /// Where the 3-D camera looks from, if the file says; `None`: chosen per scene.
+    pub camera: Option<CameraChoice>,
+    /// How the 3-D views split the methods and poses; `None`: chosen per scene.
+    pub layout: Option<Layout>,
+}
+
+/// A camera asked for by an input (`[draw] camera = {...}`), every part optional: the eye at
+/// `position`, or at the distance that fits the scene along `direction` (from the target
+/// towards the eye); looking at `target` (default: the middle of what is drawn); `up` the
+/// world direction shown up on screen (default +z).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CameraChoice {
+    /// Eye position, world frame (m).
+    pub position: Option<[f64; 3]>,
+    /// Direction from the target towards the eye (any length > 0).
+    pub direction: Option<[f64; 3]>,
+    /// The point looked at, world frame (m).
+    pub target: Option<[f64; 3]>,
+    /// World direction up on screen.
+    pub up: Option<[f64; 3]>,
+}
+
+/// How the 3-D views show several methods and poses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Layout {
+    /// One view, every method drawn and shown.
+    Together,
+    /// One view: the main method in full and Monte Carlo shown, the other methods' outlines
+    /// hidden at first (one click away in the entity tree).
+    Main,
+    /// One view per method, each with the Monte Carlo cloud.
+    PerMethod,
+    /// One view per drawn pose (rotations that would all sit at the origin).
+    PerPose,
+}
+
+impl Default for DrawChoices {
+    fn default() -> Self {
+        Self {
+            axes: true,
+            clouds: true,
+            sample_axes: true,
+            ellipsoids: true,
+            bananas: true,
+            orientation: true,
+            trajectories: true,
+            axis_length: None,
+            top_view: None,
+            shown: BTreeMap::new(),
+            links: Vec::new(),
+            labels: true,
+            camera: None,
+            layout: None,
+        }
+    }
+}
