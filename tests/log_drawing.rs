@@ -1,6 +1,8 @@
 //! The log's drawing on real logs under `tests/data/`: read, evaluated and drawn through the
 //! library's stages (a cross-stage test, so it lives here and not in `draw`).
 
+use std::collections::BTreeMap;
+
 use nalgebra::Vector3;
 use posecov::draw::log::{LogDrawSettings, draw_log};
 use posecov::eval::log::{LogEvalSettings, evaluate_log};

@@ -206,16 +206,9 @@ impl Loaded {
     /// assert!(e.to_string().starts_with("camera_on_robot.toml (bundled):"), "{e}");
     /// ```
     pub fn locate(&self, error: &EvalError) -> InputError {
-        let message = error.to_string();
-        // The location names the operation; keep its output's name, drop the repeated index.
-        let message = match error.operation() {
-            Some(i) => message
-                .strip_prefix(&format!("operation[{i}] "))
-                .unwrap_or(&message)
-                .to_owned(),
-            None => message,
-        };
-        self.source.operation_error(error.operation(), message)
+        // The location names the operation; keep its output's name, not the repeated index.
+        self.source
+            .operation_error(error.operation(), error.without_place())
     }
 }
 

@@ -156,7 +156,7 @@ pub enum EvalError {
         source: crate::Error,
     },
     /// An operand refers to a definition that does not exist yet, or is not a pose.
-    #[error("operation[{operation}] (`{output}`): operand {definition} is not an earlier pose")]
+    #[error("operation[{operation}] {}", self.without_place())]
     Undefined {
         /// Operation index.
         operation: usize,
@@ -166,7 +166,7 @@ pub enum EvalError {
         definition: usize,
     },
     /// An operation that the plan's group cannot do.
-    #[error("operation[{operation}] (`{output}`): {what} is not available for {group}")]
+    #[error("operation[{operation}] {}", self.without_place())]
     WrongGroup {
         /// Operation index.
         operation: usize,
@@ -178,9 +178,7 @@ pub enum EvalError {
         group: &'static str,
     },
     /// The work asked for exceeds [`limits::MAX_PARTICLE_STEPS`].
-    #[error(
-        "operation[{operation}] (`{output}`): {samples} samples × {steps} steps = {work:.2e} particle-steps in all exceeds the limit {limit:.0e}; lower the samples or the steps"
-    )]
+    #[error("operation[{operation}] {}", self.without_place())]
     TooMuchWork {
         /// Operation index (where the limit is crossed).
         operation: usize,
@@ -196,10 +194,7 @@ pub enum EvalError {
         limit: f64,
     },
     /// The result is not finite: an input too large, a noise too strong, a parameter too small.
-    #[error(
-        "operation[{operation}] (`{output}`{}): the {method} result is not finite (overflow); check the magnitudes of its inputs and parameters",
-        step.map_or(String::new(), |k| format!(", step {k}"))
-    )]
+    #[error("operation[{operation}] {}", self.without_place())]
     NonFinite {
         /// Operation index.
         operation: usize,
@@ -211,10 +206,7 @@ pub enum EvalError {
         method: &'static str,
     },
     /// Fusion failed; `input` is the position in `inputs` of the estimate at fault, if one is.
-    #[error(
-        "operation[{operation}] (`{output}`): fusion failed{}: {source}",
-        input.map_or(String::new(), |i| format!(" at inputs[{i}]"))
-    )]
+    #[error("operation[{operation}] {}", self.without_place())]
     Fusion {
         /// Operation index.
         operation: usize,
@@ -226,7 +218,7 @@ pub enum EvalError {
         source: crate::Error,
     },
     /// The library refused (e.g. an invalid robot, a singular joint covariance).
-    #[error("operation[{operation}] (`{output}`): {source}")]
+    #[error("operation[{operation}] {}", self.without_place())]
     Math {
         /// Operation index.
         operation: usize,
@@ -238,6 +230,62 @@ pub enum EvalError {
 }
 
 impl EvalError {
+    /// The message without its place (`operation[i] `): what a located error says after the
+    /// file's own place for that operation ([`crate::app::Loaded::locate`]). Errors of no
+    /// operation are their whole message.
+    ///
+    /// ```
+    /// use posecov::eval::EvalError;
+    /// let e = EvalError::Undefined { operation: 2, output: "x".into(), definition: 9 };
+    /// assert_eq!(e.without_place(), "(`x`): operand 9 is not an earlier pose");
+    /// assert_eq!(e.to_string(), "operation[2] (`x`): operand 9 is not an earlier pose");
+    /// ```
+    pub fn without_place(&self) -> String {
+        match self {
+            EvalError::Setting { .. } | EvalError::Pose { .. } | EvalError::Graph(_) => {
+                self.to_string()
+            }
+            EvalError::Undefined {
+                output, definition, ..
+            } => format!("(`{output}`): operand {definition} is not an earlier pose"),
+            EvalError::WrongGroup {
+                output,
+                what,
+                group,
+                ..
+            } => format!("(`{output}`): {what} is not available for {group}"),
+            EvalError::TooMuchWork {
+                output,
+                samples,
+                steps,
+                work,
+                limit,
+                ..
+            } => format!(
+                "(`{output}`): {samples} samples × {steps} steps = {work:.2e} particle-steps in all exceeds the limit {limit:.0e}; lower the samples or the steps"
+            ),
+            EvalError::NonFinite {
+                output,
+                step,
+                method,
+                ..
+            } => format!(
+                "(`{output}`{}): the {method} result is not finite (overflow); check the magnitudes of its inputs and parameters",
+                step.map_or(String::new(), |k| format!(", step {k}"))
+            ),
+            EvalError::Fusion {
+                output,
+                input,
+                source,
+                ..
+            } => format!(
+                "(`{output}`): fusion failed{}: {source}",
+                input.map_or(String::new(), |i| format!(" at inputs[{i}]"))
+            ),
+            EvalError::Math { output, source, .. } => format!("(`{output}`): {source}"),
+        }
+    }
+
     /// The index of the operation the error is about, if any.
     ///
     /// ```
