@@ -50,7 +50,7 @@ pub struct Inputs {
 /// let one = expand(&["camera_on_robot".to_owned()]).unwrap();
 /// assert_eq!((one.names.len(), one.several), (1, false));
 /// let empty = concat!(env!("CARGO_MANIFEST_DIR"), "/src");
-/// assert!(expand(&[empty.to_owned()]).unwrap_err().to_string().ends_with("no robot log (.bag, .mcap, .db3) in this directory"));
+/// assert!(expand(&[empty.to_owned()]).unwrap_err().to_string().ends_with("no robot log (.bag, .mcap, .db3, or a ROS 2 bag directory) in this directory"));
 /// let bags = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ros2");
 /// let inputs = expand(&[bags.to_owned()]).unwrap();
 /// assert_eq!(inputs.names.len(), 6); // arc.mcap and five bag directories
@@ -94,7 +94,10 @@ pub fn expand(args: &[String]) -> Result<Inputs, AppError> {
             let listed: Vec<String> = extensions.iter().map(|e| format!(".{e}")).collect();
             return Err(AppError::Input(InputError::Read {
                 path: arg.clone(),
-                reason: format!("no robot log ({}) in this directory", listed.join(", ")),
+                reason: format!(
+                    "no robot log ({}, or a ROS 2 bag directory) in this directory",
+                    listed.join(", ")
+                ),
             }));
         }
         logs.sort();
@@ -109,7 +112,8 @@ pub fn expand(args: &[String]) -> Result<Inputs, AppError> {
 /// Whether `path` is a ROS 2 bag directory (it holds `metadata.yaml`): one log, not a
 /// directory of logs.
 fn is_bag_dir(path: &Path) -> bool {
-    path.join(crate::input::log::rosbag2::METADATA_FILE).is_file()
+    path.join(crate::input::log::rosbag2::METADATA_FILE)
+        .is_file()
 }
 
 /// Runs `work` on every input in parallel under one progress bar; `done` gets each result as

@@ -266,7 +266,7 @@ fn expected() -> String {
 /// assert_eq!(detect("a.g2o", b"VERTEX2 0 0 0 0\n").unwrap(), Format::Graph);
 /// assert_eq!(detect("noext", b"EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n").unwrap(), Format::Graph);
 /// let e = detect("a.bag", b"\x89MCAP0\r\n").unwrap_err().to_string();
-/// assert!(e.starts_with("a.bag: the extension .bag says ROS 1 log, but its content is a MCAP file"), "{e}");
+/// assert!(e.starts_with("a.bag: the extension .bag says ROS 1 bag, but its content is a MCAP file"), "{e}");
 /// assert_eq!(detect("run_0.db3", b"SQLite format 3\0...").unwrap(), Format::Ros2Sqlite);
 /// let e = detect("notes.csv", b"1,2,3\n").unwrap_err().to_string();
 /// assert!(e.starts_with("notes.csv: not a file posecov reads"), "{e}");
@@ -294,13 +294,15 @@ pub fn detect(file: &str, head: &[u8]) -> Result<Format, InputError> {
             what_identifies(c)
         ))),
         (None, Some(c)) => Ok(c),
-        (Some(e @ (Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite)), None) => Err(error(format!(
-            "the extension .{extension} says {}, but {} (a {} starts with {})",
-            e.name(),
-            describe(head),
-            e.name(),
-            what_identifies(e)
-        ))),
+        (Some(e @ (Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite)), None) => {
+            Err(error(format!(
+                "the extension .{extension} says {}, but {} (a {} starts with {})",
+                e.name(),
+                describe(head),
+                e.name(),
+                what_identifies(e)
+            )))
+        }
         (Some(e), None) => match super::not_text(file, head, &format!("a {}", e.name())) {
             // A multi-byte character cut by the sniffed length is not the file's end.
             Some(_) if head.len() == SNIFF_BYTES && first_text_line(head).is_some() => Ok(e),

@@ -278,7 +278,9 @@ fn open_file_as(path: &Path, format: Format) -> Result<(Source, Input), InputErr
             let (g, input) = graph::read_file(path)?;
             Ok((Source::Graph(g), input))
         }
-        Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite => Err(not_a_plan(&path.display().to_string(), format)),
+        Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite => {
+            Err(not_a_plan(&path.display().to_string(), format))
+        }
     }
 }
 

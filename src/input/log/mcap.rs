@@ -139,12 +139,24 @@ impl Streams {
                 message_encoding,
             } => {
                 let (schema, encoding) = self.schemas.get(&schema_id).cloned().unwrap_or_default();
-                let other = || format!("{schema} in {message_encoding} encoding (schema {encoding}); posecov reads cdr or ros1");
+                let other = || {
+                    format!(
+                        "{schema} in {message_encoding} encoding (schema {encoding}); posecov reads cdr or ros1"
+                    )
+                };
                 // `mcap convert` of a ROS 1 bag writes ROS 1 names and bytes (no MD5 sum:
                 // the definition is the schema's text).
                 let (kind, reference, codec) = match message_encoding.as_str() {
-                    "cdr" => (ros2_kind(&schema).map(Ok), ros2_reference_type(&schema).map(Ok), Codec::Cdr),
-                    "ros1" => (ros1_kind(&schema, "*"), ros1_reference_type(&schema, "*"), Codec::Ros1),
+                    "cdr" => (
+                        ros2_kind(&schema).map(Ok),
+                        ros2_reference_type(&schema).map(Ok),
+                        Codec::Cdr,
+                    ),
+                    "ros1" => (
+                        ros1_kind(&schema, "*"),
+                        ros1_reference_type(&schema, "*"),
+                        Codec::Ros1,
+                    ),
                     _ => (
                         ros2_kind(&schema).map(|_| Err(other())),
                         ros2_reference_type(&schema).map(|_| Err(other())),

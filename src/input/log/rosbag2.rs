@@ -52,7 +52,6 @@ struct Entry<'a> {
     key: &'a str,
     value: &'a str,
     line: usize,
-    column: usize,
     items: Vec<(&'a str, usize)>,
 }
 
@@ -78,7 +77,9 @@ fn unquote(s: &str) -> String {
         return s[1..s.len() - 1].replace("''", "'");
     }
     if s.len() >= 2 && s.starts_with('"') && s.ends_with('"') {
-        return s[1..s.len() - 1].replace("\\\"", "\"").replace("\\\\", "\\");
+        return s[1..s.len() - 1]
+            .replace("\\\"", "\"")
+            .replace("\\\\", "\\");
     }
     s.to_owned()
 }
@@ -111,11 +112,12 @@ fn entries(text: &str) -> Vec<Entry<'_>> {
                 key: key.trim(),
                 value: value.trim(),
                 line,
-                column: indent + 1,
                 items: Vec::new(),
             });
         } else if let Some(last) = out.last_mut()
-            && let Some(item) = content.strip_prefix("- ").or((content == "-").then_some(""))
+            && let Some(item) = content
+                .strip_prefix("- ")
+                .or((content == "-").then_some(""))
         {
             // Items of a block sequence under the last key (at its indentation or deeper);
             // the nested lines of an item that is a mapping are not items of their own.
@@ -144,23 +146,16 @@ fn entries(text: &str) -> Vec<Entry<'_>> {
 /// assert_eq!((m.version, m.storage, m.compression), (5, Format::Ros2Sqlite, Compression::File));
 /// assert_eq!(m.files, [("run_0.db3".to_owned(), 5), ("run_1.db3".to_owned(), 6)]);
 /// let e = parse_metadata("version: 9\nstorage_identifier: rosbag_v2\nrelative_file_paths: [a]\n", "m.yaml").unwrap_err();
-/// assert!(e.to_string().starts_with("m.yaml:2:21: storage_identifier: \"rosbag_v2\""), "{e}");
+/// assert!(e.to_string().starts_with("m.yaml: line 2, storage_identifier: \"rosbag_v2\""), "{e}");
 /// ```
 pub fn parse_metadata(text: &str, file: &str) -> Result<BagMetadata, InputError> {
     let entries = entries(text);
-    let source = |line: usize| text.lines().nth(line - 1).unwrap_or("").to_owned();
-    let at = |e: &Entry<'_>, message: String| {
-        let column = source(e.line).find(':').map_or(e.column, |c| {
-            c + 2 + source(e.line)[c + 1..].len() - source(e.line)[c + 1..].trim_start().len()
-        });
-        InputError::At {
-            file: file.to_owned(),
-            line: e.line,
-            column,
-            field: e.key.to_owned(),
-            message,
-            source_line: source(e.line),
-        }
+    // A log's metadata, located by line and key; an error in it is a log that cannot be
+    // read (exit 2), as a damaged bag is, not a scenario's located error.
+    let at = |e: &Entry<'_>, message: String| InputError::In {
+        file: file.to_owned(),
+        place: format!("line {}, {}", e.line, e.key),
+        message,
     };
     let missing = |key: &str| InputError::Format {
         file: file.to_owned(),
@@ -174,7 +169,10 @@ pub fn parse_metadata(text: &str, file: &str) -> Result<BagMetadata, InputError>
     let version_number = unquote(version.value).parse::<u32>().map_err(|_| {
         at(
             version,
-            format!("{:?} is not a version number (rosbag2 writes 1 to 9)", version.value),
+            format!(
+                "{:?} is not a version number (rosbag2 writes 1 to 9)",
+                version.value
+            ),
         )
     })?;
     let storage = get("storage_identifier").ok_or_else(|| missing("storage_identifier"))?;
@@ -268,17 +266,14 @@ pub fn read_metadata(dir: &Path) -> Result<(BagMetadata, Vec<PathBuf>), InputErr
                 i if i + 1 == n => "the last".to_owned(),
                 _ => "a middle".to_owned(),
             };
-            return Err(InputError::At {
+            return Err(InputError::In {
                 file: file.clone(),
-                line: *line,
-                column: 1,
-                field: format!("relative_file_paths[{i}]"),
+                place: format!("line {line}, relative_file_paths[{i}]"),
                 message: format!(
                     "{name}: no such file in {} (file {} of {n}: {which} file of this bag is missing)",
                     dir.display(),
                     i + 1
                 ),
-                source_line: text.lines().nth(line - 1).unwrap_or("").to_owned(),
             });
         }
         paths.push(p);
@@ -413,10 +408,16 @@ mod tests {
         let text = "version: 9\nstorage_identifier: sqlite3\nrelative_file_paths:\n- a.db3\n\
                     compression_format: lz4\ncompression_mode: message\n";
         let e = parse_metadata(text, "m").unwrap_err().to_string();
-        assert!(e.starts_with("m:5:21: compression_format: \"lz4\""), "{e}");
+        assert!(
+            e.starts_with("m: line 5, compression_format: \"lz4\""),
+            "{e}"
+        );
         let text = text.replace("lz4", "zstd").replace("message", "chunk");
         let e = parse_metadata(&text, "m").unwrap_err().to_string();
-        assert!(e.starts_with("m:6:19: compression_mode: \"chunk\""), "{e}");
+        assert!(
+            e.starts_with("m: line 6, compression_mode: \"chunk\""),
+            "{e}"
+        );
         let e = parse_metadata("a: 1\n", "m").unwrap_err().to_string();
         assert!(e.contains("no `version`"), "{e}");
     }

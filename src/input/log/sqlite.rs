@@ -10,7 +10,7 @@
 //! MCAP's are.
 //!
 //! A file that is not SQLite, or whose pages are damaged, ends with a located error: the
-//! table, the last row read, and SQLite's own check of the file (the damaged page).
+//! table, the last row read, and the damaged pages SQLite finds.
 
 use std::collections::HashMap;
 use std::io::Read as _;
@@ -44,14 +44,16 @@ pub(super) fn read(
         place,
         message,
     };
-    check_magic(path)?;
+    let cut = check_magic(path)?;
     let db = Connection::open_with_flags(
         path,
         OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
     )
     .map_err(|e| fail(format!("SQLite cannot open it: {e}")))?;
-    let damaged = |what: &str, e: rusqlite::Error| fail(format!("{what}: {e}{}", check(&db)));
-    let tables = tables(&db).map_err(|e| damaged("its list of tables cannot be read", e))?;
+    let damaged = |what: &str, e: rusqlite::Error| {
+        fail(format!("SQLite cannot read {what}: {e}{}{cut}", check(&db)))
+    };
+    let tables = tables(&db).map_err(|e| damaged("its list of tables", e))?;
     for needed in ["topics", "messages"] {
         if !tables.iter().any(|t| t == needed) {
             return Err(fail(format!(
@@ -76,7 +78,9 @@ pub(super) fn read(
         collector.declare_stream(&stream.0);
     }
     let rows: i64 = db
-        .query_row("SELECT coalesce(max(id), 0) FROM messages", [], |r| r.get(0))
+        .query_row("SELECT coalesce(max(id), 0) FROM messages", [], |r| {
+            r.get(0)
+        })
         .map_err(|e| damaged("table messages", e))?;
     let total = u64::try_from(rows).unwrap_or(0).max(1);
     let mut statement = db
@@ -90,8 +94,7 @@ pub(super) fn read(
     let mut unpacked = Vec::new();
     let mut decompressor = match compression {
         Compression::Message => Some(
-            zstd::bulk::Decompressor::new()
-                .map_err(|e| fail(format!("zstd cannot start: {e}")))?,
+            zstd::bulk::Decompressor::new().map_err(|e| fail(format!("zstd cannot start: {e}")))?,
         ),
         _ => None,
     };
@@ -104,7 +107,10 @@ pub(super) fn read(
                     Some(id) => format!("after row id {id} ({read_rows} messages read)"),
                     None => "before its first row".to_owned(),
                 };
-                return Err(at(format!("table messages, {after}"), format!("{e}{}", check(&db))));
+                return Err(at(
+                    format!("table messages, {after}"),
+                    format!("{e}{}{cut}", check(&db)),
+                ));
             }
         };
         let fields = (|| -> rusqlite::Result<(i64, i64, i64, &[u8])> {
@@ -156,17 +162,22 @@ pub(super) fn read(
 }
 
 /// Refuses a file that is not SQLite before SQLite opens it (SQLite's own words, "file is not
-/// a database", name neither the file nor what it is).
-fn check_magic(path: &Path) -> Result<(), InputError> {
-    let mut head = Vec::with_capacity(SQLITE_MAGIC.len());
-    std::fs::File::open(path)
-        .and_then(|f| f.take(SQLITE_MAGIC.len() as u64).read_to_end(&mut head))
-        .map_err(|e| InputError::Read {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })?;
-    if head != SQLITE_MAGIC {
-        let shown: String = String::from_utf8_lossy(&head)
+/// a database", name neither the file nor what it is). Returns words for a later error when
+/// the file is shorter than its header says (SQLite file format: page size at byte 16, the
+/// database's pages at byte 28, both big-endian): a copy cut short.
+fn check_magic(path: &Path) -> Result<String, InputError> {
+    let mut head = Vec::with_capacity(32);
+    let read = std::fs::File::open(path).and_then(|f| {
+        let len = f.metadata()?.len();
+        f.take(32).read_to_end(&mut head)?;
+        Ok(len)
+    });
+    let len = read.map_err(|e| InputError::Read {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    if !head.starts_with(SQLITE_MAGIC) {
+        let shown: String = String::from_utf8_lossy(&head[..head.len().min(16)])
             .chars()
             .map(|c| if c.is_control() { '·' } else { c })
             .collect();
@@ -177,12 +188,48 @@ fn check_magic(path: &Path) -> Result<(), InputError> {
             ),
         });
     }
-    Ok(())
+    if head.len() < 32 {
+        return Ok(format!(
+            "; the file is cut short ({len} bytes, inside SQLite's header)"
+        ));
+    }
+    let page = match u16::from_be_bytes([head[16], head[17]]) {
+        1 => 65_536,
+        p => u64::from(p),
+    };
+    let pages = u64::from(u32::from_be_bytes([head[28], head[29], head[30], head[31]]));
+    Ok(if len < page * pages {
+        format!(
+            "; the file is cut short: {len} bytes, its header says {pages} pages of {page} bytes \
+             ({} bytes)",
+            page * pages
+        )
+    } else {
+        String::new()
+    })
 }
 
-/// SQLite's check of a damaged file (`PRAGMA integrity_check`, its first three findings:
-/// the pages), as words appended to an error; empty when the check finds nothing or fails.
+/// Where a damaged file is damaged, as words appended to an error: the pages SQLite's page
+/// statistics (`dbstat`) find corrupted, with their table (the first three), else the first
+/// findings of `PRAGMA integrity_check`; empty when neither says more.
 fn check(db: &Connection) -> String {
+    let pages: rusqlite::Result<Vec<String>> = db
+        .prepare("SELECT name, pageno FROM dbstat WHERE pagetype = 'corrupted' LIMIT 3")
+        .and_then(|mut s| {
+            s.query_map([], |r| {
+                Ok(format!(
+                    "page {} (table {})",
+                    r.get::<_, i64>(1)?,
+                    r.get::<_, String>(0)?
+                ))
+            })?
+            .collect()
+        });
+    if let Ok(pages) = pages
+        && !pages.is_empty()
+    {
+        return format!("; damaged: {}", pages.join(", "));
+    }
     let found: rusqlite::Result<Vec<String>> = db
         .prepare("PRAGMA integrity_check(3)")
         .and_then(|mut s| s.query_map([], |r| r.get::<_, String>(0))?.collect());
