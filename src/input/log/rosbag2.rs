@@ -53,6 +53,8 @@ struct Entry<'a> {
     value: &'a str,
     line: usize,
     items: Vec<(&'a str, usize)>,
+    /// The indentation of the first item (the items are those at it).
+    item_indent: Option<usize>,
 }
 
 /// A line's content without a trailing comment (a `#` after a blank, outside quotes).
@@ -113,6 +115,7 @@ fn entries(text: &str) -> Vec<Entry<'_>> {
                 value: value.trim(),
                 line,
                 items: Vec::new(),
+                item_indent: None,
             });
         } else if let Some(last) = out.last_mut()
             && let Some(item) = content
@@ -121,11 +124,7 @@ fn entries(text: &str) -> Vec<Entry<'_>> {
         {
             // Items of a block sequence under the last key (at its indentation or deeper);
             // the nested lines of an item that is a mapping are not items of their own.
-            let first_indent = last
-                .items
-                .first()
-                .and_then(|(_, l)| body.iter().find(|b| b.0 == *l).map(|b| b.1));
-            if first_indent.is_none_or(|i| i == indent) {
+            if *last.item_indent.get_or_insert(indent) == indent {
                 last.items.push((item, line));
             }
         }
