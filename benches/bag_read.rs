@@ -15,6 +15,10 @@
 //!   decoded beforehand and handed over in cache, a block of 64 at a time, as the read hands
 //!   them over after decoding): they should add ≤ 10 % to the read's time.
 //!
+//! ROS 2 SQLite bags (`bag_read/db3_*`): the committed `arc_v9` and `arc_zstd_message`
+//! directories; `benches/run_db3.sh` adds them 200 times over (no, message and file zstd
+//! compression) and times `rosbags` reading the same bags (`benches/db3_rosbags.py`).
+//!
 //! Run: `cargo bench --no-default-features --bench bag_read -- --warm-up-time 1 --measurement-time 3`
 //! (`POSECOV_BENCH_BAGS=a.bag:b.bag` adds those bags, as `benches/run_rosbags.sh` does with
 //! test2.bag rewritten ten times over with no, lz4 and bz2 chunk compression).
@@ -39,6 +43,13 @@ const MCAP: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/tests/data/mcap/health_cases.mcap"
 );
+/// ROS 2 SQLite bags (rosbag2 directories written by rosbags: tests/data/ros2/make_bags.py),
+/// uncompressed and with zstd-compressed messages.
+const DB3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ros2/arc_v9");
+const DB3_ZSTD: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/ros2/arc_zstd_message"
+);
 
 fn pose_messages(path: &str) -> u64 {
     let plan = read_log(
@@ -57,6 +68,8 @@ fn bags() -> Vec<(String, String)> {
     let mut bags: Vec<(String, String)> = vec![
         ("ros1_test2_bz2".into(), TEST2.into()),
         ("mcap_health_cases".into(), MCAP.into()),
+        ("db3_arc_v9".into(), DB3.into()),
+        ("db3_arc_zstd_message".into(), DB3_ZSTD.into()),
     ];
     for path in extra.split(':').filter(|p| !p.is_empty()) {
         let stem = Path::new(path)

@@ -150,7 +150,7 @@ fn near_misses_get_the_nearest_name() {
 }
 
 #[test]
-fn a_missing_path_is_one_line_and_a_db3_gets_the_conversion() {
+fn a_missing_path_is_one_line_and_a_damaged_db3_is_named() {
     let o = posecov(&["check", "no/such/dir/run.mcap"]);
     assert_eq!(o.status.code(), Some(2));
     let e = stderr(&o);
@@ -161,6 +161,8 @@ fn a_missing_path_is_one_line_and_a_db3_gets_the_conversion() {
         "the bundled list is for bare names: {e}"
     );
     let db3 = temp_file("run_0.db3", b"SQLite format 3\0rest of the file");
-    let e = stderr(&posecov(&["check", db3.to_str().unwrap()]));
-    assert!(e.contains("ros2 bag convert"), "{e}");
+    let o = posecov(&["check", db3.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("run_0.db3: ") && e.contains("SQLite"), "{e}");
 }

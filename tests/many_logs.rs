@@ -117,7 +117,9 @@ fn a_directory_without_logs_is_refused() {
     let (code, out, err) = run(&["report", dir.to_str().unwrap(), "--json"]);
     assert_eq!(code, Some(2));
     assert!(
-        err.contains("no robot log (.bag, .mcap) in this directory"),
+        err.contains(
+            "no robot log (.bag, .mcap, .db3, or a ROS 2 bag directory) in this directory"
+        ),
         "{err}"
     );
     let json: serde_json::Value = serde_json::from_str(&out).expect("the error as JSON");

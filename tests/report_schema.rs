@@ -213,6 +213,21 @@ fn every_bundled_example_validates_against_the_schema_and_every_key_is_documente
 }
 
 #[test]
+fn a_ros2_sqlite_bag_report_validates_with_its_format() {
+    let schema: Value = serde_json::from_str(SCHEMA).unwrap();
+    let bag = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ros2/arc_humble");
+    let overrides = Overrides {
+        reference: Some("/truth".into()),
+        ..Default::default()
+    };
+    let text = report(bag, &overrides, true).unwrap();
+    let value: Value = serde_json::from_str(&text).unwrap();
+    let found = dedup(problems(&schema, &value, "arc_humble"));
+    assert!(found.is_empty(), "{found:#?}");
+    assert_eq!(value["format"], "ros2_sqlite");
+}
+
+#[test]
 fn a_log_report_with_a_reference_validates_and_documents_its_consistency_keys() {
     let schema: Value = serde_json::from_str(SCHEMA).unwrap();
     let dir = std::env::temp_dir().join(format!("posecov-schema-nees-{}", std::process::id()));

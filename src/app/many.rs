@@ -1,6 +1,7 @@
 //! Many inputs in one command: `posecov report DIR_OR_FILES… [--json]` and `posecov check
 //! FILES…`. The arguments are expanded once ([`expand`]: a directory means every robot log in
-//! it, `.bag` and `.mcap`, by name); the inputs run in parallel on rayon's pool under one
+//! it, `.bag`, `.mcap`, `.db3` and ROS 2 bag directories, by name; a ROS 2 bag directory is one
+//! log); the inputs run in parallel on rayon's pool under one
 //! progress bar (the per-log bars are hidden), and each result is printed whole as soon as it
 //! is ready — one compact JSON object per line (JSON Lines), one `check` line — so memory does
 //! not grow with the number of inputs. Every line names its input (`scenario`), since lines
@@ -33,9 +34,10 @@ pub struct Inputs {
     pub several: bool,
 }
 
-/// The inputs `args` stand for: each argument as given (a file or a bundled example), a
-/// directory replaced by every file in it whose extension is a log format's (`.bag`, `.mcap`;
-/// not its subdirectories), sorted by name.
+/// The inputs `args` stand for: each argument as given (a file, a ROS 2 bag directory or a
+/// bundled example), any other directory replaced by every file in it whose extension is a log
+/// format's (`.bag`, `.mcap`, `.db3`) and every ROS 2 bag directory in it (not other
+/// subdirectories), sorted by name.
 ///
 /// # Errors
 /// A directory that cannot be listed, or that holds no log.
@@ -48,7 +50,12 @@ pub struct Inputs {
 /// let one = expand(&["camera_on_robot".to_owned()]).unwrap();
 /// assert_eq!((one.names.len(), one.several), (1, false));
 /// let empty = concat!(env!("CARGO_MANIFEST_DIR"), "/src");
-/// assert!(expand(&[empty.to_owned()]).unwrap_err().to_string().ends_with("no robot log (.bag, .mcap) in this directory"));
+/// assert!(expand(&[empty.to_owned()]).unwrap_err().to_string().ends_with("no robot log (.bag, .mcap, .db3, or a ROS 2 bag directory) in this directory"));
+/// let bags = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ros2");
+/// let inputs = expand(&[bags.to_owned()]).unwrap();
+/// assert_eq!(inputs.names.len(), 6); // arc.mcap and five bag directories
+/// let one = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ros2/arc_v9");
+/// assert_eq!(expand(&[one.to_owned()]).unwrap().names, [one]);
 /// ```
 pub fn expand(args: &[String]) -> Result<Inputs, AppError> {
     let extensions: Vec<&str> = Format::ALL
@@ -60,7 +67,7 @@ pub fn expand(args: &[String]) -> Result<Inputs, AppError> {
     let mut directory = false;
     for arg in args {
         let path = Path::new(arg);
-        if !path.is_dir() {
+        if !path.is_dir() || is_bag_dir(path) {
             names.push(arg.clone());
             continue;
         }
@@ -79,7 +86,7 @@ pub fn expand(args: &[String]) -> Result<Inputs, AppError> {
                 .and_then(|e| e.to_str())
                 .and_then(Format::from_extension)
                 .is_some_and(|f| f.kind() == InputKind::Log);
-            if is_log && file.is_file() {
+            if (is_log && file.is_file()) || is_bag_dir(&file) {
                 logs.push(file.display().to_string());
             }
         }
@@ -87,7 +94,10 @@ pub fn expand(args: &[String]) -> Result<Inputs, AppError> {
             let listed: Vec<String> = extensions.iter().map(|e| format!(".{e}")).collect();
             return Err(AppError::Input(InputError::Read {
                 path: arg.clone(),
-                reason: format!("no robot log ({}) in this directory", listed.join(", ")),
+                reason: format!(
+                    "no robot log ({}, or a ROS 2 bag directory) in this directory",
+                    listed.join(", ")
+                ),
             }));
         }
         logs.sort();
@@ -97,6 +107,13 @@ pub fn expand(args: &[String]) -> Result<Inputs, AppError> {
         several: directory || names.len() > 1,
         names,
     })
+}
+
+/// Whether `path` is a ROS 2 bag directory (it holds `metadata.yaml`): one log, not a
+/// directory of logs.
+fn is_bag_dir(path: &Path) -> bool {
+    path.join(crate::input::log::rosbag2::METADATA_FILE)
+        .is_file()
 }
 
 /// Runs `work` on every input in parallel under one progress bar; `done` gets each result as

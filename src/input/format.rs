@@ -7,6 +7,8 @@
 //! | TOML scenario | `.toml` | text whose first line that is not a comment is a `[table]` or `key = value` |
 //! | ROS 1 bag | `.bag` | starts with `#ROSBAG V2.0\n` |
 //! | MCAP (ROS 2 bag) | `.mcap` | starts with `\x89MCAP0\r\n` |
+//! | ROS 2 bag in SQLite | `.db3` | starts with `SQLite format 3\0` |
+//! | ROS 2 bag directory | (a directory) | holds `metadata.yaml`; its `storage_identifier` says `sqlite3` (a ROS 2 SQLite bag) or `mcap` (MCAP) |
 //! | g2o / GTSAM / TORO pose graph | `.g2o`, `.txt`, `.graph` | text whose first token that is not a comment is `VERTEX_SE2`, `EDGE_SE2`, `VERTEX_SE3:QUAT`, `EDGE_SE3:QUAT`, `VERTEX2` or `EDGE2` |
 
 use std::io::Read as _;
@@ -24,8 +26,11 @@ pub enum Format {
     Scenario,
     /// A ROS 1 bag (version 2.0).
     Ros1Bag,
-    /// An MCAP file (ROS 2 bags).
+    /// An MCAP file (ROS 2 bags), or a ROS 2 bag directory in MCAP storage.
     Mcap,
+    /// A ROS 2 bag in SQLite storage: a `.db3` file, or a bag directory (`metadata.yaml`
+    /// naming `sqlite3` storage and its `.db3` files).
+    Ros2Sqlite,
     /// A g2o / GTSAM text pose graph ([`crate::input::graph`]).
     Graph,
 }
@@ -59,12 +64,12 @@ impl InputKind {
     /// The kind in words, for messages ("applies to robot logs").
     ///
     /// ```
-    /// assert_eq!(posecov::input::format::InputKind::Log.name_plural(), "robot logs (ROS 1 bags, MCAP files)");
+    /// assert_eq!(posecov::input::format::InputKind::Log.name_plural(), "robot logs (ROS 1 bags, MCAP files, ROS 2 SQLite bags)");
     /// ```
     pub fn name_plural(self) -> &'static str {
         match self {
             InputKind::Plan => "scenarios and pose graphs",
-            InputKind::Log => "robot logs (ROS 1 bags, MCAP files)",
+            InputKind::Log => "robot logs (ROS 1 bags, MCAP files, ROS 2 SQLite bags)",
         }
     }
 }
@@ -73,8 +78,8 @@ impl InputKind {
 pub const ROSBAG_MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 /// MCAP magic.
 pub const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
-/// SQLite's magic (ROS 2's default `.db3` bag storage, which posecov does not read).
-const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
+/// SQLite's magic (ROS 2's `.db3` bag storage, Humble's default).
+pub const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
 /// The g2o / GTSAM records posecov reads (any of them first identifies a graph).
 pub const GRAPH_TAGS: &[&str] = &[
     "VERTEX_SE2",
@@ -89,11 +94,12 @@ pub const SNIFF_BYTES: usize = 64 * 1024;
 
 impl Format {
     /// Every format, in the order `posecov list` shows them.
-    pub const ALL: [Format; 4] = [
+    pub const ALL: [Format; 5] = [
         Format::Scenario,
         Format::Graph,
         Format::Ros1Bag,
         Format::Mcap,
+        Format::Ros2Sqlite,
     ];
 
     /// The format in words.
@@ -107,6 +113,7 @@ impl Format {
             Format::Scenario => "TOML scenario",
             Format::Ros1Bag => "ROS 1 bag",
             Format::Mcap => "MCAP file (ROS 2 bag)",
+            Format::Ros2Sqlite => "ROS 2 bag in SQLite (.db3)",
             Format::Graph => "g2o / GTSAM pose graph",
         }
     }
@@ -121,7 +128,7 @@ impl Format {
     pub fn kind(self) -> InputKind {
         match self {
             Format::Scenario | Format::Graph => InputKind::Plan,
-            Format::Ros1Bag | Format::Mcap => InputKind::Log,
+            Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite => InputKind::Log,
         }
     }
 
@@ -136,6 +143,7 @@ impl Format {
             Format::Scenario => "TOML scenarios",
             Format::Ros1Bag => "ROS 1 bags",
             Format::Mcap => "MCAP files (ROS 2 bags)",
+            Format::Ros2Sqlite => "ROS 2 bags in SQLite (.db3)",
             Format::Graph => "g2o / GTSAM pose graphs",
         }
     }
@@ -151,6 +159,7 @@ impl Format {
             Format::Scenario => &["toml"],
             Format::Ros1Bag => &["bag"],
             Format::Mcap => &["mcap"],
+            Format::Ros2Sqlite => &["db3"],
             Format::Graph => &["g2o", "txt", "graph"],
         }
     }
@@ -176,6 +185,7 @@ impl Format {
     /// use posecov::input::Format;
     /// assert_eq!(Format::from_content(b"#ROSBAG V2.0\n..."), Some(Format::Ros1Bag));
     /// assert_eq!(Format::from_content(b"\x89MCAP0\r\n..."), Some(Format::Mcap));
+    /// assert_eq!(Format::from_content(b"SQLite format 3\0..."), Some(Format::Ros2Sqlite));
     /// assert_eq!(Format::from_content(b"# a graph\nVERTEX_SE2 0 0 0 0\n"), Some(Format::Graph));
     /// assert_eq!(Format::from_content(b"# a scenario\n[scenario]\n"), Some(Format::Scenario));
     /// assert_eq!(Format::from_content(b"\x00\x01binary"), None);
@@ -186,6 +196,9 @@ impl Format {
         }
         if head.starts_with(MCAP_MAGIC) {
             return Some(Format::Mcap);
+        }
+        if head.starts_with(SQLITE_MAGIC) {
+            return Some(Format::Ros2Sqlite);
         }
         let line = first_text_line(head)?;
         let token = line.split_whitespace().next().unwrap_or("");
@@ -254,8 +267,7 @@ fn expected() -> String {
 /// assert_eq!(detect("noext", b"EDGE_SE2 0 1 1 0 0 1 0 0 1 0 1\n").unwrap(), Format::Graph);
 /// let e = detect("a.bag", b"\x89MCAP0\r\n").unwrap_err().to_string();
 /// assert!(e.starts_with("a.bag: the extension .bag says ROS 1 bag, but its content is a MCAP file"), "{e}");
-/// let e = detect("run_0.db3", b"SQLite format 3\0...").unwrap_err().to_string();
-/// assert!(e.contains("ros2 bag convert"), "{e}");
+/// assert_eq!(detect("run_0.db3", b"SQLite format 3\0...").unwrap(), Format::Ros2Sqlite);
 /// let e = detect("notes.csv", b"1,2,3\n").unwrap_err().to_string();
 /// assert!(e.starts_with("notes.csv: not a file posecov reads"), "{e}");
 /// ```
@@ -273,14 +285,6 @@ pub fn detect(file: &str, head: &[u8]) -> Result<Format, InputError> {
         file: file.to_owned(),
         message,
     };
-    if extension.eq_ignore_ascii_case("db3") || head.starts_with(SQLITE_MAGIC) {
-        return Err(error(
-            "a ROS 2 bag in SQLite storage (.db3); posecov reads MCAP: convert it with \
-             `ros2 bag convert -i BAG_DIR -o out.yaml` (out.yaml naming `storage_id: mcap`), \
-             or record with `ros2 bag record -s mcap`"
-                .to_owned(),
-        ));
-    }
     match (by_extension, by_content) {
         (Some(e), Some(c)) if e == c => Ok(e),
         (Some(e), Some(c)) => Err(error(format!(
@@ -290,13 +294,15 @@ pub fn detect(file: &str, head: &[u8]) -> Result<Format, InputError> {
             what_identifies(c)
         ))),
         (None, Some(c)) => Ok(c),
-        (Some(e @ (Format::Ros1Bag | Format::Mcap)), None) => Err(error(format!(
-            "the extension .{extension} says {}, but {} (a {} starts with {})",
-            e.name(),
-            describe(head),
-            e.name(),
-            what_identifies(e)
-        ))),
+        (Some(e @ (Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite)), None) => {
+            Err(error(format!(
+                "the extension .{extension} says {}, but {} (a {} starts with {})",
+                e.name(),
+                describe(head),
+                e.name(),
+                what_identifies(e)
+            )))
+        }
         (Some(e), None) => match super::not_text(file, head, &format!("a {}", e.name())) {
             // A multi-byte character cut by the sniffed length is not the file's end.
             Some(_) if head.len() == SNIFF_BYTES && first_text_line(head).is_some() => Ok(e),
@@ -316,9 +322,35 @@ fn what_identifies(format: Format) -> &'static str {
     match format {
         Format::Ros1Bag => "`#ROSBAG V2.0`",
         Format::Mcap => "the MCAP magic `\\x89MCAP0\\r\\n`",
+        Format::Ros2Sqlite => "SQLite's `SQLite format 3`",
         Format::Graph => "its first record is a g2o vertex or edge",
         Format::Scenario => "its first line is a TOML table or key",
     }
+}
+
+/// The format of a directory: a ROS 2 bag directory (its `metadata.yaml`'s storage, `sqlite3`
+/// or `mcap`, and every file it names present), else an error saying what a directory must
+/// hold to be read.
+///
+/// ```
+/// use posecov::input::{Format, format::detect_dir};
+/// let bag = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ros2/arc_humble");
+/// assert_eq!(detect_dir(bag.as_ref()).unwrap(), Format::Ros2Sqlite);
+/// let src = concat!(env!("CARGO_MANIFEST_DIR"), "/src");
+/// assert!(detect_dir(src.as_ref()).unwrap_err().to_string().contains("no metadata.yaml"));
+/// ```
+pub fn detect_dir(dir: &Path) -> Result<Format, InputError> {
+    use super::log::rosbag2::{METADATA_FILE, read_metadata};
+    if !dir.join(METADATA_FILE).is_file() {
+        return Err(InputError::Format {
+            file: dir.display().to_string(),
+            message: format!(
+                "a directory with no {METADATA_FILE}: not a ROS 2 bag directory \
+                 (`posecov report DIR` and `posecov check DIR` read every log in a directory)"
+            ),
+        });
+    }
+    Ok(read_metadata(dir)?.0.storage)
 }
 
 /// The first [`SNIFF_BYTES`] of a file (fewer if it is shorter).

@@ -174,6 +174,12 @@ impl Located {
 /// ```
 pub fn locate(name_or_path: &str) -> Result<Located, InputError> {
     let path = Path::new(name_or_path);
+    if path.is_dir() {
+        return Ok(Located {
+            place: Place::File(path.to_owned()),
+            format: format::detect_dir(path)?,
+        });
+    }
     if path.exists() {
         let format = format::detect(name_or_path, &format::read_head(path)?)?;
         return Ok(Located {
@@ -270,7 +276,9 @@ fn open_file_as(path: &Path, format: Format) -> Result<(Source, Input), InputErr
             let (g, input) = graph::read_file(path)?;
             Ok((Source::Graph(g), input))
         }
-        Format::Ros1Bag | Format::Mcap => Err(not_a_plan(&path.display().to_string(), format)),
+        Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite => {
+            Err(not_a_plan(&path.display().to_string(), format))
+        }
     }
 }
 
@@ -292,7 +300,7 @@ pub fn open_text(text: &str, origin: &str, format: Format) -> Result<(Source, In
             let (g, input) = graph::read_text(text, origin)?;
             Ok((Source::Graph(g), input))
         }
-        Format::Ros1Bag | Format::Mcap => Err(not_a_plan(origin, format)),
+        Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite => Err(not_a_plan(origin, format)),
     }
 }
 

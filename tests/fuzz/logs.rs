@@ -1,11 +1,14 @@
-//! Robot logs: ROS 1 bags and MCAP files, mutated byte by byte (bits, lengths and counts set
+//! Robot logs: ROS 1 bags, MCAP files and ROS 2 SQLite bags (`.db3`), mutated byte by byte (bits, lengths and counts set
 //! to edge values, pieces repeated, zeroed or cut), run as `posecov check` and `report
 //! --json` run a log: read (streamed, every read bounded) → evaluate (a few samples per
 //! drawn message) → draw → validate → the JSON report.
 //!
 //! Seeds: the bundled logs (a real bz2 log, the generated health-case MCAP) and a small
 //! uncompressed bag written here, so that mutations reach the records, the index and the
-//! messages, not only a compressed stream.
+//! messages, not only a compressed stream; for `.db3`, the committed bags of tests/data/ros2
+//! (version 9, Humble's version 5, zstd-compressed messages named by the file's own
+//! `metadata` table), so that mutations reach SQLite's pages, the rows, the topics and the
+//! metadata text.
 
 use std::path::PathBuf;
 
@@ -26,9 +29,10 @@ use crate::harness::{
 pub enum LogKind {
     Ros1,
     Mcap,
+    Db3,
 }
 
-/// A log family (`ros1` or `mcap`).
+/// A log family (`ros1`, `mcap` or `db3`).
 pub struct Logs {
     kind: LogKind,
     seeds: Vec<Vec<u8>>,
@@ -43,6 +47,7 @@ impl Logs {
         let seeds = match kind {
             LogKind::Ros1 => bundled.chain([small_bag()]).collect(),
             LogKind::Mcap => bundled.collect(),
+            LogKind::Db3 => DB3_SEEDS.iter().map(|s| s.to_vec()).collect(),
         };
         Self { kind, seeds }
     }
@@ -53,9 +58,17 @@ impl LogKind {
         match self {
             LogKind::Ros1 => "bag",
             LogKind::Mcap => "mcap",
+            LogKind::Db3 => "db3",
         }
     }
 }
+
+/// The `.db3` seeds: a version 9 bag, Humble's layout, zstd-compressed messages.
+pub const DB3_SEEDS: [&[u8]; 3] = [
+    include_bytes!("../data/ros2/arc_v9/arc_v9.db3"),
+    include_bytes!("../data/ros2/arc_humble/arc_humble_0.db3"),
+    include_bytes!("../data/ros2/arc_zstd_message/arc_zstd_message.db3"),
+];
 
 /// Strings the mutator inserts: record field names and values of both formats.
 const TOKENS: &[&str] = &[
@@ -74,6 +87,11 @@ const TOKENS: &[&str] = &[
     "lz4",
     "cdr",
     "\u{ff}\u{ff}\u{ff}\u{ff}",
+    "sqlite3",
+    "compression_mode: message",
+    "compression_format: lz4",
+    "nav_msgs/msg/Odometry",
+    "geometry_msgs/msg/PoseWithCovarianceStamped",
 ];
 
 impl Family for Logs {
@@ -81,6 +99,7 @@ impl Family for Logs {
         match self.kind {
             LogKind::Ros1 => "ros1",
             LogKind::Mcap => "mcap",
+            LogKind::Db3 => "db3",
         }
     }
     fn extension(&self) -> &'static str {
@@ -90,7 +109,9 @@ impl Family for Logs {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(case);
         // The small seeds more often: their mutants are read through in microseconds.
-        let k = if rng.random_bool(0.3) {
+        let k = if self.kind == LogKind::Db3 {
+            rng.random_range(0..self.seeds.len())
+        } else if rng.random_bool(0.3) {
             0
         } else {
             self.seeds.len() - 1

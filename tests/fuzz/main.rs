@@ -10,6 +10,7 @@
 //! | `graph` | the g2o / GTSAM / TORO graphs, mutated by token, line and byte | read → lower → evaluate (16 samples) → draw → validate → `report --json` |
 //! | `ros1` | the bundled bz2 bag and a small uncompressed bag written here, mutated by byte (lengths and counts set to edge values) | read → evaluate → draw → validate → `report --json` |
 //! | `mcap` | the bundled MCAP, mutated by byte | the same |
+//! | `db3` | three ROS 2 SQLite bags of tests/data/ros2 (version 9, Humble's 5, zstd messages), mutated by byte | the same |
 //! | `live_api` | raw HTTP requests to the live page's server: methods, paths, `Host`, `Origin`, content types, edits of every control to edge values | a real server on loopback |
 //!
 //! # Invariants
@@ -68,6 +69,7 @@ fn families() -> Vec<Box<dyn Family>> {
         Box::new(graph::Graphs),
         Box::new(logs::Logs::new(logs::LogKind::Ros1)),
         Box::new(logs::Logs::new(logs::LogKind::Mcap)),
+        Box::new(logs::Logs::new(logs::LogKind::Db3)),
     ];
     // The page server needs the viewer feature (axum, tokio).
     #[cfg(feature = "viewer")]
@@ -137,6 +139,11 @@ fn seeds_are_valid() {
         found.iter().all(|f| f.class == "ok"),
         "small bag: {found:?}"
     );
+    let db3 = logs::Logs::new(logs::LogKind::Db3);
+    for seed in logs::DB3_SEEDS {
+        let (found, _) = db3.check(seed, &limits);
+        assert!(found.iter().all(|f| f.class == "ok"), "db3 seed: {found:?}");
+    }
 }
 
 /// Runs one scenario file (`POSECOV_FUZZ_FILE`) through the same checks and prints what it

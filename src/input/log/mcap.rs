@@ -1,7 +1,8 @@
 //! MCAP files (ROS 2) through the `mcap` crate's sans-I/O linear reader: the file is read in
 //! bounded pieces, and each chunk is decompressed here, once (zstd, lz4), so memory stays
 //! bounded by one chunk whatever the file's length. Messages are CDR
-//! (`message_encoding = "cdr"`), decoded in `decode` with `re_cdr`.
+//! (`message_encoding = "cdr"`), decoded in `decode` with `re_cdr`, or ROS 1 serialization
+//! (`ros1`, as `mcap convert` writes a ROS 1 bag), decoded as a ROS 1 bag's are.
 //!
 //! Every read is bounded by the file's size: a record longer than what is left of the file
 //! is refused where it starts, a chunk must decompress to exactly the size its header gives
@@ -16,9 +17,9 @@ use std::path::Path;
 
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
-use super::decode::ros2_kind;
+use super::decode::{ros1_kind, ros2_kind};
 use super::mcap_records::{ChunkHeader, McapRecord, parse};
-use super::reference::ros2_reference_type;
+use super::reference::{ros1_reference_type, ros2_reference_type};
 use super::{Codec, Collector, RECORD_LIMIT, Stream};
 use crate::input::InputError;
 
@@ -116,8 +117,8 @@ enum Flow {
 #[derive(Default)]
 struct Streams {
     schemas: HashMap<u16, (String, String)>,
-    /// By channel id (a `u16`): an index, not a hash, per message.
-    channels: Vec<Option<Stream>>,
+    /// By channel id (a `u16`): an index, not a hash, per message; with its encoding.
+    channels: Vec<Option<(Stream, Codec)>>,
 }
 
 impl Streams {
@@ -138,24 +139,30 @@ impl Streams {
                 message_encoding,
             } => {
                 let (schema, encoding) = self.schemas.get(&schema_id).cloned().unwrap_or_default();
-                let kind = ros2_kind(&schema).map(|k| {
-                    if message_encoding == "cdr" {
-                        Ok(k)
-                    } else {
-                        Err(format!(
-                            "{schema} in {message_encoding} encoding (schema {encoding}); posecov reads cdr"
-                        ))
-                    }
-                });
-                let reference = ros2_reference_type(&schema).map(|k| {
-                    if message_encoding == "cdr" {
-                        Ok(k)
-                    } else {
-                        Err(format!(
-                            "{schema} in {message_encoding} encoding; posecov reads cdr"
-                        ))
-                    }
-                });
+                let other = || {
+                    format!(
+                        "{schema} in {message_encoding} encoding (schema {encoding}); posecov reads cdr or ros1"
+                    )
+                };
+                // `mcap convert` of a ROS 1 bag writes ROS 1 names and bytes (no MD5 sum:
+                // the definition is the schema's text).
+                let (kind, reference, codec) = match message_encoding.as_str() {
+                    "cdr" => (
+                        ros2_kind(&schema).map(Ok),
+                        ros2_reference_type(&schema).map(Ok),
+                        Codec::Cdr,
+                    ),
+                    "ros1" => (
+                        ros1_kind(&schema, "*"),
+                        ros1_reference_type(&schema, "*"),
+                        Codec::Ros1,
+                    ),
+                    _ => (
+                        ros2_kind(&schema).map(|_| Err(other())),
+                        ros2_reference_type(&schema).map(|_| Err(other())),
+                        Codec::Cdr,
+                    ),
+                };
                 let type_name = if schema.is_empty() {
                     format!("(no schema, {message_encoding} encoding)")
                 } else {
@@ -172,7 +179,7 @@ impl Streams {
                 if self.channels.len() <= at {
                     self.channels.resize_with(at + 1, || None);
                 }
-                self.channels[at] = Some(stream);
+                self.channels[at] = Some((stream, codec));
             }
             McapRecord::Message {
                 channel_id,
@@ -182,15 +189,17 @@ impl Streams {
                 if collector.stop() {
                     return Ok(Flow::Stop);
                 }
+                let channel = self
+                    .channels
+                    .get(usize::from(channel_id))
+                    .and_then(Option::as_ref);
                 collector.message_on(
-                    self.channels
-                        .get(usize::from(channel_id))
-                        .and_then(Option::as_ref),
+                    channel.map(|c| &c.0),
                     "channel",
                     channel_id.into(),
                     log_time,
                     data,
-                    Codec::Cdr,
+                    channel.map_or(Codec::Cdr, |c| c.1),
                 )?;
             }
             McapRecord::Chunk { .. } => return Err("a chunk inside a chunk".to_owned()),

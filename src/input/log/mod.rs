@@ -1,6 +1,7 @@
 //! Robot logs: ROS 1 bags (format 2.0; uncompressed, bz2 and lz4 chunks, through the `rosbag`
-//! crate) and MCAP files (ROS 2, CDR messages, through the `mcap` crate's streaming reader
-//! and `re_cdr`). Both are streamed: messages are decoded one at a time into a bounded
+//! crate), MCAP files (CDR or ROS 1 messages, through the `mcap` crate's streaming reader and
+//! `re_cdr`) and ROS 2 bags (`rosbag2.rs`: a directory of SQLite `.db3` files, `sqlite.rs`, or
+//! MCAP files; or one `.db3`). All are streamed: messages are decoded one at a time into a bounded
 //! [`LogSummary`] — every message's health is counted, a decimated set of messages is kept for
 //! drawing, and time series are kept at a bounded length (halving their density when full).
 //!
@@ -37,11 +38,13 @@ mod mcap_records;
 pub mod reference;
 mod ros1;
 mod ros1_linear;
+pub mod rosbag2;
+mod sqlite;
 mod tf;
 mod topic;
 
 use reference::ReferenceType;
-use topic::TopicState;
+use topic::{TopicState, no_pose_topic};
 
 /// The largest record or decompressed chunk of a log read (1 GiB): larger ones are refused,
 /// not allocated.
@@ -82,7 +85,11 @@ pub fn read_log(
     let file = path.display().to_string();
     let located = Located {
         place: Place::File(path.to_owned()),
-        format: format::detect(&file, &format::read_head(path)?)?,
+        format: if path.is_dir() {
+            format::detect_dir(path)?
+        } else {
+            format::detect(&file, &format::read_head(path)?)?
+        },
     };
     read_located(&located, options, progress, cancel)
 }
@@ -183,8 +190,13 @@ fn read_path(
 ) -> Result<LogSummary, InputError> {
     let mut collector = Collector::new(options, cancel, observer);
     match format {
+        // A rosbag2 directory (metadata.yaml and its files, sqlite3 or mcap storage).
+        Format::Ros2Sqlite | Format::Mcap if path.is_dir() => {
+            rosbag2::read_dir(path, &mut collector, progress)?;
+        }
         Format::Ros1Bag => ros1::read(path, &mut collector, progress)?,
         Format::Mcap => mcap::read(path, &mut collector, progress)?,
+        Format::Ros2Sqlite => sqlite::read(path, None, &mut collector, progress)?,
         other => {
             return Err(InputError::Format {
                 file: origin.to_owned(),
@@ -535,41 +547,6 @@ impl<'a, 'o> Collector<'a, 'o> {
             tf: self.tf.finish(),
         })
     }
-}
-
-/// Why a log has nothing to draw: the topics it has (type and count), its pose topics without
-/// messages, and the types posecov reads.
-fn no_pose_topic(plan: &LogSummary) -> String {
-    const SHOWN: usize = 12;
-    let mut has: Vec<String> = plan
-        .skipped
-        .iter()
-        .take(SHOWN)
-        .map(|k| format!("{} ({}, {} messages)", k.name, k.message_type, k.count))
-        .collect();
-    if plan.skipped.len() > SHOWN {
-        has.push(format!("… and {} more topics", plan.skipped.len() - SHOWN));
-    }
-    let empty: Vec<&str> = plan.topics.iter().map(|t| t.name.as_str()).collect();
-    if !empty.is_empty() {
-        has.push(format!(
-            "pose topics without messages: {}",
-            empty.join(", ")
-        ));
-    }
-    let has = if has.is_empty() {
-        "no messages at all".to_owned()
-    } else {
-        has.join(", ")
-    };
-    let reads: Vec<String> = PoseMessageKind::ALL
-        .iter()
-        .map(|k| format!("{} (ROS 2: {})", k.ros1_name(), k.ros2_name()))
-        .collect();
-    format!(
-        "no pose-with-covariance topic to draw; the log has {has}; posecov reads {}",
-        reads.join(", ")
-    )
 }
 
 #[cfg(test)]

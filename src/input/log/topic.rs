@@ -5,8 +5,8 @@
 
 use crate::lie::GroupKind;
 use crate::plan::log::{
-    Decimator, DrawnMessage, Issue, IssueCount, PoseMessage, PoseMessageKind, SeriesPoint,
-    TopicSummary, is_odom_frame,
+    Decimator, DrawnMessage, Issue, IssueCount, LogSummary, PoseMessage, PoseMessageKind,
+    SeriesPoint, TopicSummary, is_odom_frame,
 };
 
 use super::decode::DecodeError;
@@ -220,4 +220,39 @@ impl TopicState {
             sigma_stats,
         }
     }
+}
+
+/// Why a log has nothing to draw: the topics it has (type and count), its pose topics without
+/// messages, and the types posecov reads.
+pub(super) fn no_pose_topic(plan: &LogSummary) -> String {
+    const SHOWN: usize = 12;
+    let mut has: Vec<String> = plan
+        .skipped
+        .iter()
+        .take(SHOWN)
+        .map(|k| format!("{} ({}, {} messages)", k.name, k.message_type, k.count))
+        .collect();
+    if plan.skipped.len() > SHOWN {
+        has.push(format!("… and {} more topics", plan.skipped.len() - SHOWN));
+    }
+    let empty: Vec<&str> = plan.topics.iter().map(|t| t.name.as_str()).collect();
+    if !empty.is_empty() {
+        has.push(format!(
+            "pose topics without messages: {}",
+            empty.join(", ")
+        ));
+    }
+    let has = if has.is_empty() {
+        "no messages at all".to_owned()
+    } else {
+        has.join(", ")
+    };
+    let reads: Vec<String> = PoseMessageKind::ALL
+        .iter()
+        .map(|k| format!("{} (ROS 2: {})", k.ros1_name(), k.ros2_name()))
+        .collect();
+    format!(
+        "no pose-with-covariance topic to draw; the log has {has}; posecov reads {}",
+        reads.join(", ")
+    )
 }
