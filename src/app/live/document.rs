@@ -10,7 +10,6 @@ use toml_edit::{Array, DocumentMut, Item, Value};
 use super::controls::{self, Control, ControlKind, Place, Seg, Slot};
 use super::prose;
 use crate::app::{AppError, Loaded, load_text};
-use crate::input::scenario::bundled;
 use crate::uncertain::Method;
 
 /// Monte Carlo samples of the evaluation that checks an edited file before it is accepted.
