@@ -113,15 +113,7 @@ pub(super) fn read(
                 ));
             }
         };
-        let fields = (|| -> rusqlite::Result<(i64, i64, i64, &[u8])> {
-            Ok((
-                row.get(0)?,
-                row.get(1)?,
-                row.get(2)?,
-                row.get_ref(3)?.as_blob()?,
-            ))
-        })();
-        let (id, topic_id, timestamp, data) = fields.map_err(|e| {
+        let (id, topic_id, timestamp, data) = row_fields(row).map_err(|e| {
             at(
                 format!("table messages, row after id {}", last_id.unwrap_or(0)),
                 format!("{e} (rosbag2 writes integer id, topic_id and timestamp, and a blob)"),
@@ -153,12 +145,22 @@ pub(super) fn read(
                 stream.map_or(Codec::Cdr, |s| s.1),
             )
             .map_err(|e| at(place(), e))?;
-        if read_rows % 4096 == 0 {
+        if read_rows.is_multiple_of(4096) {
             progress(u64::try_from(id).unwrap_or(0).min(total), total);
         }
     }
     progress(total, total);
     Ok(())
+}
+
+/// A `messages` row: id, topic id, timestamp and the data's bytes (borrowed, not copied).
+fn row_fields<'r>(row: &'r rusqlite::Row<'_>) -> rusqlite::Result<(i64, i64, i64, &'r [u8])> {
+    Ok((
+        row.get(0)?,
+        row.get(1)?,
+        row.get(2)?,
+        row.get_ref(3)?.as_blob()?,
+    ))
 }
 
 /// Refuses a file that is not SQLite before SQLite opens it (SQLite's own words, "file is not
