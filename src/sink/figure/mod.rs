@@ -171,7 +171,28 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
         about.insert(0, format!("regions at {} confidence", p));
     }
     let steps = scene.steps();
+    let graph_states = scene.states.as_ref().map(|s| &s.steps);
+    match (options.steps, graph_states) {
+        (Steps::All, Some(states)) => {
+            if let Some((k, _)) = states.last() {
+                about.push(format!(
+                    "before, and after: the final solution ({k} loop closures)"
+                ));
+            }
+        }
+        (Steps::At(k), Some(states)) => {
+            let step = scene
+                .states
+                .as_ref()
+                .and_then(|s| s.step_after(k.max(0) as u64));
+            if let Some((count, _)) = states.iter().find(|(_, s)| Some(*s) == step) {
+                about.push(format!("after {count} loop closures (--step {k})"));
+            }
+        }
+        _ => {}
+    }
     match (options.steps, steps.first(), steps.last()) {
+        _ if graph_states.is_some() => {}
         (Steps::All, Some(a), Some(b)) if a != b => {
             let drawn = drawn_steps(scene);
             if drawn.len() == steps.len() {
@@ -297,6 +318,26 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
 fn selected(scene: &Scene, steps: Steps) -> Vec<&SceneItem> {
     let drawable = |i: &&SceneItem| !matches!(i.kind, ItemKind::Text(_));
     match steps {
+        Steps::All if scene.states.is_some() => {
+            // A graph: the chain's steps at once, and the after view's final state only.
+            let last = scene
+                .states
+                .as_ref()
+                .and_then(|s| s.steps.last())
+                .map(|(_, k)| *k);
+            let drawn = drawn_steps(scene);
+            let states = scene.states.as_ref();
+            scene
+                .items
+                .iter()
+                .filter(|i| match (i.timing, states) {
+                    (Timing::Step(k), Some(st)) if st.contains(&i.path) => Some(k) == last,
+                    (Timing::Step(k), _) => drawn.contains(&k),
+                    _ => true,
+                })
+                .filter(drawable)
+                .collect()
+        }
         Steps::All => {
             let drawn = drawn_steps(scene);
             let mut last_stamp: std::collections::BTreeMap<&str, i64> = Default::default();
@@ -318,6 +359,12 @@ fn selected(scene: &Scene, steps: Steps) -> Vec<&SceneItem> {
                 .collect()
         }
         Steps::At(k) => {
+            // A graph's K: the state after K loop closures.
+            let k = scene
+                .states
+                .as_ref()
+                .and_then(|s| s.step_after(k.max(0) as u64))
+                .unwrap_or(k);
             // Per entity, its latest item at or before step k (static first, then by step).
             let mut order: Vec<usize> = (0..scene.items.len()).collect();
             order.sort_by_key(|&i| match scene.items[i].timing {
@@ -361,6 +408,7 @@ fn drawn_steps(scene: &Scene) -> Vec<i64> {
         .items
         .iter()
         .filter(|i| matches!(i.kind, ItemKind::Points(_) | ItemKind::Surface(_)))
+        .filter(|i| !scene.states.as_ref().is_some_and(|s| s.contains(&i.path)))
         .filter_map(|i| match i.timing {
             Timing::Step(k) => Some(k),
             _ => None,
