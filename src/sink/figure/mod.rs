@@ -7,7 +7,11 @@
 //! its robot-scale view, a graph's before and after, one method each), with every step of a
 //! propagation at once ([`Steps::All`], each step's frame numbered; a robot log's messages:
 //! the last, as the viewer opens) or the state at one step ([`Steps::At`], what the viewer
-//! shows with its time cursor there). Around it: the title, the confidence of every drawn
+//! shows with its time cursor there). A pose graph ([`Scene::states`]) is drawn as its before
+//! and its **final** after: with every step, the odometry chain's steps at once and the after
+//! view's last state only — the intermediate loop-closure states stay on the viewer's `step`
+//! timeline, never overlaid; `--step K` draws the state after K loop closures (the last
+//! timeline state with at most K). Around it: the title, the confidence of every drawn
 //! region, axes in metres with a grid whose spacing is stated and a scale bar, the legend with
 //! colour swatches ([`Scene::legend`]) and the scene's plots against step or time.
 //!
