@@ -84,7 +84,7 @@ impl StepPolicy {
     ///
     /// ```
     /// let p = posecov::plan::StepPolicy::GRAPH;
-    /// assert!(p.samples(1700, 1727) && !p.samples(1701, 1727) && p.samples(1727, 1727));
+    /// assert!(p.samples(1692, 1727) && !p.samples(1694, 1727) && p.samples(1727, 1727));
     /// ```
     pub fn samples(&self, step: u64, last: u64) -> bool {
         self.records(step, last)
