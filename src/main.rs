@@ -100,7 +100,8 @@ struct FigureArgs {
     #[arg(long, default_value = "xy")]
     plane: posecov::sink::figure::Plane,
     /// Which steps of a propagation: `all` at once (numbered), or one step K as the viewer
-    /// shows it there.
+    /// shows it there. A pose graph: `all` is the before and the final after; K the state
+    /// after K loop closures.
     #[arg(long, value_name = "K|all", default_value = "all")]
     step: posecov::sink::figure::Steps,
 }

@@ -29,6 +29,9 @@ use nalgebra::{Matrix3, Vector3};
 pub mod choices;
 pub mod graph;
 pub mod log;
+mod steps;
+
+pub use steps::StepPolicy;
 
 use crate::lie::{LieGroup, Se2, Se3, So2, So3, Tangent, TangentMatrix};
 pub use crate::propagate::odometry::StepNoise;
@@ -478,62 +481,6 @@ impl AnyPlan {
             Self::So3(p) => longest(p),
             Self::Se3(p) => longest(p),
         }
-    }
-}
-
-/// Which steps of a long propagation keep their numbers and their particles: numbers at most
-/// [`max_recorded`](Self::max_recorded) steps (every k-th, k = ⌈steps / max⌉, and the last),
-/// particles (and so clouds and surfaces) at most [`max_detailed`](Self::max_detailed). Memory
-/// is then bounded whatever the step count. Evaluation and drawing share one value, resolved
-/// once.
-///
-/// ```
-/// use posecov::plan::StepPolicy;
-/// let p = StepPolicy::default();
-/// assert!(p.records(0, 100) && p.records(100, 100));
-/// assert!(p.detailed(95, 100) && !p.detailed(96, 100) && p.detailed(100, 100));
-/// let long = (0..=100_000).filter(|k| p.records(*k, 100_000)).count();
-/// assert!(long <= 1001);
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct StepPolicy {
-    /// At most this many recorded steps per propagation (plus the last).
-    pub max_recorded: u64,
-    /// At most this many detailed steps per propagation (plus the last).
-    pub max_detailed: u64,
-}
-
-impl Default for StepPolicy {
-    fn default() -> Self {
-        Self {
-            max_recorded: 1000,
-            max_detailed: 20,
-        }
-    }
-}
-
-impl StepPolicy {
-    fn keeps(step: u64, last: u64, max: u64) -> bool {
-        let stride = last.div_ceil(max.max(1)).max(1);
-        step.is_multiple_of(stride) || step == last
-    }
-
-    /// Whether step `step` of a propagation whose last step is `last` keeps its numbers.
-    ///
-    /// ```
-    /// assert!(posecov::plan::StepPolicy::default().records(7, 7));
-    /// ```
-    pub fn records(&self, step: u64, last: u64) -> bool {
-        Self::keeps(step, last, self.max_recorded)
-    }
-
-    /// Whether step `step` keeps its particles and is drawn in full.
-    ///
-    /// ```
-    /// assert!(posecov::plan::StepPolicy::default().detailed(0, 7));
-    /// ```
-    pub fn detailed(&self, step: u64, last: u64) -> bool {
-        self.records(step, last) && Self::keeps(step, last, self.max_detailed)
     }
 }
 

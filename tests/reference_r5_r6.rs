@@ -139,6 +139,7 @@ fn r5_se2_embedding_matches_se3_and_monte_carlo() {
         steps: StepPolicy {
             max_recorded: 1,
             max_detailed: 1,
+            max_sampled: 1,
         },
         ..mc_settings(100_000, 2014)
     };

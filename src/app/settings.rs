@@ -336,7 +336,7 @@ pub fn resolve(
         .confidence
         .or(file.confidence)
         .unwrap_or(Confidence::DEFAULT);
-    let steps = overrides.steps.unwrap_or_default();
+    let steps = overrides.steps.or(file.steps).unwrap_or_default();
     Ok(Settings {
         eval: EvalSettings {
             seed: overrides.seed.or(file.seed).unwrap_or(0),

@@ -388,9 +388,24 @@ fn finding_text(f: &Finding) -> String {
             output,
             steps,
             recorded,
-        } => format!(
-            "`{output}` has {steps} steps: {recorded} evenly spaced ones (and the last) are recorded and drawn, to bound memory."
-        ),
+            sampled,
+        } => {
+            let mut s = format!("`{output}` has {steps} steps: ");
+            if recorded <= steps {
+                s.push_str(&format!(
+                    "{recorded} evenly spaced ones (and the last) are recorded and drawn, to bound memory."
+                ));
+            } else {
+                s.push_str("every one is recorded.");
+            }
+            if sampled < recorded {
+                s.push_str(&format!(
+                    " **Monte Carlo at {sampled} of {} steps**: every sample takes every step, and the cloud's statistics (mean, covariance, coverage with their standard errors) are taken at {sampled} evenly spaced steps, the drawn ones and the last, to bound time.",
+                    steps + 1
+                ));
+            }
+            s
+        }
         Finding::Interrupted => {
             "*Evaluation interrupted: later operations or steps were not evaluated.*".to_owned()
         }

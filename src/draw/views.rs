@@ -153,11 +153,46 @@ pub(super) fn before_after(scene: &Scene, plan: &ViewInputs, after: &str) -> Vec
         },
     ];
     let aspect = views_aspect(scene, views.len());
+    // The after view opens on the final solution: fitted to its last state and what is
+    // static, not to the dead-reckoning state it starts the timeline with.
+    let last = scene
+        .states
+        .as_ref()
+        .and_then(|s| s.steps.last())
+        .map(|(_, k)| *k);
+    let keep = |i: &SceneItem| match i.timing {
+        crate::scene::Timing::Step(k) => {
+            !scene.states.as_ref().is_some_and(|s| s.contains(&i.path)) || Some(k) == last
+        }
+        _ => true,
+    };
     for view in &mut views {
-        view.camera = camera(&points_of(scene, view, |_| true), plan, aspect);
+        view.camera = camera(&robust(points_of(scene, view, keep)), plan, aspect);
         view.grid_spacing = view.camera.as_ref().map(grid_spacing);
     }
     views
+}
+
+/// The points without outliers: those within 1.5 × the 98th-percentile distance from the
+/// median point (per axis), so that one far pose or cloud sample does not shrink the rest.
+///
+fn robust(points: Vec<Vector3<f64>>) -> Vec<Vector3<f64>> {
+    if points.len() < 20 {
+        return points;
+    }
+    let median = |axis: usize| {
+        let mut v: Vec<f64> = points.iter().map(|p| p[axis]).collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let centre = Vector3::new(median(0), median(1), median(2));
+    let mut d: Vec<f64> = points.iter().map(|p| (p - centre).norm()).collect();
+    d.sort_by(f64::total_cmp);
+    let reach = 1.5 * d[(d.len() as f64 * 0.98) as usize];
+    points
+        .into_iter()
+        .filter(|p| (p - centre).norm() <= reach)
+        .collect()
 }
 
 /// The ground grid's spacing for a view opening with `camera`: a nice length (1, 2 or 5 ×
@@ -447,6 +482,17 @@ mod tests {
         let sight = (Vector3::from(c.target) - Vector3::from(c.position)).normalize();
         let off = sight.dot(&Vector3::y()).abs().acos().to_degrees();
         assert!((off - OBLIQUE_TILT_DEG).abs() < 1.0, "{off}°");
+    }
+
+    #[test]
+    fn one_far_point_does_not_shrink_the_rest() {
+        let mut points: Vec<Vector3<f64>> = (0..99)
+            .map(|i| Vector3::new((i % 10) as f64, (i / 10) as f64, 0.0))
+            .collect();
+        points.push(Vector3::new(1e6, 0.0, 0.0));
+        let kept = robust(points);
+        assert_eq!(kept.len(), 99);
+        assert!(kept.iter().all(|p| p.x < 10.0));
     }
 
     #[test]

@@ -131,6 +131,8 @@ pub enum Finding {
         steps: u64,
         /// Steps recorded.
         recorded: u64,
+        /// Recorded steps with Monte Carlo statistics (all recorded ones without Monte Carlo).
+        sampled: u64,
     },
     /// Ctrl-C stopped the evaluation: later operations or steps are missing.
     Interrupted,

@@ -335,6 +335,17 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
     }
 }
 
+/// `run(c, chunk)` over the slice's chunks of [`CHUNK_SIZE`](crate::sample::CHUNK_SIZE), in
+/// parallel: chunk `c` (counted from the slice's start) makes its own generators, e.g. one per
+/// step of a run of steps with [`chunk_rng`](crate::sample::chunk_rng)`(seed, family_k,
+/// first_chunk + c)` — the draws [`fill_par_map`] makes one step at a time.
+pub(super) fn fill_par_runs<G: Send>(xs: &mut [G], run: impl Fn(u64, &mut [G]) + Sync) {
+    use rayon::prelude::*;
+    xs.par_chunks_mut(crate::sample::CHUNK_SIZE)
+        .enumerate()
+        .for_each(|(c, chunk)| run(c as u64, chunk));
+}
+
 /// `x ← f(rng, x)` over a slice, in parallel, deterministic per seed and family.
 pub(super) fn fill_par_map<G: Copy + Send + Sync>(
     xs: &mut [G],

@@ -23,7 +23,8 @@ use crate::propagate::odometry::{
 use crate::sample::Sampler;
 use crate::uncertain::{Method, Side, UncertainPose};
 
-use super::ops::fill_par_map;
+use super::ops::{fill_par_map, fill_par_runs};
+use crate::sample::chunk_rng;
 
 impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
     /// Odometry: analytic recursions, then every particle takes every step with fresh noise;
@@ -88,6 +89,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         }
         let last = controls.len() as u64;
         let name = self.output();
+        let policy = self.settings.steps;
         let step_estimates = |k: usize| -> Vec<Propagated<G, N>> {
             tracks.iter().filter_map(|t| t.get(k).copied()).collect()
         };
@@ -95,32 +97,50 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             .monte_carlo
             .then(|| self.particles_of(&start, start_particles).as_ref().clone());
         let samplers = Sampler::<G, N>::right_noise(noise.as_slice()).map_err(|e| self.math(e))?;
-        self.push_step(&name, 0, last, step_estimates(0), current.as_deref())?;
-        for (k, control) in controls.iter().enumerate() {
+        let first = current.as_deref().filter(|_| policy.samples(0, last));
+        self.push_step(&name, 0, last, step_estimates(0), first)?;
+        // From one recorded step to the next, each chunk of particles takes every step in
+        // one task (the same draws as one parallel pass per step: step k's family, chunk c's
+        // stream), and only the recorded step is pushed (the others keep no numbers).
+        let mut done = 0usize;
+        while done < controls.len() {
             if self.settings.cancelled() {
                 self.out.findings.push(Finding::Interrupted);
                 break;
             }
-            if let (Some(particles), Some(sampler)) =
-                (current.as_mut(), samplers.get(k).or(samplers.first()))
-            {
-                let family = self.next_family();
+            let next = (done + 1..=controls.len())
+                .find(|&k| policy.records(k as u64, last))
+                .unwrap_or(controls.len());
+            if let Some(particles) = current.as_mut() {
+                let families: Vec<u64> = (done..next).map(|_| self.next_family()).collect();
                 let (seed, first_chunk) = (self.settings.seed, self.first_chunk());
-                fill_par_map(particles, seed, family, first_chunk, |rng, x| {
-                    let w = sampler.draw_tangent(rng);
-                    match model {
-                        OdometryModel::Increment => x.compose(&control.increment).rplus(&w),
-                        OdometryModel::Exp => x.rplus(&(control.tangent + w)),
+                let run: Vec<(&Control<G, N>, Option<&Sampler<G, N>>)> = (done..next)
+                    .map(|k| (&controls[k], samplers.get(k).or(samplers.first())))
+                    .collect();
+                fill_par_runs(particles, |c, chunk| {
+                    for ((control, sampler), &family) in run.iter().zip(&families) {
+                        let Some(sampler) = sampler else { continue };
+                        let mut rng = chunk_rng(seed, family, first_chunk + c);
+                        for x in chunk.iter_mut() {
+                            let w = sampler.draw_tangent(&mut rng);
+                            *x = match model {
+                                OdometryModel::Increment => x.compose(&control.increment).rplus(&w),
+                                OdometryModel::Exp => x.rplus(&(control.tangent + w)),
+                            };
+                        }
                     }
                 });
             }
             self.push_step(
                 &name,
-                k as u64 + 1,
+                next as u64,
                 last,
-                step_estimates(k + 1),
-                current.as_deref(),
+                step_estimates(next),
+                current
+                    .as_deref()
+                    .filter(|_| policy.samples(next as u64, last)),
             )?;
+            done = next;
         }
         self.nominal_path(tracks[0].iter().map(|r| *r.pose.mean()).collect());
         self.thinned(last);
@@ -159,16 +179,22 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         });
     }
 
-    /// Says when a long propagation recorded only some steps.
+    /// Says when a long propagation recorded only some steps, or took Monte Carlo statistics
+    /// at only some of them.
     pub(super) fn thinned(&mut self, last: u64) {
-        let recorded = (0..=last)
-            .filter(|k| self.settings.steps.records(*k, last))
-            .count() as u64;
-        if recorded < last + 1 {
+        let policy = self.settings.steps;
+        let recorded = (0..=last).filter(|k| policy.records(*k, last)).count() as u64;
+        let sampled = if self.monte_carlo {
+            (0..=last).filter(|k| policy.samples(*k, last)).count() as u64
+        } else {
+            recorded
+        };
+        if recorded < last + 1 || sampled < recorded {
             self.out.findings.push(Finding::StepsThinned {
                 output: self.output(),
                 steps: last,
                 recorded,
+                sampled,
             });
         }
     }

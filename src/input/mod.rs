@@ -329,6 +329,9 @@ pub struct FileSettings {
     pub methods: Vec<Method>,
     /// Sigma-point parameters (`[methods.sigma_points]`), if given.
     pub sigma_points: Option<crate::propagate::sigma_point::Unscented>,
+    /// Which steps of long propagations keep numbers, particles and Monte Carlo statistics
+    /// (a pose graph's: [`crate::plan::StepPolicy::GRAPH`]); `None`: the default.
+    pub steps: Option<crate::plan::StepPolicy>,
 }
 
 /// A checked input: the plan to evaluate and what the file says about it.

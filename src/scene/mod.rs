@@ -448,6 +448,46 @@ pub struct Scene {
     /// column (robot logs, whose health findings need the height); else the plots stand under
     /// the text panel on the right.
     pub plots_below: bool,
+    /// A subtree whose items at several steps are successive states of one picture (a pose
+    /// graph's after view, re-solved loop closure by loop closure), if any: a figure of every
+    /// step draws each of its entities' last state only, and a figure at step K its state
+    /// after K loop closures ([`States`]).
+    pub states: Option<States>,
+}
+
+/// Successive states of one subtree on the `step` timeline ([`Scene::states`]).
+///
+/// ```
+/// let s = posecov::scene::States { path: "world/optimized".into(), steps: vec![(0, 0), (5, 12), (9, 13)] };
+/// assert_eq!(s.step_after(6), Some(12));
+/// assert_eq!(s.step_after(100), Some(13));
+/// assert!(s.contains("world/optimized/marginals") && !s.contains("world/optimized_x"));
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct States {
+    /// The subtree's path.
+    pub path: String,
+    /// (how many loop closures the state has, its step), in order.
+    pub steps: Vec<(u64, i64)>,
+}
+
+impl States {
+    /// The step of the last state with at most `count` loop closures (the first state's when
+    /// none has so few).
+    pub fn step_after(&self, count: u64) -> Option<i64> {
+        self.steps
+            .iter()
+            .rev()
+            .find(|(k, _)| *k <= count)
+            .or(self.steps.first())
+            .map(|(_, s)| *s)
+    }
+
+    /// Whether `path` is in the subtree.
+    pub fn contains(&self, path: &str) -> bool {
+        path.strip_prefix(self.path.as_str())
+            .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
+    }
 }
 
 impl Scene {
@@ -470,6 +510,7 @@ impl Scene {
             legend: Vec::new(),
             confidence: None,
             plots_below: false,
+            states: None,
         }
     }
 

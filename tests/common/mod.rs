@@ -215,6 +215,7 @@ pub fn mc_settings(samples: usize, seed: u64) -> EvalSettings {
         steps: StepPolicy {
             max_recorded: u64::MAX,
             max_detailed: u64::MAX,
+            max_sampled: u64::MAX,
         },
         ..Default::default()
     }

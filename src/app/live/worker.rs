@@ -36,6 +36,7 @@ pub const PREVIEW_SAMPLES: u64 = CHUNK_SIZE as u64 / 2;
 pub const PREVIEW_STEPS: StepPolicy = StepPolicy {
     max_recorded: 25,
     max_detailed: 5,
+    max_sampled: 25,
 };
 
 /// Monte Carlo work (particle-steps, [`AnyPlan::monte_carlo_work`](crate::plan::AnyPlan::monte_carlo_work))

@@ -81,11 +81,17 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         state(p, g, &s.poses, &s.covariances, None, &look);
     } else {
         let chain_end = p.scene.steps().last().copied().unwrap_or(0).max(0) as u64;
+        let mut states = Vec::new();
         for (i, step) in g.timeline.steps.iter().enumerate() {
             let at = if i == 0 { 0 } else { chain_end + i as u64 };
             state(p, g, &step.poses, &step.covariances, Some(at), &look);
             closed_so_far(p, g, step, at, radius);
+            states.push((step.closures as u64, at as i64));
         }
+        p.scene.states = Some(scene::States {
+            path: format!("{WORLD}/{AFTER}"),
+            steps: states,
+        });
     }
     // Loop closures: lines between the optimised ends; residual arrows X_i·Z → X_j.
     for (outliers, name, color) in [(false, "inliers", scene::LINK), (true, "outliers", OUTLIER)] {

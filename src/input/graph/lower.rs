@@ -14,7 +14,7 @@ use super::{InputError, Locator, Summary};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
 use crate::plan::{
-    AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, limits,
+    AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, StepPolicy, limits,
 };
 use crate::uncertain::{Method, Side, UncertainPose};
 
@@ -443,6 +443,7 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         plan: G::any(plan),
         defaults: FileSettings {
             methods: vec![Method::FirstOrder, Method::MonteCarlo],
+            steps: Some(StepPolicy::GRAPH),
             ..FileSettings::default()
         },
         draw: choices,

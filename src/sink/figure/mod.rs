@@ -7,7 +7,11 @@
 //! its robot-scale view, a graph's before and after, one method each), with every step of a
 //! propagation at once ([`Steps::All`], each step's frame numbered; a robot log's messages:
 //! the last, as the viewer opens) or the state at one step ([`Steps::At`], what the viewer
-//! shows with its time cursor there). Around it: the title, the confidence of every drawn
+//! shows with its time cursor there). A pose graph ([`Scene::states`]) is drawn as its before
+//! and its **final** after: with every step, the odometry chain's steps at once and the after
+//! view's last state only — the intermediate loop-closure states stay on the viewer's `step`
+//! timeline, never overlaid; `--step K` draws the state after K loop closures (the last
+//! timeline state with at most K). Around it: the title, the confidence of every drawn
 //! region, axes in metres with a grid whose spacing is stated and a scale bar, the legend with
 //! colour swatches ([`Scene::legend`]) and the scene's plots against step or time.
 //!
@@ -31,8 +35,12 @@ pub mod chart;
 mod panel;
 mod raster;
 mod region;
+mod steps;
 pub mod svg;
 pub mod world;
+
+pub use steps::MAX_DRAWN_STEPS;
+use steps::{drawn_steps, selected};
 
 pub use world::Plane;
 
@@ -171,7 +179,28 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
         about.insert(0, format!("regions at {} confidence", p));
     }
     let steps = scene.steps();
+    let graph_states = scene.states.as_ref().map(|s| &s.steps);
+    match (options.steps, graph_states) {
+        (Steps::All, Some(states)) => {
+            if let Some((k, _)) = states.last() {
+                about.push(format!(
+                    "before, and after: the final solution ({k} loop closures)"
+                ));
+            }
+        }
+        (Steps::At(k), Some(states)) => {
+            let step = scene
+                .states
+                .as_ref()
+                .and_then(|s| s.step_after(k.max(0) as u64));
+            if let Some((count, _)) = states.iter().find(|(_, s)| Some(*s) == step) {
+                about.push(format!("after {count} loop closures (--step {k})"));
+            }
+        }
+        _ => {}
+    }
     match (options.steps, steps.first(), steps.last()) {
+        _ if graph_states.is_some() => {}
         (Steps::All, Some(a), Some(b)) if a != b => {
             let drawn = drawn_steps(scene);
             if drawn.len() == steps.len() {
@@ -289,92 +318,6 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
         );
     }
     out.finish()
-}
-
-/// The items a figure draws: geometry only (no text), at the chosen steps. With every step, a
-/// robot log's items (at stamps) are each entity's last, as the viewer opens: the last message
-/// drawn whole over the static outlines of every drawn message.
-fn selected(scene: &Scene, steps: Steps) -> Vec<&SceneItem> {
-    let drawable = |i: &&SceneItem| !matches!(i.kind, ItemKind::Text(_));
-    match steps {
-        Steps::All => {
-            let drawn = drawn_steps(scene);
-            let mut last_stamp: std::collections::BTreeMap<&str, i64> = Default::default();
-            for item in &scene.items {
-                if let Timing::Stamp(ns) = item.timing {
-                    let last = last_stamp.entry(item.path.as_str()).or_insert(ns);
-                    *last = (*last).max(ns);
-                }
-            }
-            scene
-                .items
-                .iter()
-                .filter(|i| match i.timing {
-                    Timing::Step(k) => drawn.contains(&k),
-                    Timing::Stamp(ns) => last_stamp.get(i.path.as_str()) == Some(&ns),
-                    Timing::Static => true,
-                })
-                .filter(drawable)
-                .collect()
-        }
-        Steps::At(k) => {
-            // Per entity, its latest item at or before step k (static first, then by step).
-            let mut order: Vec<usize> = (0..scene.items.len()).collect();
-            order.sort_by_key(|&i| match scene.items[i].timing {
-                Timing::Static => (0, 0),
-                Timing::Step(s) => (1, s),
-                Timing::Stamp(ns) => (2, ns),
-            });
-            let mut latest: std::collections::BTreeMap<&str, usize> = Default::default();
-            for i in order {
-                let item = &scene.items[i];
-                if !matches!(item.timing, Timing::Step(s) if s > k) {
-                    latest.insert(item.path.as_str(), i);
-                }
-            }
-            let keep: std::collections::BTreeSet<usize> = latest.into_values().collect();
-            scene
-                .items
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| keep.contains(i))
-                .map(|(_, item)| item)
-                .filter(drawable)
-                .collect()
-        }
-    }
-}
-
-/// At most this many steps are drawn at once: a longer propagation shows its steps with
-/// clouds and regions (the detailed ones), evenly thinned to this many, always the last.
-pub const MAX_DRAWN_STEPS: usize = 12;
-
-/// The steps an all-steps figure draws: every step when they are few, else the detailed
-/// steps (those with clouds or regions), evenly thinned to [`MAX_DRAWN_STEPS`] with the first
-/// and the last.
-fn drawn_steps(scene: &Scene) -> Vec<i64> {
-    let steps = scene.steps();
-    if steps.len() <= MAX_DRAWN_STEPS {
-        return steps;
-    }
-    let mut detailed: Vec<i64> = scene
-        .items
-        .iter()
-        .filter(|i| matches!(i.kind, ItemKind::Points(_) | ItemKind::Surface(_)))
-        .filter_map(|i| match i.timing {
-            Timing::Step(k) => Some(k),
-            _ => None,
-        })
-        .collect();
-    detailed.sort_unstable();
-    detailed.dedup();
-    let pool = if detailed.len() >= 2 { detailed } else { steps };
-    let stride = (pool.len() - 1).div_ceil(MAX_DRAWN_STEPS - 1).max(1);
-    let mut drawn: Vec<i64> = pool.iter().step_by(stride).copied().collect();
-    if let Some(last) = pool.last().filter(|l| drawn.last() != Some(l)) {
-        drawn.push(*last);
-    }
-    drawn
 }
 
 /// Draws the world panel; returns the grid spacing (metres).

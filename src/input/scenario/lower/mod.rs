@@ -222,6 +222,7 @@ impl Lowering<'_> {
             confidence,
             methods,
             sigma_points: self.sigma_points(&self.file.methods.sigma_points, h.group.dof())?,
+            steps: None,
         })
     }
 
