@@ -45,7 +45,7 @@ use std::collections::{BTreeMap, VecDeque};
 
 use nalgebra::{Matrix6, SMatrix, Vector3};
 
-use super::{RightForm, right_form};
+use super::meaning::{RightForm, right_form};
 
 mod math;
 mod model;
