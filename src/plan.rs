@@ -23,6 +23,12 @@
 //! plan.operation("map_from_camera", Op::Compose { lhs: map_from_robot, rhs: Operand::Known(robot_from_camera), cross_cov: None });
 //! assert_eq!(plan.definitions(), 2);
 //! ```
+//!
+//! Here: `Plan<G>` (poses, `Op`s with typed values and resolved operands), `StepPolicy` (which
+//! steps keep numbers and particles), `limits` (sizes refused up front); `plan/log.rs`:
+//! `LogSummary`, a robot log as bounded data (topics, health counts, drawn messages, series; no
+//! container format, no words); graph, thinning, `/tf`, reference: `plan/`'s module docs. Not
+//! here: spans, key names, strings to parse, words for users.
 
 use nalgebra::{Matrix3, Vector3};
 
