@@ -11,6 +11,8 @@
 //! `tests/data/robot_localization/test2.bag`, `logs/` for `tests/data/mcap/` and `logs/*.bag`
 //! for the bags of `tests/data/robot_localization/`.
 //!
+//! The CLI reference's `posecov --help` block is compared with what the binary prints.
+//!
 //! Skipped, and why: commands that open a viewer (no `report`, `check`, `figure` or `--save`:
 //! they need `rerun` or a browser), `live` (a server and a viewer), and `--reference` (the
 //! guide's reference files and ground-truth topic are the user's; `tests/nees.rs` runs NEES on
@@ -211,4 +213,26 @@ fn every_guide_command_that_writes_or_prints_runs() {
         ran.len()
     );
     std::fs::remove_dir_all(&tmp).ok();
+}
+
+/// The CLI reference's `posecov --help` block is what the binary prints.
+#[test]
+fn the_cli_reference_shows_the_binarys_help() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let page = std::fs::read_to_string(root.join("docs/guide/cli.md")).expect("cli.md");
+    let heading = "## Every option: `posecov --help`";
+    let after = &page[page.find(heading).expect("the --help section")..];
+    let start = after.find("```text\n").expect("a text block") + "```text\n".len();
+    let end = start + after[start..].find("\n```").expect("closed block");
+    let help = Command::new(BIN)
+        .arg("--help")
+        .output()
+        .expect("run --help");
+    assert!(help.status.success());
+    let printed = String::from_utf8_lossy(&help.stdout);
+    assert_eq!(
+        &after[start..end],
+        printed.trim_end_matches('\n'),
+        "docs/guide/cli.md: paste `posecov --help` again"
+    );
 }

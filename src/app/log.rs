@@ -1,5 +1,5 @@
 //! Robot logs (ROS 1 bags, MCAP) through the application: read one streamed with a progress
-//! bar and Ctrl-C, evaluate, draw ([`run`], called by [`super::run::Run::start`]); the
+//! bar and Ctrl-C, evaluate, draw (`run`, called by [`super::run::Run::start`]); the
 //! printing commands' text and JSON.
 //!
 //! ```

@@ -4,13 +4,13 @@
 //!
 //! - [`scenario`]: TOML scenario files (and the bundled lecture scenarios);
 //! - [`graph`]: g2o / GTSAM text pose graphs (and two bundled GTSAM examples);
-//! - [`bag`]: robot logs, ROS 1 bags and MCAP files (ROS 2), streamed.
+//! - [`log`]: robot logs, ROS 1 bags and MCAP files (ROS 2), streamed.
 //!
 //! [`locate`] is the one entry: it finds the file (or a bundled example by name) and decides
 //! its [`Format`] by content and extension, once; [`Format::kind`] says whether it is a plan
 //! ([`open_located`]: that format's reader) or a robot log ([`log::read_located`]). A new plan
 //! format is a [`Format`] variant, a [`Source`] variant and one arm in [`open_file`] and
-//! [`open_text`]; a new log source is one module under [`bag`] and one arm in
+//! [`open_text`]; a new log source is one module under [`log`] and one arm in
 //! [`log::read_located`].
 //!
 //! ```
