@@ -24,6 +24,11 @@
 //! let pose = msg.try_to_uncertain(RosReading::Tf2).unwrap();
 //! assert_eq!(RosPoseWithCovariance::from_uncertain(&pose, RosReading::Tf2), msg);
 //! ```
+//!
+//! # What this module and `convert.rs` own
+//!
+//! The boundaries: ROS `PoseWithCovariance` (`ros.rs`: the one ROS conversion, in tf2's or the body
+//! reading), rotation-first orders (the one permutation), Euler-angle charts; nalgebra/glam.
 
 use nalgebra::{Matrix3, Matrix6, SVector, Vector3, Vector6};
 use serde::{Deserialize, Serialize};

@@ -24,6 +24,13 @@
 //! let back = world_from_cam.between(&world_from_body); // cam_from_body
 //! assert!(back.compose(&body_from_cam).rminus(&Se3::identity()).norm() < 1e-12);
 //! ```
+//!
+//! # What this folder owns
+//!
+//! The groups SO(2), SE(2), SO(3), SE(3): closed forms per group file, everything generic written
+//! once on `LieGroup`; group facts (`GroupKind`: DOF, rotation range, planar; `to_se3`).
+//!
+//! It does not know about files or drawing.
 
 use std::fmt::{Debug, Display};
 use std::ops::Range;

@@ -23,6 +23,13 @@
 //! plan.operation("map_from_camera", Op::Compose { lhs: map_from_robot, rhs: Operand::Known(robot_from_camera), cross_cov: None });
 //! assert_eq!(plan.definitions(), 2);
 //! ```
+//!
+//! Here: `Plan<G>` (poses, `Op`s with typed values and resolved operands), `StepPolicy` (`plan/steps.rs`:
+//! which steps keep numbers, particles and Monte Carlo statistics; a pose graph's
+//! `StepPolicy::GRAPH`), `limits` (sizes refused up front); `plan/log.rs`:
+//! `LogSummary`, a robot log as bounded data (topics, health counts, drawn messages, series; no
+//! container format, no words; `plan/log/health.rs` the one table of health findings); graph, thinning, `/tf`, reference: `plan/`'s module docs. Not
+//! here: spans, key names, strings to parse, words for users.
 
 use nalgebra::{Matrix3, Vector3};
 

@@ -3,6 +3,9 @@
 //!
 //! Right / body (default): X = μ · Exp(ε); left / world: X = Exp(ε) · μ; ε ~ N(0, Σ).
 //! Σ_left = Ad_μ Σ_right Ad_μᵀ. See the [crate conventions](crate#conventions).
+//!
+//! Here: `UncertainPose` (mean, Σ, side), side changes, marginals (the one world-position
+//! covariance, `position_cov_in_world_3d`); `validate.rs` and `confidence.rs` below.
 
 use nalgebra::{Matrix2, Matrix3, SMatrix, Vector2, Vector3};
 use serde::{Deserialize, Serialize};

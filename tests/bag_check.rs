@@ -1,4 +1,4 @@
-//! `posecov check` as CI gates on it, and the exit-code table (README, `--help`): 1 on a
+//! `posecov check` as CI gates on it, and the exit-code table (docs/guide/cli.md, `--help`): 1 on a
 //! log's defects, 2 when a log cannot be processed (no pose-with-covariance topic), no empty
 //! recording written, `--allow` by name, a closed stdout ends quietly with 0.
 

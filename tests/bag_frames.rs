@@ -166,7 +166,7 @@ fn log_with(
     log.finish()
 }
 
-/// The committed AMCL-like log (the README's picture of a join): this file's [`log_with`] with
+/// The committed AMCL-like log (the guide's picture of a join, docs/guide/logs.md): this file's [`log_with`] with
 /// AMCL's map → odom and the odometry's covariance growing as dead reckoning's does
 /// ([`growing_cov`]). `POSECOV_UPDATE_GOLDEN=1 cargo test --test bag_frames` rewrites it.
 const AMCL_EXAMPLE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mcap/amcl_tf.mcap");
@@ -188,7 +188,7 @@ fn committed_amcl_log_is_the_generators_output() {
         read(Path::new(AMCL_EXAMPLE)) == read(&generated),
         "tests/data/mcap/amcl_tf.mcap is not this generator's output: rerun with POSECOV_UPDATE_GOLDEN=1"
     );
-    // What the README shows: /odom (in odom) drawn in map beside /amcl_pose.
+    // What the guide (docs/guide/logs.md) shows: /odom (in odom) drawn in map beside /amcl_pose.
     let run = log_run(Path::new(AMCL_EXAMPLE));
     let odom = run.evaluation.topics.iter().find(|t| t.name == "/odom");
     let join = odom.and_then(|t| t.joined.as_ref()).expect("joined");

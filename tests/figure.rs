@@ -311,15 +311,20 @@ fn the_command_writes_each_format_and_refuses_others() {
 }
 
 #[test]
-fn the_gallery_has_every_bundled_example_and_the_readme_shows_it() {
+fn the_gallery_has_every_bundled_example_and_the_figures_page_shows_it() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let readme = std::fs::read_to_string(root.join("README.md")).expect("README");
+    let page = std::fs::read_to_string(root.join("docs/guide/figures.md")).expect("figures page");
     for example in posecov::input::examples() {
         let file = format!("docs/gallery/{}.png", example.name);
         assert!(
             root.join(&file).is_file(),
             "{file} missing: cargo run --release --example gallery"
         );
-        assert!(readme.contains(&file), "README does not show {file}");
+        // The page sits in docs/guide/: it links the picture as ../gallery/NAME.png.
+        let link = format!("../gallery/{}.png", example.name);
+        assert!(
+            page.contains(&link),
+            "docs/guide/figures.md does not show {file}"
+        );
     }
 }

@@ -156,7 +156,7 @@ fn tf_and_tum_references_give_the_topic_s_numbers() {
     let a = anees(&topic(&by_topic, "/ekf")["consistency"]).0;
     let b = anees(&topic(&by_tf, "/ekf")["consistency"]).0;
     let c = anees(&topic(&by_file, "/ekf")["consistency"]).0;
-    // POSECOV_NEES_OUT=DIR keeps the log and its TUM truth there (the README's picture).
+    // POSECOV_NEES_OUT=DIR keeps the log and its TUM truth there (the picture in docs/guide/logs.md).
     if let Some(out) = std::env::var_os("POSECOV_NEES_OUT") {
         let out = PathBuf::from(out);
         std::fs::create_dir_all(&out).unwrap();

@@ -48,16 +48,17 @@ fn every_bundled_scenario_evaluates_and_draws() {
     }
 }
 
-/// The README's commented scenario example is a valid scenario.
+/// The guide's commented scenario example (docs/guide/scenarios.md) is a valid scenario.
 #[test]
-fn readme_example_parses_and_evaluates() {
-    let readme = include_str!("../README.md");
+fn guide_example_parses_and_evaluates() {
+    let readme = include_str!("../docs/guide/scenarios.md");
     let start = readme
         .find("```toml\n")
-        .expect("README has a ```toml block")
+        .expect("docs/guide/scenarios.md has a ```toml block")
         + "```toml\n".len();
     let end = start + readme[start..].find("```").expect("closed block");
-    let loaded = load_text(&readme[start..end], "README.md").unwrap_or_else(|e| panic!("{e}"));
+    let loaded =
+        load_text(&readme[start..end], "docs/guide/scenarios.md").unwrap_or_else(|e| panic!("{e}"));
     pipeline(&loaded, &small(), None).unwrap_or_else(|e| panic!("{e}"));
 }
 

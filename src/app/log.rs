@@ -237,7 +237,7 @@ fn sigma_json(e: &crate::eval::log::TopicEvaluation) -> serde_json::Value {
 
 /// The JSON report of a log: per topic its type, frames, counts, stamps (s), planar or 3-D
 /// with the χ² dimensions, drawn messages, and health (per issue the count and first stamp in
-/// seconds); the skipped topics. Keys are stable (see the README).
+/// seconds); the skipped topics. Keys are stable (see docs/guide/json-report.md).
 ///
 /// See the [module docs](self) for an example.
 pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {

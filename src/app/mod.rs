@@ -13,6 +13,41 @@
 //! assert!(!evaluation.records().is_empty());
 //! assert!(scene.validate().is_ok());
 //! ```
+//!
+//! # What this folder owns
+//!
+//! - `run.rs`: `open` (the one place an input's kind is decided: `input::locate`, then a plan is
+//!   read, a log is kept to stream) and one pure `Run` of any input, started by `Run::start(opened,
+//!   &overrides, RunOptions)` — the only place that matches the input's kind, which every command
+//!   (`report`, `check`, `figure`, the viewer) goes through, `RunOptions` saying whether the scene
+//!   is drawn and progress shown
+//! - `checked.rs`: `Checked`, what `check` found (`Run::Plan(PlanRun)`: evaluation, scene, later
+//!   Monte Carlo blocks; `Run::Log(LogRun)`: the log read, evaluated, drawn)
+//! - settings resolved once (`settings.rs`: flags over file over defaults, errors name the flag;
+//!   `resolve` for a plan, `resolve_log` for a log, both checked against one table of the flags
+//!   that apply to one kind of input only — logs, plans, or pose graphs — `kind_flags`, and a
+//!   graph's `--joint` ids against its vertices)
+//! - the pure pipeline (`load`, `evaluate`, `pipeline`, `report_json`; every key of every format's
+//!   report is documented in `docs/report.schema.json`, `REPORT_SCHEMA_VERSION`)
+//! - the printing commands (`commands.rs`)
+//! - many inputs at once (`many.rs`: `report` and `check` of several inputs or a directory of logs
+//!   — expanded once, run in parallel on rayon's pool under one progress bar, each result printed
+//!   whole as it finishes, JSON Lines, the worst exit code)
+//! - `figure.rs` (`posecov figure`: any input's `Run`'s scene to `sink::figure`, and the gallery)
+//! - robot logs (`log.rs`: `run` — read with a progress bar, evaluate, and draw when
+//!   `RunOptions::draw` asks (`report` and `check` print numbers: their run keeps the scene's title
+//!   and description only, and `draw::items_drawn` stays where it was); `log/nees.rs`:
+//!   `--reference` decided — a topic of the log, `tf:CHILD`, a TUM file; a bare value both or
+//!   neither is refused — the observer set up and finished, `topics[].consistency`; a scene that
+//!   cannot be drawn is located in the log — and the log's text and JSON report, stamps to the µs)
+//! - `view.rs` (the default command: `run::open`, then a watched file to `live::watch_in_place` or
+//!   `session::watch_saving`, any other input to `session::show`)
+//! - `session.rs` (`show`: the one sequence that logs any `Run` — scene, then later blocks — to any
+//!   sink; `--watch --save`); and `sinks.rs`, which every path that shows a picture shares (the
+//!   viewer options, the sink chosen, served, finished with the exit code; `--png`). The imports
+//!   run one way: `view.rs` → `live/`, `session.rs` → `run.rs` → `log.rs`, and → `sinks.rs`
+//!
+//! Not here: math.
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -53,7 +88,7 @@ pub const EXIT_CANNOT: u8 = 2;
 /// Exit code after Ctrl-C (128 + SIGINT), as shells expect.
 pub const EXIT_INTERRUPTED: u8 = 130;
 
-/// The exit codes of every command, as `--help` and the README show them.
+/// The exit codes of every command, as `--help` and docs/guide/cli.md show them.
 pub const EXIT_CODES_HELP: &str = "\
 Exit codes (every command; `check` differs where shown):
   0    success (notes in a log are allowed); stdout closed by the reader (`… | head`): quiet
@@ -298,7 +333,7 @@ pub const POSECOV_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// parameters), every estimate with its error against Monte Carlo (`results`), every node's
 /// Monte Carlo statistics (`monte_carlo`: Lie mean, centred covariance, uncentred covariance
 /// about the nominal on both sides, Cartesian mean) and every finding (`findings`, e.g. the
-/// fusion cost V). Keys are stable (see the README).
+/// fusion cost V). Keys are stable (see docs/guide/json-report.md).
 ///
 /// ```
 /// use posecov::app::{Overrides, load, pipeline, report_json};

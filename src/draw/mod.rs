@@ -26,6 +26,39 @@
 //! assert!(s.items.iter().any(|i| i.path == "world/a/given/banana"));
 //! assert!(s.validate().is_ok());
 //! ```
+//!
+//! # What this folder owns
+//!
+//! - `scene(&Evaluation, &DrawSettings) → Scene`: which poses are shown (a result relative to a
+//!   frame other than the root, `b_from_world`, drawn from the root's drawn pose of that frame,
+//!   `world_from_b`'s mean, and said so), (and the lines the input asks for between named poses,
+//!   `DrawChoices::links`), each node's regions and particles (`node.rs`), shapes as geometry
+//!   (`shapes.rs`: ellipsoids, banana meshes, outlines; the caller places them), the painter
+//!   (`painter.rs`: the scene being drawn, its confidence and sizes, and the one place a shape is
+//!   placed on an entity path, at a step or a stamp), the legend's words (`legend.rs`), particles,
+//!   plots with titles and units as data (`plots.rs`), the text panel and every finding in words
+//!   (`text.rs`; `words.rs`: the placeholders of a title or description, `{{coverage …}}` and the
+//!   like, filled with the run's numbers and their standard errors — the one way a number the run
+//!   computes reaches the author's words; a pose graph's findings and its paragraph — loop closures
+//!   before and after, joint marginals — in `graph/mod.rs`, its after picture — marginals following
+//!   the loop-closure timeline on the `step` timeline after the chain's steps, loop closures,
+//!   relative uncertainties, labels that do not collide — in `graph/after.rs`), the 3-D views —
+//!   layout, hidden entities, each view's camera fitted to what it draws (`views.rs`);
+//! - `log.rs` (`draw_log`: a robot log's scene on the `stamp` timeline and its views: one whole-log
+//!   view per `frame_id`, never overlaid, and per topic a view at the robot's scale whose camera is
+//!   fitted to its last message) with `log/message.rs` (one drawn message wherever it is placed —
+//!   frame, RViz's picture, the meaning's banana, ellipsoid and cloud, or a red cross — and the
+//!   faint history)
+//! - `log/rviz.rs` (RViz's picture; a placeholder axis ≥ 1e6 clipped and labelled)
+//! - `log/robot.rs` (the selected message at the origin with its σ)
+//! - `log/plots.rs` (σ and trace plots in units and ranges fitted to the data)
+//! - `log/frames.rs` (which topic was joined to which frame by which transforms, and each frame
+//!   problem's sentence)
+//! - `log/nees.rs` (with `--reference`: one NEES plot per topic with the 95 % bound and ANEES band,
+//!   its paragraph, the verdict's words) and `log/text.rs` (the health summary and every health
+//!   word, `issue_word`)
+//!
+//! It does not evaluate.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

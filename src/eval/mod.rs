@@ -31,6 +31,54 @@
 //! let e = evaluate(&plan, &settings).unwrap();
 //! assert!(e.records().iter().any(|r| r.label == "a_inv" && r.relative_error_vs_monte_carlo.is_some()));
 //! ```
+//!
+//! # What this folder owns
+//!
+//! - `evaluate(&Plan, &EvalSettings) → Evaluation`: numbers only.
+//! - `engine.rs` (definitions table, particles, the one place a result becomes a checked node with
+//!   its Monte Carlo statistics)
+//! - `ops.rs` (one function per `Op`; the propagations — odometry, compounding, differential drive,
+//!   Euler vs Exp — in `propagations.rs`)
+//! - `reports.rs` (a method that failed, a covariance not PSD: typed findings)
+//! - `blocked.rs` (statistics summed over blocks)
+//! - `batch_means.rs` (the one Monte Carlo standard error of a mean of the samples: batch means
+//!   over 20 consecutive batches, the same for a whole and a blocked sample)
+//! - `groups.rs` (what only some groups can do)
+//! - `model.rs` (`Evaluation`, `Node`, typed `Finding`s)
+//! - `consistency.rs` (the one "inside" rule per region: the share of each node's Monte Carlo
+//!   samples inside every region an estimate draws, and their ANEES; counted in `engine.rs` for a
+//!   whole sample, in the first pass of a blocked one);
+//! - `graph/` (a plan's pose graph: `solve.rs` the Jacobians and the Levenberg–Marquardt /
+//!   Gauss–Newton loop, `sparse.rs` the block-sparse normal equations and faer's supernodal
+//!   Cholesky with a block AMD ordering, `marginals.rs` selected inversion of the factor, one
+//!   supernode at a time on dense blocks with faer's kernels (and two block solves for a pair off
+//!   its pattern), `parts.rs` the gauge of each connected part, `evaluate.rs` loop closures'
+//!   residuals before and after at the confidence, the joint marginals asked for (`--joint`) and
+//!   the relative pose's covariance, `timeline.rs` the graph re-solved loop closure by loop closure
+//!   (bounded: 24 steps, 10⁴ poses), every solve's steps reported to a `ProgressHook` the app
+//!   draws, `report.rs` the `optimized` records of `report --json`);
+//! - `log/` — a robot log's numbers — `mod.rs` (`evaluate_log`: each topic's drawn messages,
+//!   trajectory and series moved — never copied — out of its summary as `TopicMessages`; per drawn
+//!   message the right-form Gaussian (`meaning.rs`: through `interop::ros_cov_to_right` in the
+//!   chosen `RosReading`, in the topic's `GroupKind`, SE(2) or SE(3): its degrees of freedom), a seeded
+//!   cloud, RViz's numbers, its σ per estimated axis; per topic its `frame_id`; per topic the σ
+//!   summary of each axis — the streamed statistics and the median of the kept series);
+//!   - `stamped.rs` (the one home of a pose at a stamp: `StampedPoses`, SE(3) interpolation between
+//!     the bracketing samples, never extrapolated — NEES's reference and each `/tf` edge use it);
+//!   - `frames.rs` (topics in different frames joined through the log's `/tf`: the tree's problems
+//!     — a cycle, several parents, a missing link, a frame never transformed — the lowest common
+//!     frame, each drawn message and trajectory point moved by common_from_frame at its stamp, its
+//!     covariance by `interop::ros_cov_moved`; called by `evaluate_log`, which then evaluates the
+//!     moved topic as any other);
+//!   - `nees.rs` + `nees/` (NEES of every message of a log against a reference, streamed:
+//!     `NeesObserver`, the `plan::log::LogObserver` the reader hands every reference sample and
+//!     estimate message to — SE(3) interpolation of the truth without extrapolation, e = Log(X̂⁻¹
+//!     X_ref) in the right form through `log/mod.rs`'s one conversion, joint / position /
+//!     orientation NEES, ANEES with its χ² band and the typed `Verdict`, `--align` first / se3
+//!     (Umeyama); `model.rs` the settings, `Verdict` and results, `math.rs` the three NEES of one
+//!     message and Umeyama's fit)
+//!
+//! Not here: entity paths, colours, Markdown, plots, draw settings.
 
 use std::ops::Range;
 use std::sync::Arc;

@@ -19,6 +19,63 @@
 //! assert_eq!(source.format(), Format::Scenario);
 //! assert!(!input.about.title.is_empty());
 //! ```
+//!
+//! # What this folder owns
+//!
+//! - `mod.rs`: `locate` (a file or a bundled example by name → `Located`: where it is and its
+//!   `Format`, detected once), `open_located` / `open` (a plan's `Source` + `Input`), the bundled
+//!   `examples()`;
+//! - `format.rs`: which `Format` a file is (magic bytes, first token, extension; they must agree;
+//!   a directory is a ROS 2 bag by its `metadata.yaml`'s storage, `detect_dir`) and its `InputKind` (`Format::kind`: plan or log, the one place that decides);
+//! - `located.rs`: `InputError` (file:line:column: field, or file: place for binary formats) and
+//!   `Locator`. One module per input format; each reads, checks with its own locations and produces
+//!   an `Input` (plan + text + the file's settings and drawing choices).
+//! - `input/graph/`: g2o / GTSAM text graphs (`parse.rs` records and numbers, `convention.rs`
+//!   information → \[ρ; θ\] covariance and GTSAM's reading, `lower.rs` the odometry chain and loop
+//!   closures as drawn before the optimisation (their residuals are evaluated in `eval/graph/`),
+//!   `problem.rs` the optimisation problem — a `plan::graph::PoseGraph` with the file's priors and
+//!   `FIX` records, and the initial guess chained from the edges when the file has no vertex lines,
+//!   `bundled.rs`).
+//! - `input/log/`: robot logs, streamed — `ros1.rs` (ROS 1 bags through the `rosbag` crate: chunks
+//!   found by the index, decompressed a few per thread in parallel, messages in file order),
+//!   `ros1_linear.rs` (a ROS 1 bag without a usable index — cut short, or its recording interrupted
+//!   — read chunk by chunk from the start up to the cut, which the plan keeps as `LogCut`)
+//!   - `mcap.rs` (MCAP through the `mcap` crate's sans-I/O reader; channels in `cdr` or `ros1`
+//!     encoding, each keeping its codec)
+//!   - `rosbag2.rs` (ROS 2 bag directories: `metadata.yaml` versions 1–9 read by a small
+//!     block-YAML reader, storage `sqlite3` or `mcap`, split files in order and checked present
+//!     before reading, zstd `file` compression decompressed to a temporary file and `message`
+//!     compression handed to the SQLite reader; the same metadata in a `.db3`'s `metadata` table)
+//!   - `sqlite.rs` (one `.db3` through `rusqlite`'s bundled SQLite: `topics`, then `messages` in
+//!     row order, one pass; a damaged file located by the last row read and `dbstat`'s corrupted
+//!     pages, a cut one by its header's page count)
+//!   - `decode.rs` (ROS 1 serialization and CDR via `re_cdr`'s serde of the message types, into
+//!     `plan::log::PoseMessage`, the one message struct from decoder to drawn message)
+//!   - `health.rs` (every covariance-health word and threshold; `TopicHealth`, the per-message
+//!     health and σ work, which `benches/bag_read.rs` times alone; `health/classify.rs` one
+//!     message's covariance and orientation on their own: one pass decides the common case, every
+//!     check the rest)
+//!   - `mod.rs` (`read_located`: one arm per log source; the collector of every message)
+//!   - `topic.rs` (one topic's streaming state: stamps, health, constancy, the σ statistics of
+//!     every message)
+//!   - `bundled.rs`
+//!   - `tf.rs` (`/tf` and `/tf_static` decoded by `reference.rs`'s decoder — the one TF decoder —
+//!     and kept per edge, bounded, into `plan::log::TfTree`)
+//!   - `reference.rs` (the message types a reference is read from — PoseStamped, TransformStamped,
+//!     TFMessage, the pose of the covariance types — in ROS 1 and CDR; the collector hands the
+//!     reference's samples, and every estimate message, to a `LogObserver` in file order:
+//!     `read_located_observed`); `input/tum.rs` reads a TUM trajectory file (a log's
+//!     `--reference`); it produces a `plan::log::LogSummary`, not an `Input` (no `Plan<G>`: a log
+//!     is evaluated by `eval::log`).
+//! - `input/scenario/`: `schema.rs` (serde, spans)
+//!   - `parse_errors.rs` (TOML errors in the file's words)
+//!   - `values.rs` (means, covariances, controls)
+//!   - `lower/` (every check: `mod.rs` the one table of operation keys, settings, names and
+//!     operands; `operations.rs` each kind's values and ranges; `choices.rs` the camera and the
+//!     sigma-point parameters)
+//!   - `bundled.rs`
+//!
+//! It does not evaluate.
 
 use std::path::Path;
 

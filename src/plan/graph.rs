@@ -21,6 +21,12 @@
 //! ```
 //!
 //! [CONVENTIONS §10]: crate::conventions#10-pose-graphs-g2o-and-gtsam
+//!
+//! # In the plan
+//!
+//! `plan/graph.rs`: `PoseGraph` (vertices, edges and priors with their information in g2o's reading
+//! — GTSAM's is derived, `GraphReading`, one half-angle rule — fixed vertices; the residual r =
+//! Log(Z⁻¹ X_i⁻¹ X_j) and χ²), carried by `Plan::graph`.
 
 use super::{AnyPlan, Plan};
 use crate::lie::{LieGroup, TangentMatrix};

@@ -5,6 +5,11 @@
 //! data (for the JSON report and the viewer), with the relative Frobenius error against
 //! Monte Carlo where Monte Carlo ran. Monte Carlo itself is the evaluation engine's
 //! ([`crate::eval`]): particles flow through the operations of a [`crate::plan::Plan`].
+//!
+//! # What this folder owns
+//!
+//! The analytic methods (first order, 2nd/4th order, sigma points, vector space, odometry,
+//! differential drive, fusion); not Monte Carlo (that is `eval/`).
 
 pub mod diff_drive;
 pub mod first_order;

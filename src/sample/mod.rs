@@ -36,6 +36,11 @@
 //! ```
 //!
 //! [CONVENTIONS §8]: crate::conventions#8-sample-statistics
+//!
+//! # What this folder owns
+//!
+//! Seeded chunked sampling (`mod.rs`); the one Lie mean (`LieMeanAccumulator`, streaming over
+//! blocks) and sample statistics (`statistics.rs`).
 
 use std::fmt::Debug;
 

@@ -35,6 +35,19 @@
 //! ));
 //! assert!(scene.validate().is_ok());
 //! ```
+//!
+//! # What this folder owns
+//!
+//! The plain-data scene (items on entity paths, plots, series; the legend (`LegendEntry`: colour,
+//! swatch mark, words) and the confidence of its regions; `Timing::Step` / `Timing::Stamp` and the
+//! scene's `Timeline`; 3-D views with their cameras: `view.rs`; the viewer's layout at 1024 × 640 —
+//! the panes' sizes, the legend's tiles, each 3-D view's shape (a log's views above its rows of
+//! plots too), which the cameras are fitted to, and the one measure of text (the bundled font's
+//! advance widths) that the legend tiles and the figures wrap with: `layout.rs`), palette, mesh,
+//! validation; layout choices as data (`Plot::range`, a value axis fitted by `draw/`;
+//! `Scene::plots_below`, the plots under the views for robot logs).
+//!
+//! It does not know Rerun.
 
 pub mod layout;
 mod mesh;

@@ -33,6 +33,23 @@
 //! # }
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! # What this folder owns
+//!
+//! `figure/`: Scene → a static figure without Rerun (the one sink built without the `viewer`
+//! feature; `svg.rs` the SVG writer, `mod.rs` the figure's layout (the world panels, the legend and
+//! plots beside), `panel.rs` one world panel per 3-D view and their grid, `world.rs` the plane
+//! projection of every item kind, `region.rs` a surface as the outline of its projected triangles'
+//! union, `chart.rs` axes, scale bar, legend and plots, `raster.rs` PNG through resvg and PDF
+//! through svg2pdf with the bundled font `assets/fonts/`); Scene → Rerun archetypes (`rerun.rs`)
+//! and the layout (`blueprint.rs`: blueprint archetypes written directly, with each view's
+//! `EyeControls3D` and hidden entities); .rrd files (written whole or not at all), stdout, spawn,
+//! connect, the embedded web viewer on loopback; `restream.rs`: a new scene in place of the last in
+//! the same recording (clears of every entity position touched before, frames overwritten instead;
+//! plots under a generation path, earlier ones shadowed by static empty scalars; the layout sent
+//! again only when the views change).
+//!
+//! It does not decide what to draw.
 
 #[cfg(feature = "viewer")]
 pub mod blueprint;

@@ -1,6 +1,9 @@
 //! Confidence regions ([CONVENTIONS §7]): how far out, in Mahalanobis radius, a region of a
 //! d-dimensional Gaussian holds probability p (χ² with d degrees of freedom), and back.
 //!
+//! Here: `Confidence` (a probability in (0, 1), checked once; its χ² radius), χ² radii and
+//! probabilities of confidence regions, the ANEES band, `Region` and `Coverage`.
+//!
 //! [CONVENTIONS §7]: crate::conventions#7-drawing-uncertainty
 
 use serde::{Deserialize, Serialize};

@@ -1,5 +1,8 @@
 //! Validation of covariances: finite, symmetric and positive semi-definite within the one
 //! pair of tolerances every stage uses (files, evaluation, the health of robot logs).
+//!
+//! The one symmetry and PSD rule (`symmetry_tolerance`, `psd_tolerance`) that files,
+//! evaluation and the health of robot logs share.
 
 use nalgebra::allocator::Allocator;
 use nalgebra::{

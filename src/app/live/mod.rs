@@ -9,6 +9,26 @@
 //! - `server` (viewer feature): the page and its JSON API on loopback.
 //! - `proxy` (viewer feature): the served web viewer through the page (same origin).
 //! - `run` (viewer feature): the `live` command and `--watch`.
+//!
+//! # What this folder owns
+//!
+//! - live mode and `--watch` on a viewer: `controls.rs` (the controls, generated from the TOML
+//!   document and `OPERATION_KINDS`: no second list of keys; the methods offered are those an
+//!   evaluation with every method ran, `AnyEvaluation::methods_that_ran`: no second list of which
+//!   method applies)
+//! - `document.rs` (edits on a `toml_edit` document, comments kept, each loaded with
+//!   `app::load_text` so validation is the file's; reset; the text to save)
+//! - `worker.rs` (the evaluation thread: newest change only, `passes` — a preview with fewer
+//!   samples and steps kept, then the full picture — a newer change cancels the refinement, never a
+//!   first picture; status)
+//! - `server.rs` (the page and JSON API on loopback, Host/Origin checked; the page itself is
+//!   `assets/live/`)
+//! - `proxy.rs` (the served web viewer and its gRPC-web stream forwarded through the page, same
+//!   origin; the viewer's servers stay on loopback)
+//! - `prose.rs` (the title's and description's typed values restated when edited)
+//! - `run.rs` (the `live` command, `--watch`)
+//!
+//! Not here: math, drawing, Rerun archetypes.
 
 pub mod controls;
 pub mod document;

@@ -1,6 +1,6 @@
 //! Covariance health of one message, and the per-topic state that finds drops, unbounded
 //! growth and a covariance that stays constant while the pose moves. Names, classes and
-//! thresholds are the README's ("Covariance health").
+//! thresholds are the user guide's (docs/guide/logs.md, "Covariance health").
 
 use crate::plan::log::{AxisStats, COV_LEN, Health, Issue, IssueCount, PoseMessage, Stretch};
 

@@ -1,5 +1,10 @@
 //! Bounded, even thinning of a log's per-message series: the drawn messages and series the
 //! reader keeps (`input::log`), and the NEES series kept at the same messages (`eval::log::nees`).
+//!
+//! # In the plan
+//!
+//! `plan/log/decimate.rs` (the one bounded, even thinning: drawn messages, series and the NEES
+//! series at the same messages).
 
 /// Keeps items at indices that are multiples of `stride`; when more than `cap` are kept, the
 /// stride doubles and every other one is dropped. Memory stays bounded by `cap`.

@@ -11,6 +11,11 @@
 //! let s = ReferenceSample { stamp_ns: 1, position: [0.0; 3], orientation_xyzw: [0.0, 0.0, 0.0, 1.0] };
 //! assert_eq!(s.stamp_ns, 1);
 //! ```
+//!
+//! # In the plan
+//!
+//! `plan/log/reference.rs` (a reference in the log, its samples, what the reader saw of it, and
+//! `LogObserver`, the streamed per-message hook from the reader to evaluation).
 
 use std::fmt;
 

@@ -2,6 +2,11 @@
 //! frame → child frame) its samples, bounded, as the reader kept them. Nothing here looks a
 //! transform up (`eval::log::frames` does, through `eval::log::stamped`).
 //! What is kept, and why memory stays bounded: [`TfTree`].
+//!
+//! # In the plan
+//!
+//! `plan/log/tf.rs` (`TfTree`: a log's transforms per parent → child edge, at most 8192 `/tf`
+//! samples per edge evenly thinned, the latest `/tf_static` value, at most 64 edges).
 
 use super::ReferenceSample;
 

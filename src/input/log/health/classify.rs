@@ -1,5 +1,5 @@
 //! One message's covariance health: what its 36 entries and its orientation say on their own
-//! ([`classify`]), the words and thresholds of the README's "Covariance health". A topic's
+//! ([`classify`]), the words and thresholds of docs/guide/logs.md's "Covariance health". A topic's
 //! running state (drops, growth, constant stretches, counts) is the parent module's.
 //!
 //! Most messages are decided by one pass ([`clean_full_block`]): an EKF's covariance, every
