@@ -163,14 +163,14 @@ fn errors_name_the_file_and_the_flag() {
     let (code, _, err) = run(&["check", "camera_on_robot", "--topic", "/odom"]);
     assert_eq!(code, Some(2));
     assert!(
-        err.contains("--topic /odom: applies to robot logs (ROS 1 bags, MCAP files) only"),
+        err.contains("--topic /odom: applies to robot logs (ROS 1 bags, MCAP files, ROS 2 SQLite bags) only"),
         "{err}"
     );
     // A flag for the other kind of input is refused once, by name, with what it is for.
     let (code, _, err) = run(&["camera_on_robot", "--every", "3", "--save", "x.rrd"]);
     assert_eq!(code, Some(2));
     assert!(
-        err.contains("--every 3: applies to robot logs (ROS 1 bags, MCAP files) only (it draws every N-th message of a log); this input is a scenario"),
+        err.contains("--every 3: applies to robot logs (ROS 1 bags, MCAP files, ROS 2 SQLite bags) only (it draws every N-th message of a log); this input is a scenario"),
         "{err}"
     );
     let (code, _, err) = run(&["report", TEST2, "--block-samples", "4096"]);

@@ -296,7 +296,7 @@ pub struct Settings {
 /// let e = resolve(&loaded.input, &Overrides { samples: Some(1), ..Default::default() }, None).unwrap_err();
 /// assert_eq!(e.to_string(), "--samples 1: out of range: use 2 ..= 10000000");
 /// let e = resolve(&loaded.input, &Overrides { every: Some(3), ..Default::default() }, None).unwrap_err();
-/// assert!(e.to_string().starts_with("--every 3: applies to robot logs (ROS 1 bags, MCAP files) only"), "{e}");
+/// assert!(e.to_string().starts_with("--every 3: applies to robot logs (ROS 1 bags, MCAP files, ROS 2 SQLite bags) only"), "{e}");
 /// let s = resolve(&loaded.input, &Overrides { seed: Some(9), ..Default::default() }, None).unwrap();
 /// assert_eq!(s.eval.seed, 9);
 /// ```
