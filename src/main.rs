@@ -12,15 +12,17 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context as _;
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use posecov::app::live::{self, LiveOptions};
 use posecov::app::sinks::{EXIT_INTERRUPTED, ServeOptions, ViewOptions};
 use posecov::app::view::view;
 use posecov::app::{AppError, EXIT_CANNOT, EXIT_CODES_HELP, Overrides};
 use posecov::app::{commands, many};
-use posecov::eval::graph::{GraphReading, Optimizer};
 use posecov::interop::RosReading;
 use posecov::sink::Sink;
+
+mod flags;
+use flags::{GraphReadingArg, OptimizerArg, parse_joint, parse_probability, parse_size};
 
 /// See robot pose uncertainty: Lie-group poses with covariances, propagated and drawn in Rerun.
 ///
@@ -230,40 +232,6 @@ struct EvalArgs {
     joints: Vec<(u64, u64)>,
 }
 
-/// `--graph-reading`'s values (the flag's words for [`GraphReading`]).
-#[derive(Debug, Clone, Copy, ValueEnum)]
-enum GraphReadingArg {
-    /// As g2o defines the information matrices.
-    G2o,
-    /// As GTSAM's readG2o reads them.
-    Gtsam,
-}
-
-/// `--optimizer`'s values (the flag's words for [`Optimizer`]).
-#[derive(Debug, Clone, Copy, ValueEnum)]
-enum OptimizerArg {
-    /// Levenberg–Marquardt.
-    Lm,
-    /// Gauss–Newton.
-    Gn,
-}
-
-/// `A,B`: two vertex ids.
-fn parse_joint(text: &str) -> Result<(u64, u64), String> {
-    let parse = |s: &str| s.trim().parse::<u64>().ok();
-    match text.split_once(',') {
-        Some((a, b)) => match (parse(a), parse(b)) {
-            (Some(a), Some(b)) => Ok((a, b)),
-            _ => Err(format!(
-                "expected two vertex ids A,B (non-negative integers), got `{text}`"
-            )),
-        },
-        None => Err(format!(
-            "expected two vertex ids separated by a comma, A,B, got `{text}`"
-        )),
-    }
-}
-
 impl EvalArgs {
     fn overrides(&self) -> Overrides {
         Overrides {
@@ -277,14 +245,8 @@ impl EvalArgs {
             reference: None,
             align: None,
             steps: None,
-            graph_reading: self.graph_reading.map(|r| match r {
-                GraphReadingArg::G2o => GraphReading::G2o,
-                GraphReadingArg::Gtsam => GraphReading::Gtsam,
-            }),
-            optimizer: self.optimizer.map(|o| match o {
-                OptimizerArg::Lm => Optimizer::LevenbergMarquardt,
-                OptimizerArg::Gn => Optimizer::GaussNewton,
-            }),
+            graph_reading: self.graph_reading.map(GraphReadingArg::reading),
+            optimizer: self.optimizer.map(OptimizerArg::optimizer),
             joints: self.joints.clone(),
         }
     }
@@ -340,26 +302,6 @@ struct ServeArgs {
     /// Open the served web viewer in the default browser.
     #[arg(long)]
     open_browser: bool,
-}
-
-fn parse_probability(s: &str) -> Result<posecov::uncertain::Confidence, String> {
-    let p = s.parse::<f64>().map_err(|e| e.to_string())?;
-    posecov::uncertain::Confidence::new(p).map_err(|e| e.to_string())
-}
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|n| (16..=8192).contains(n))
-    };
-    match s.split_once(['x', 'X']).map(|(w, h)| (parse(w), parse(h))) {
-        Some((Some(w), Some(h))) => Ok((w, h)),
-        _ => Err(format!(
-            "{s:?} is not WIDTHxHEIGHT with sides in 16..=8192, e.g. 1024x640"
-        )),
-    }
 }
 
 impl ScenarioArgs {

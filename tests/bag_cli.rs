@@ -163,7 +163,9 @@ fn errors_name_the_file_and_the_flag() {
     let (code, _, err) = run(&["check", "camera_on_robot", "--topic", "/odom"]);
     assert_eq!(code, Some(2));
     assert!(
-        err.contains("--topic /odom: applies to robot logs (ROS 1 bags, MCAP files, ROS 2 SQLite bags) only"),
+        err.contains(
+            "--topic /odom: applies to robot logs (ROS 1 bags, MCAP files, ROS 2 SQLite bags) only"
+        ),
         "{err}"
     );
     // A flag for the other kind of input is refused once, by name, with what it is for.

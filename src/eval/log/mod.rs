@@ -1,6 +1,6 @@
 //! The numbers of a robot log ([`LogSummary`]): per drawn message, what its covariance means in
 //! posecov's body-frame right form (through the one ROS conversion,
-//! [`ros_cov_to_right`]), a seeded sample cloud, and the numbers RViz draws from
+//! [`ros_cov_to_right`](crate::interop::ros_cov_to_right)), a seeded sample cloud, and the numbers RViz draws from
 //! the same message. Planar topics become SE(2) (x, y, yaw), others SE(3).
 //!
 //! Confidence regions: a planar topic's position region has d = 2 degrees of freedom and its
