@@ -101,7 +101,7 @@ pub enum EvalError {
 
 impl EvalError {
     /// The message without its place (`operation[i] `): what a located error says after the
-    /// file's own place for that operation ([`crate::app::Loaded::locate`]). Errors of no
+    /// file's own place for that operation (the app's `Loaded::locate`). Errors of no
     /// operation are their whole message.
     ///
     /// ```
