@@ -3,7 +3,7 @@
 
 use posecov::app::{Loaded, Overrides, Settings, load, load_text, resolve};
 use posecov::draw::{particle_part, scene as build_scene};
-use posecov::eval::{AnyEvaluation, Finding, evaluate_block};
+use posecov::eval::{AnyEvaluation, Finding, PointEstimate, evaluate_block};
 use posecov::propagate::ResultRecord;
 use posecov::scene::ItemKind;
 use posecov::uncertain::Method;
@@ -166,7 +166,18 @@ fn assert_blocked_matches(name: &str, samples: u64, block: usize) {
     if let (AnyEvaluation::Se3(a), AnyEvaluation::Se3(b)) = (&single, &blocked) {
         for (pa, pb) in a.points.iter().zip(&b.points) {
             assert_eq!(pa.estimates.len(), pb.estimates.len(), "{name} {}", pa.name);
-            for ((ma, mean_a, cov_a), (mb, mean_b, cov_b)) in pa.estimates.iter().zip(&pb.estimates)
+            for (
+                PointEstimate {
+                    method: ma,
+                    mean: mean_a,
+                    cov: cov_a,
+                },
+                PointEstimate {
+                    method: mb,
+                    mean: mean_b,
+                    cov: cov_b,
+                },
+            ) in pa.estimates.iter().zip(&pb.estimates)
             {
                 assert_eq!(ma, mb);
                 for (x, y) in mean_a.iter().zip(mean_b) {
@@ -211,7 +222,7 @@ fn blocked_statistics_equal_single_block_statistics_for_every_group_and_operatio
         e.points[0]
             .estimates
             .iter()
-            .any(|(m, ..)| *m == Method::MonteCarlo),
+            .any(|p| p.method == Method::MonteCarlo),
         "the landmark has a Monte Carlo estimate"
     );
     assert_blocked_matches("camera_on_robot", 3000, 1024);
@@ -234,8 +245,8 @@ fn blocked_compounding_and_diff_drive_match_single_block() {
         assert_eq!(sa.len(), sb.len(), "{name}");
         for (x, y) in sa.iter().zip(&sb) {
             assert_eq!(
-                (&x.path, x.points.len()),
-                (&y.path, y.points.len()),
+                (&x.path(), x.points.len()),
+                (&y.path(), y.points.len()),
                 "{name}"
             );
             for ((kx, vx), (ky, vy)) in x.points.iter().zip(&y.points) {
@@ -243,7 +254,7 @@ fn blocked_compounding_and_diff_drive_match_single_block() {
                 assert!(
                     (vx - vy).abs() <= 1e-8 * vx.abs().max(1e-12),
                     "{name} {}: {vx} vs {vy}",
-                    x.path
+                    x.path()
                 );
             }
         }

@@ -402,10 +402,14 @@ fn graph_flags_are_refused_by_name_where_they_do_not_apply() {
         },
     );
     assert!(e.starts_with("--joint 1,2: applies to pose graphs"), "{e}");
-    let e = posecov::app::resolve_log(&Overrides {
-        joints: vec![(1, 2)],
-        ..Overrides::default()
-    })
+    let e = resolve(
+        posecov::app::RobotLog,
+        &Overrides {
+            joints: vec![(1, 2)],
+            ..Overrides::default()
+        },
+        None,
+    )
     .unwrap_err()
     .to_string();
     assert!(e.ends_with("this input is a robot log"), "{e}");

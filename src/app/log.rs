@@ -19,15 +19,13 @@ use super::AppError;
 use super::checked::Checked;
 use super::run::RunOptions;
 use super::settings::LogSettings;
-use crate::draw::log::{
-    LogDrawSettings, description, draw_log, issue_sentence, issue_word, topic_entity,
-};
+use crate::draw::log::{LogDrawSettings, description, draw_log, issue_sentence, issue_word};
 use crate::eval::log::{LogEvaluation, evaluate_log};
 use crate::input::log::{LogOptions, bundled, read_located_observed};
 use crate::input::{About, InputError, Located, Place};
 use crate::plan::log::LogObserver;
 use crate::plan::log::{Class, Issue, LogSummary};
-use crate::scene::{Scene, SceneError, Timing};
+use crate::scene::{Origin, Scene, SceneError, Timing};
 
 /// A read, evaluated and drawn log.
 #[derive(Debug, Clone)]
@@ -99,7 +97,7 @@ pub(super) fn run(
         let scene = draw_log(&evaluation, &draw, &summary);
         scene
             .validate()
-            .map_err(|e| undrawable(located, &evaluation, &scene, e))?;
+            .map_err(|e| undrawable(located, &scene, e))?;
         scene
     } else {
         Scene::new(draw.about.title, summary)
@@ -114,28 +112,30 @@ pub(super) fn run(
 }
 
 /// A log's scene that cannot be drawn (a number beyond what the viewer holds, `f32`, that
-/// evaluation let through), located in the log's words: the topic from the item's entity path,
-/// the message from its stamp (a static overview names the topic only).
-fn undrawable(located: &Located, e: &LogEvaluation, scene: &Scene, error: SceneError) -> AppError {
+/// evaluation let through), located in the log's words from the item's typed origin
+/// ([`SceneItem::origin`](crate::scene::SceneItem::origin)): the topic and the message it
+/// shows (a static overview names the topic only).
+fn undrawable(located: &Located, scene: &Scene, error: SceneError) -> AppError {
     let item = scene.items.iter().find(|i| i.validate().is_err());
-    let topic = item.and_then(|item| {
-        e.topics.iter().find(|t| {
-            item.path
-                .starts_with(&format!("{}/", topic_entity(&t.name)))
-        })
-    });
-    let place = match (topic, item.map(|i| i.timing)) {
-        (Some(t), Some(Timing::Stamp(ns))) => match t.poses.iter().find(|p| p.stamp_ns == ns) {
-            Some(p) => format!(
-                "topic {}, message {} (stamp {:.3} s)",
-                t.name,
-                p.index,
-                stamp_seconds(ns)
-            ),
-            None => format!("topic {}, stamp {:.3} s", t.name, stamp_seconds(ns)),
-        },
-        (Some(t), _) => format!("topic {} (its overview of every drawn message)", t.name),
-        (None, _) => "the log's drawing".to_owned(),
+    let place = match item.map(|i| (i.origin.as_ref(), i.timing)) {
+        Some((
+            Some(Origin::Topic {
+                topic,
+                message: Some(m),
+            }),
+            _,
+        )) => format!(
+            "topic {topic}, message {} (stamp {:.3} s)",
+            m.index,
+            stamp_seconds(m.stamp_ns)
+        ),
+        Some((Some(Origin::Topic { topic, .. }), Timing::Stamp(ns))) => {
+            format!("topic {topic}, stamp {:.3} s", stamp_seconds(ns))
+        }
+        Some((Some(Origin::Topic { topic, .. }), _)) => {
+            format!("topic {topic} (its overview of every drawn message)")
+        }
+        Some((Some(Origin::Node(_)) | None, _)) | None => "the log's drawing".to_owned(),
     };
     AppError::Input(InputError::In {
         file: located.origin(),
@@ -469,7 +469,7 @@ mod tests {
         Overrides,
         run::{Run, open},
     };
-    use crate::scene::{Color, ItemKind, LineStrips, SceneItem};
+    use crate::scene::{Color, ItemKind, LineStrips, Origin, SceneItem, paths};
 
     #[test]
     fn an_undrawable_value_is_located_in_the_log() {
@@ -483,17 +483,24 @@ mod tests {
         let topic = &run.evaluation.topics[1];
         let pose = &topic.poses[2];
         let mut scene = run.scene.clone();
-        scene.items.push(SceneItem::new(
-            format!("{}/meaning/banana_outline", topic_entity(&topic.name)),
+        let mut item = SceneItem::new(
+            paths::child(&paths::topic(&topic.name), "meaning/banana_outline"),
             Timing::Stamp(pose.stamp_ns),
             ItemKind::LineStrips(LineStrips {
                 strips: vec![vec![[0.0; 3], [1e39, 0.0, 0.0]]],
                 color: Color::rgb(0, 0, 0),
                 radius: 0.01,
             }),
-        ));
+        );
+        // The origin draw stamps on every item of a message (what the place is read from).
+        let drawn = run.scene.items.iter().find(|i| {
+            matches!(&i.origin, Some(Origin::Topic { topic: t, message: Some(m) })
+                if *t == topic.name && m.index == pose.index)
+        });
+        item.origin = drawn.expect("the message is drawn").origin.clone();
+        scene.items.push(item);
         let error = scene.validate().unwrap_err();
-        let e = undrawable(&run.located, &run.evaluation, &scene, error).to_string();
+        let e = undrawable(&run.located, &scene, error).to_string();
         let expected = format!(
             "health_cases.mcap (bundled): topic {}, message {} (stamp {:.3} s): a value beyond what the viewer can draw (f32): ",
             topic.name,

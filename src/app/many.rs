@@ -212,8 +212,14 @@ pub fn check(
                 }
                 Err(err) => {
                     worst = worst.max(err.exit_code());
-                    let text = err.to_string();
-                    let reason = text.strip_prefix(&format!("{name}: ")).unwrap_or(&text);
+                    // The input's name once: the error's own naming of the file left out.
+                    let reason = match &err {
+                        AppError::Input(e) => match e.reason() {
+                            (file, Some(reason)) if file == name => reason,
+                            _ => err.to_string(),
+                        },
+                        _ => err.to_string(),
+                    };
                     format!("{name}: error: {reason}")
                 }
             };

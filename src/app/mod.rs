@@ -24,9 +24,10 @@
 //! - `checked.rs`: `Checked`, what `check` found (`Run::Plan(PlanRun)`: evaluation, scene, later
 //!   Monte Carlo blocks; `Run::Log(LogRun)`: the log read, evaluated, drawn)
 //! - settings resolved once (`settings.rs`: flags over file over defaults, errors name the flag;
-//!   `resolve` for a plan, `resolve_log` for a log, both checked against one table of the flags
-//!   that apply to one kind of input only — logs, plans, or pose graphs — `kind_flags`, and a
-//!   graph's `--joint` ids against its vertices)
+//!   one resolver, `resolve(&input | RobotLog, …)` over the `Target` it resolves for, every
+//!   flag checked first against one table of the flags that apply to one kind of input
+//!   only — logs, plans, or pose graphs — `kind_flags`, and a graph's `--joint` ids against its
+//!   vertices)
 //! - the pure pipeline (`load`, `evaluate`, `pipeline`, `report_json`; every key of every format's
 //!   report is documented in `docs/report.schema.json`, `REPORT_SCHEMA_VERSION`)
 //! - the printing commands (`commands.rs`)
@@ -74,7 +75,7 @@ pub mod view;
 
 pub use settings::{
     AppliesTo, DEFAULT_SAMPLES, Given, LogSettings, MAX_CLOUD_SAMPLES, Overrides, ReferenceArg,
-    ReferenceSettings, Settings, SettingsError, resolve, resolve_log,
+    ReferenceSettings, RobotLog, Settings, SettingsError, Target, resolve,
 };
 
 /// Exit code: success; notes (and, except for `check`, defects) in a log are not failures.
@@ -113,6 +114,15 @@ pub enum AppError {
     /// The drawing is not valid (a bug: evaluation checks every number it hands on).
     #[error("the scene is not drawable: {0}")]
     Scene(#[from] SceneError),
+    /// A plan's drawing is not valid at one of its poses (a bug, as [`AppError::Scene`]):
+    /// the pose (from the item's typed [`Origin`](crate::scene::Origin)) and the value.
+    #[error("{origin}: the scene is not drawable: {error}")]
+    Undrawable {
+        /// What the first undrawable item was drawn from.
+        origin: crate::scene::Origin,
+        /// The entity, field and value.
+        error: SceneError,
+    },
     /// The viewer, the file or the stream.
     #[cfg(feature = "viewer")]
     #[error(transparent)]
@@ -313,12 +323,27 @@ fn evaluate_and_draw(
         return Ok((
             settings,
             evaluation,
-            Scene::new(about.title.clone(), about.description.clone()),
+            Scene::new(
+                about.title.clone(),
+                draw::input_description(about, &loaded.input.draw),
+            ),
         ));
     }
     let scene = draw::scene(&evaluation, &settings.draw);
-    scene.validate()?;
+    scene
+        .validate()
+        .map_err(|error| undrawable(&scene, error))?;
     Ok((settings, evaluation, scene))
+}
+
+/// A plan's scene that cannot be drawn, named by the pose its first undrawable item was drawn
+/// from ([`AppError::Undrawable`]; [`AppError::Scene`] when no pose drew it).
+fn undrawable(scene: &Scene, error: SceneError) -> AppError {
+    let item = scene.items.iter().find(|i| i.validate().is_err());
+    match item.and_then(|i| i.origin.clone()) {
+        Some(origin) => AppError::Undrawable { origin, error },
+        None => AppError::Scene(error),
+    }
 }
 
 /// The layout version of `report --json` (top-level `schema_version`): raised only when a key
@@ -358,7 +383,7 @@ pub fn report_json(
         "input": loaded.source.facts(),
         "meta": {
             "title": loaded.input.about.title,
-            "description": loaded.input.about.description,
+            "description": draw::input_description(&loaded.input.about, &loaded.input.draw),
             "source": loaded.input.about.source,
             "group": evaluation.group().name(),
             "seed": ran.seed,
@@ -381,4 +406,34 @@ pub fn report_json(
         );
     }
     report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Color, ItemKind, Origin, PointCloud, SceneItem, Timing, paths};
+
+    #[test]
+    fn an_undrawable_plan_scene_names_the_pose_and_the_value() {
+        let mut scene = Scene::new("t", "");
+        let mut item = SceneItem::new(
+            paths::child(&paths::monte_carlo("T_MC"), "cloud"),
+            Timing::Static,
+            ItemKind::Points(PointCloud {
+                positions: vec![[0.0, 1e39, 0.0]],
+                color: Color::rgb(0, 0, 0),
+                radius: 0.01,
+            }),
+        );
+        item.origin = Some(Origin::Node("T_MC".into()));
+        scene.push(item);
+        let error = scene.validate().unwrap_err();
+        let e = undrawable(&scene, error).to_string();
+        assert!(
+            e.starts_with(
+                "pose T_MC: the scene is not drawable: world/T_MC/monte_carlo/cloud: positions[1] = 1000"
+            ) && e.ends_with("is not a finite number (as f32)"),
+            "{e}"
+        );
+    }
 }

@@ -1,6 +1,6 @@
 //! One pure run of any input: [`open`] decides, once, whether the input is a plan (a scenario,
 //! a pose graph) or a robot log; [`Run::start`] resolves its settings (one table of flags,
-//! [`super::resolve`] / [`super::resolve_log`]), evaluates and draws it. A run is the scene
+//! [`super::resolve`], the one resolver), evaluates and draws it. A run is the scene
 //! plus, for a plan whose Monte Carlo ran in blocks, the later blocks' clouds
 //! ([`PlanRun::block`]); every sink shows it through one sequence (`session::show`).
 //!
@@ -20,7 +20,7 @@ use std::time::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::log::{self, LogRun};
-use super::{AppError, Loaded, Overrides, Settings, resolve_log};
+use super::{AppError, Loaded, Overrides, RobotLog, Settings, resolve};
 use crate::draw;
 use crate::eval::graph::{Iteration, ProgressHook, Stage};
 use crate::eval::{self, AnyEvaluation};
@@ -230,7 +230,7 @@ impl Run {
                 run.map(|run| Run::Plan(Box::new(run)))
             }
             Opened::Log(located) => {
-                let settings = resolve_log(overrides)?;
+                let settings = resolve(RobotLog, overrides, None)?;
                 log::run(&located, &settings, &options).map(|run| Run::Log(Box::new(run)))
             }
         }

@@ -287,26 +287,111 @@ pub struct Settings {
     pub draw: DrawSettings,
 }
 
-/// Resolves the settings of `input` under `overrides` (values in the file were checked when
-/// it was read; flags are checked here and named in errors).
+/// What [`resolve`] resolves settings for: a plan's [`Input`] (`&Input`: its file's values
+/// under the flags) or a robot log ([`RobotLog`]: the flags alone, a log file has no settings
+/// of its own). Each gives its kind as far as flags go and its own values.
 ///
 /// ```
-/// use posecov::app::{Overrides, load, resolve};
+/// use posecov::app::{Given, Overrides, RobotLog, Target, load};
+/// let loaded = load("gtsam_pose2example").unwrap();
+/// assert_eq!((&loaded.input).given(), Given::PoseGraph);
+/// assert_eq!(RobotLog.given(), Given::Log);
+/// assert_eq!(RobotLog.values(&Overrides::default(), None).unwrap().eval.cloud_samples, 100);
+/// ```
+pub trait Target {
+    /// The settings it runs with: [`Settings`] for a plan, [`LogSettings`] for a log.
+    type Settings;
+    /// What it is, as far as flags go.
+    fn given(&self) -> Given;
+    /// Its values under `overrides`, the flags already checked against the one table.
+    ///
+    /// # Errors
+    /// A flag's value out of range, named by the flag.
+    fn values(
+        self,
+        overrides: &Overrides,
+        cancel: Option<Arc<AtomicBool>>,
+    ) -> Result<Self::Settings, SettingsError>;
+}
+
+/// A robot log, as [`resolve`] sees it: the flags alone (`--samples` is the cloud drawn per
+/// message).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RobotLog;
+
+impl Target for &Input {
+    type Settings = Settings;
+
+    fn given(&self) -> Given {
+        Given::of(self)
+    }
+
+    fn values(
+        self,
+        overrides: &Overrides,
+        cancel: Option<Arc<AtomicBool>>,
+    ) -> Result<Settings, SettingsError> {
+        plan_settings(self, overrides, cancel)
+    }
+}
+
+impl Target for RobotLog {
+    type Settings = LogSettings;
+
+    fn given(&self) -> Given {
+        Given::Log
+    }
+
+    fn values(
+        self,
+        overrides: &Overrides,
+        _cancel: Option<Arc<AtomicBool>>,
+    ) -> Result<LogSettings, SettingsError> {
+        log_settings(overrides)
+    }
+}
+
+/// The one settings resolver: flags over the file's values over defaults. Every flag is first
+/// checked against the one table of flags that apply to one kind of input only (the other kind
+/// refuses it by name, saying what it is for); then the target's own values are checked and
+/// resolved — a plan's `--samples` is its Monte Carlo sample, a log's the cloud drawn per
+/// message. Values in a file were checked when it was read.
+///
+/// ```
+/// use posecov::app::{Overrides, RobotLog, load, resolve};
 /// let loaded = load("camera_on_robot").unwrap();
 /// let e = resolve(&loaded.input, &Overrides { samples: Some(1), ..Default::default() }, None).unwrap_err();
 /// assert_eq!(e.to_string(), "--samples 1: out of range: use 2 ..= 10000000");
-/// let e = resolve(&loaded.input, &Overrides { every: Some(3), ..Default::default() }, None).unwrap_err();
+/// let every = Overrides { every: Some(3), ..Default::default() };
+/// let e = resolve(&loaded.input, &every, None).unwrap_err();
 /// assert!(e.to_string().starts_with("--every 3: applies to robot logs (ROS 1 bags, MCAP files, ROS 2 SQLite bags) only"), "{e}");
+/// assert!(resolve(RobotLog, &every, None).is_ok());
 /// let s = resolve(&loaded.input, &Overrides { seed: Some(9), ..Default::default() }, None).unwrap();
 /// assert_eq!(s.eval.seed, 9);
+/// let blocks = Overrides { block_samples: Some(4096), ..Default::default() };
+/// let e = resolve(RobotLog, &blocks, None).unwrap_err();
+/// assert!(e.to_string().starts_with("--block-samples 4096: applies to scenarios and pose graphs only"), "{e}");
+/// assert_eq!(resolve(RobotLog, &Overrides::default(), None).unwrap().eval.cloud_samples, 100);
 /// ```
-pub fn resolve(
+///
+/// # Errors
+/// A flag the target cannot take, or a value out of range, named by the flag.
+pub fn resolve<T: Target>(
+    target: T,
+    overrides: &Overrides,
+    cancel: Option<Arc<AtomicBool>>,
+) -> Result<T::Settings, SettingsError> {
+    check_flags(target.given(), overrides)?;
+    target.values(overrides, cancel)
+}
+
+/// A plan's values, its flags checked against the table already ([`resolve`]).
+fn plan_settings(
     input: &Input,
     overrides: &Overrides,
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<Settings, SettingsError> {
     let file = &input.defaults;
-    check_flags(Given::of(input), overrides)?;
     if let Some(ids) = input.plan.graph_vertex_ids() {
         check_joints(&overrides.joints, &ids)?;
     }
@@ -439,17 +524,9 @@ pub struct LogSettings {
     pub confidence: Confidence,
 }
 
-/// Resolves the settings of a robot log under `overrides` (a log file has no settings of its
-/// own): the same flag checks as [`resolve`], and `--samples` is the cloud drawn per message.
-///
-/// ```
-/// use posecov::app::{Overrides, resolve_log};
-/// let e = resolve_log(&Overrides { block_samples: Some(4096), ..Default::default() }).unwrap_err();
-/// assert!(e.to_string().starts_with("--block-samples 4096: applies to scenarios and pose graphs only"), "{e}");
-/// assert_eq!(resolve_log(&Overrides::default()).unwrap().eval.cloud_samples, 100);
-/// ```
-pub fn resolve_log(overrides: &Overrides) -> Result<LogSettings, SettingsError> {
-    check_flags(Given::Log, overrides)?;
+/// A robot log's values, its flags checked against the table already ([`resolve`]):
+/// `--samples` is the cloud drawn per message.
+fn log_settings(overrides: &Overrides) -> Result<LogSettings, SettingsError> {
     let samples = overrides.samples.unwrap_or(DEFAULT_CLOUD_SAMPLES as u64);
     if !(1..=MAX_CLOUD_SAMPLES).contains(&samples) {
         return Err(SettingsError::OutOfRange {

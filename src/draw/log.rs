@@ -32,7 +32,7 @@ use crate::lie::GroupKind;
 use crate::plan::choices::{About, Layout};
 use crate::scene::layout::views_aspect;
 use crate::scene::{
-    Color, ItemKind, LineStrips, Scene, Swatch, Timeline, Timing, Vec3, View3d, WORLD,
+    Color, ItemKind, LineStrips, Origin, Scene, Swatch, Timeline, Timing, Vec3, View3d, paths,
 };
 use crate::uncertain::{Confidence, Method};
 
@@ -81,10 +81,10 @@ pub struct LogDrawSettings {
 /// let scene = draw_log(&e, &settings, &description(&plan, "ROS 1 bag", &e, posecov::uncertain::Confidence::DEFAULT));
 /// assert!(scene.validate().is_ok());
 /// let topic = "world/jackal_velocity_controller/odom";
-/// assert!(scene.items.iter().any(|i| i.path == format!("{topic}/meaning/banana")));
+/// assert!(scene.items.iter().any(|i| i.path == paths::child(&topic, "meaning/banana")));
 /// // Beside the whole trajectory (84 m), the selected message at the robot's scale.
 /// assert_eq!(scene.views.len(), 2);
-/// assert_eq!(scene.views[1].include, vec![format!("{topic}/robot")]);
+/// assert_eq!(scene.views[1].include, vec![paths::child(&topic, "robot")]);
 /// ```
 pub fn draw_log(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene {
     super::counted(build(e, settings, summary))
@@ -109,6 +109,7 @@ fn build(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene 
         extent,
         layout: Layout::Together,
         methods: Vec::new(),
+        origin: None,
     };
     p.scene.planar = planar;
     p.scene.plots_below = true;
@@ -132,40 +133,6 @@ fn build(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene 
     nees::plots(&mut p.scene, e);
     p.scene.views = log_views(&p.scene, e, planar);
     p.scene
-}
-
-/// The entity path under which a topic is drawn: `world/` and its name's segments (`/a/b` →
-/// `world/a/b`; characters other than letters, digits, `_`, `-` and `.` → `_`).
-///
-/// ```
-/// assert_eq!(posecov::draw::log::topic_entity("/amcl pose"), "world/amcl_pose");
-/// ```
-pub fn topic_entity(name: &str) -> String {
-    format!("{WORLD}/{}", topic_path(name))
-}
-
-/// An entity path segment list for a topic name (`/a/b` → `a/b`; other characters → `_`).
-fn topic_path(name: &str) -> String {
-    let cleaned: Vec<String> = name
-        .split('/')
-        .filter(|s| !s.is_empty())
-        .map(|s| {
-            s.chars()
-                .map(|c| {
-                    if c.is_ascii_alphanumeric() || "_-.".contains(c) {
-                        c
-                    } else {
-                        '_'
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    if cleaned.is_empty() {
-        "root".into()
-    } else {
-        cleaned.join("/")
-    }
 }
 
 /// The frame a topic's poses are in, as its view names it.
@@ -235,11 +202,8 @@ fn log_views(scene: &Scene, e: &LogEvaluation, planar: bool) -> Vec<View3d> {
                     joined.join(", ")
                 )
             },
-            include: topics.iter().map(|t| topic_entity(&t.name)).collect(),
-            exclude: topics
-                .iter()
-                .map(|t| format!("{}/{}", topic_entity(&t.name), robot::ROBOT))
-                .collect(),
+            include: topics.iter().map(|t| paths::topic(&t.name)).collect(),
+            exclude: topics.iter().map(|t| paths::robot(&t.name)).collect(),
             ..Default::default()
         };
         let points = views::points_of(scene, &view, |_| true);
@@ -251,7 +215,7 @@ fn log_views(scene: &Scene, e: &LogEvaluation, planar: bool) -> Vec<View3d> {
         };
         let view = View3d {
             name: format!("robot scale: {} at the time cursor", t.name),
-            include: vec![format!("{}/{}", topic_entity(&t.name), robot::ROBOT)],
+            include: vec![paths::robot(&t.name)],
             ..Default::default()
         };
         let at = Timing::Stamp(last.stamp_ns);
@@ -286,7 +250,11 @@ fn flat(planar: bool, v: &Vector3<f64>) -> Vec3 {
 /// drawn message in the whole-log view (RViz's placeholder note on the shape when
 /// `rviz_note`, [`rviz_noting`]) and its robot view.
 fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation, rviz_note: bool) {
-    let base = topic_entity(&t.name);
+    let base = paths::topic(&t.name);
+    p.origin = Some(Origin::Topic {
+        topic: t.name.clone(),
+        message: None,
+    });
     let color = Method::ALL[k % Method::ALL.len()].color();
     let strip: Vec<Vec3> = t
         .trajectory
@@ -297,7 +265,7 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation, rviz_note: bool) {
     if !strip.is_empty() {
         p.legend(format!("{}: trajectory", t.name), color, Swatch::Line);
         p.place(
-            format!("{base}/trajectory"),
+            paths::child(&base, "trajectory"),
             Timing::Static,
             ItemKind::LineStrips(LineStrips {
                 strips: vec![strip],
@@ -318,5 +286,6 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation, rviz_note: bool) {
             message::message(p, &place, t, pose, &mean);
         }
     }
-    robot::robot_view(p, &base, t);
+    robot::robot_view(p, t);
+    p.origin = None;
 }

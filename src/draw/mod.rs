@@ -32,14 +32,16 @@
 //! - `scene(&Evaluation, &DrawSettings) → Scene`: which poses are shown (a result relative to a
 //!   frame other than the root, `b_from_world`, drawn from the root's drawn pose of that frame,
 //!   `world_from_b`'s mean, and said so), (and the lines the input asks for between named poses,
-//!   `DrawChoices::links`), each node's regions and particles (`node.rs`), shapes as geometry
+//!   `DrawChoices::links`), each node's regions and particles (`node.rs`), what a plan draws
+//!   besides its poses — paths, links, points, Euler frames (`extras.rs`) — shapes as geometry
 //!   (`shapes.rs`: ellipsoids, banana meshes, outlines; the caller places them), the painter
 //!   (`painter.rs`: the scene being drawn, its confidence and sizes, and the one place a shape is
 //!   placed on an entity path, at a step or a stamp), the legend's words (`legend.rs`), particles,
 //!   plots with titles and units as data (`plots.rs`), the text panel and every finding in words
 //!   (`text.rs`; `words.rs`: the placeholders of a title or description, `{{coverage …}}` and the
 //!   like, filled with the run's numbers and their standard errors — the one way a number the run
-//!   computes reaches the author's words; a pose graph's findings and its paragraph — loop closures
+//!   computes reaches the author's words; a pose graph file's description from its facts,
+//!   `graph/about.rs`; a pose graph's findings and its paragraph — loop closures
 //!   before and after, joint marginals — in `graph/mod.rs`, its after picture — marginals following
 //!   the loop-closure timeline on the `step` timeline after the chain's steps, loop closures,
 //!   relative uncertainties, labels that do not collide — in `graph/after.rs`), the 3-D views —
@@ -60,23 +62,20 @@
 //!
 //! It does not evaluate.
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::sync::atomic::{AtomicU64, Ordering as AtomicOrdering};
 
 use nalgebra::Vector3;
 
-use crate::eval::{AnyEvaluation, Evaluation, Node, PathKind, Role};
+use crate::eval::{AnyEvaluation, Evaluation, Node, Role};
 use crate::lie::{GroupKind, LieGroup, Se3};
 use crate::plan::StepPolicy;
 use crate::plan::choices::{About, DrawChoices, Layout};
-use crate::scene::WORLD;
-use crate::scene::{
-    self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, Scene,
-    Swatch, Triads, Vec3,
-};
+use crate::scene::{Arrows, Color, Frame, ItemKind, PointCloud, Scene, Swatch, Triads, Vec3};
+use crate::scene::{Origin, paths};
 use crate::uncertain::{Confidence, Method};
 
+mod extras;
 mod graph;
 mod legend;
 pub mod log;
@@ -207,17 +206,21 @@ fn part_of<G: LieGroup<N>, const N: usize>(
             .as_ref()
             .filter(|_| detailed(&settings.steps, node))
         {
+            p.origin = Some(Origin::Node(node.name.clone()));
             draw_particles(&mut p, node, particles, Some(part), &settings.choices);
+            p.origin = None;
         }
     }
     if settings.choices.clouds {
         for point in &block.points {
             if let Some(particles) = &point.particles {
+                p.origin = Some(Origin::Node(point.name.clone()));
                 p.push(
-                    format!("{WORLD}/{}/monte_carlo/cloud/block_{part}", point.name),
+                    paths::block_cloud(&point.name, part),
                     None,
                     point_cloud_item(particles.clone()),
                 );
+                p.origin = None;
             }
         }
     }
@@ -328,6 +331,8 @@ fn parent_frame(name: &str) -> Option<&str> {
     name.split_once("_from_").map(|(parent, _)| parent)
 }
 
+/// A plan's scene: its poses (each item carrying its node as origin), paths, links, a graph's
+/// optimised picture, points, Euler frames, then the plots and the views over what was drawn.
 fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSettings) -> Scene {
     let mut p = Painter::for_plan(e, settings, text::description(e, settings));
     p.scene.confidence = Some(settings.confidence);
@@ -335,135 +340,31 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     p.scene.planar = choices.top_view.unwrap_or(G::KIND.is_planar());
     let shown = Shown::new(e, choices);
     if choices.layout.is_none() {
-        let drawn: Vec<&Node<G, N>> = e
-            .nodes
-            .iter()
-            .filter(|n| shown.node(n) && n.role != Role::Fixed)
-            .collect();
-        let mut names: Vec<&str> = drawn.iter().map(|n| n.name.as_str()).collect();
-        names.dedup();
-        let most_methods = drawn
-            .iter()
-            .map(|n| {
-                n.estimates
-                    .iter()
-                    .filter(|x| is_analytic(n, x.result.method))
-                    .count()
-            })
-            .max()
-            .unwrap_or(0);
-        p.layout = views::default_layout(G::KIND.is_rotation_only(), names.len(), most_methods);
+        p.layout = default_layout(e, &shown);
     }
     for node in &e.nodes {
+        // Every item of a node carries it as its origin (an undrawable one is reported there).
+        p.origin = Some(Origin::Node(node.name.clone()));
         if shown.node(node) {
             draw_node(&mut p, node, settings);
         } else if let Some(via) = shown.through(e, node) {
             draw_through(&mut p, node, via, settings);
         }
+        p.origin = None;
     }
     if choices.trajectories {
-        let radius = 0.004 * p.extent.max(0.25);
-        for path in &e.trajectories {
-            let (name, color, what) = match path.kind {
-                PathKind::Nominal => (
-                    format!("{WORLD}/{}/nominal", path.output),
-                    scene::NOMINAL,
-                    "nominal path",
-                ),
-                PathKind::Sample(i) => (
-                    format!("{WORLD}/{}/samples/{i}", path.output),
-                    Method::MonteCarlo.color(),
-                    "Monte Carlo sample paths",
-                ),
-            };
-            p.legend(what.to_owned(), color, Swatch::Line);
-            let strip: Vec<Vec3> = path
-                .poses
-                .iter()
-                .map(|x| v3(x.to_se3().translation()))
-                .collect();
-            p.push(
-                name,
-                None,
-                ItemKind::LineStrips(LineStrips {
-                    strips: vec![strip],
-                    color,
-                    radius,
-                }),
-            );
-        }
+        extras::trajectories(&mut p, e);
     }
-    links(&mut p, e, &choices.links);
+    extras::links(&mut p, e, &choices.links);
     if let Some(g) = &e.graph {
         graph::draw_optimized(&mut p, g);
     }
     for point in &e.points {
-        for (method, mean, cov) in &point.estimates {
-            p.legend(
-                format!(
-                    "{}: {} ellipsoid of the point",
-                    method.label(),
-                    p.confidence()
-                ),
-                method.color(),
-                Swatch::Dashed,
-            );
-            let shape = shapes::ellipsoid_of(mean, cov, p.confidence().radius(3));
-            p.push(
-                format!("{WORLD}/{}/{}/ellipsoid", point.name, method.slug()),
-                None,
-                ItemKind::Ellipsoids(Ellipsoids {
-                    shapes: vec![shape],
-                    color: method.color(),
-                    fill: FillMode::MajorWireframe,
-                    line_radius: 0.003,
-                    label: None,
-                }),
-            );
-        }
-        if let (Some(particles), true) = (&point.particles, choices.clouds) {
-            p.legend(
-                format!("Monte Carlo points ({})", particles.len()),
-                Method::MonteCarlo.color(),
-                Swatch::Dots,
-            );
-            p.push(
-                format!("{WORLD}/{}/monte_carlo/cloud", point.name),
-                None,
-                point_cloud_item(particles.clone()),
-            );
-        }
+        p.origin = Some(Origin::Node(point.name.clone()));
+        extras::draw_point(&mut p, point, choices.clouds);
+        p.origin = None;
     }
-    let last_frame: BTreeMap<&str, u64> =
-        e.matrix_frames.iter().fold(BTreeMap::new(), |mut m, f| {
-            let last = m.entry(f.output.as_str()).or_insert(0);
-            *last = (*last).max(f.step);
-            m
-        });
-    for frame in &e.matrix_frames {
-        let last = last_frame
-            .get(frame.output.as_str())
-            .copied()
-            .unwrap_or(frame.step);
-        if !settings.steps.detailed(frame.step, last) {
-            continue;
-        }
-        p.scene
-            .add_legend(legend::axes("Euler-angle frame (rotation matrix columns)"));
-        for (k, color) in shapes::AXIS_COLORS.iter().enumerate() {
-            let c = frame.columns.column(k);
-            p.push(
-                format!("{WORLD}/{}/euler/axis_{}", frame.output, ["x", "y", "z"][k]),
-                Some(frame.step),
-                ItemKind::Arrows(Arrows {
-                    origins: vec![[0.0; 3]],
-                    vectors: vec![[c[0], c[1], c[2]]],
-                    color: *color,
-                    radius: 0.01,
-                }),
-            );
-        }
-    }
+    extras::euler_frames(&mut p, e, settings);
     let (plots, series) = plots::plots(e);
     p.scene.plots = plots;
     p.scene.series = series;
@@ -475,7 +376,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         camera: choices.camera,
     };
     p.scene.views = if e.graph.is_some() {
-        views::before_after(&p.scene, &plan, &format!("{WORLD}/{}", graph::AFTER))
+        views::before_after(&p.scene, &plan, &paths::optimized())
     } else {
         views::views(&p.scene, &plan)
     };
@@ -485,34 +386,42 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     p.scene
 }
 
-/// The lines the input asks for between two poses (a graph's loop closures), at
-/// `world/links`, between the poses' nominal positions.
-fn links<G: LieGroup<N>, const N: usize>(
-    p: &mut Painter,
-    e: &Evaluation<G, N>,
-    links: &[(String, String)],
-) {
-    let position = |name: &str| {
-        e.nodes
-            .iter()
-            .find(|n| n.name == name)
-            .map(|n| v3(n.nominal.to_se3().translation()))
-    };
-    let strips: Vec<Vec<Vec3>> = links
+/// The layout when the input does not choose one: by the group, the number of drawn poses
+/// (fixed ones left out) and the most analytic methods one of them shows.
+fn default_layout<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, shown: &Shown) -> Layout {
+    let drawn: Vec<&Node<G, N>> = e
+        .nodes
         .iter()
-        .filter_map(|(a, b)| Some(vec![position(a)?, position(b)?]))
+        .filter(|n| shown.node(n) && n.role != Role::Fixed)
         .collect();
-    if !strips.is_empty() {
-        p.legend("links between poses".to_owned(), scene::LINK, Swatch::Line);
-        p.push(
-            format!("{WORLD}/links"),
-            None,
-            ItemKind::LineStrips(LineStrips {
-                strips,
-                color: scene::LINK,
-                radius: 0.003 * p.extent.max(0.25),
-            }),
-        );
+    let mut names: Vec<&str> = drawn.iter().map(|n| n.name.as_str()).collect();
+    names.dedup();
+    let most_methods = drawn
+        .iter()
+        .map(|n| {
+            n.estimates
+                .iter()
+                .filter(|x| is_analytic(n, x.result.method))
+                .count()
+        })
+        .max()
+        .unwrap_or(0);
+    views::default_layout(G::KIND.is_rotation_only(), names.len(), most_methods)
+}
+
+/// An input's own description, as the text panel and `report --json` (`meta.description`)
+/// show it: the file's words, or for a pose graph the words written from its facts
+/// ([`DrawChoices::graph`]) followed by any words added to it (a live edit's note).
+///
+/// ```
+/// let input = posecov::input::graph::read_text("VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nEDGE_SE2 0 1 1 0 0 100 0 0 100 0 400\n", "a.g2o").unwrap().1;
+/// let d = posecov::draw::input_description(&input.about, &input.draw);
+/// assert!(d.starts_with("**2 vertices, 1 edges** (SE(2))."), "{d}");
+/// ```
+pub fn input_description(about: &About, choices: &DrawChoices) -> String {
+    match &choices.graph {
+        Some(facts) => graph::file_description(facts) + &about.description,
+        None => about.description.clone(),
     }
 }
 

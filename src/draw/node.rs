@@ -2,58 +2,43 @@
 //! orientation spray) on one side, and its Monte Carlo particles.
 
 use super::*;
-use crate::uncertain::Region;
+use crate::uncertain::{Region, UncertainPose};
 
 /// Colour of the Monte Carlo heading arrows of planar poses (light red).
 const HEADING_COLOR: Color = Color::rgb(255, 120, 120);
 
+/// Draws `node`: its nominal frame, then (unless fixed) every method's regions on the main
+/// method's side — only the main method's ellipsoid between the detailed steps — then says
+/// which ellipses coincide, and draws its Monte Carlo particles.
 pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     node: &Node<G, N>,
     settings: &DrawSettings,
 ) {
     let choices = &settings.choices;
-    let (axes, ellipsoids, bananas, orientation) = (
-        choices.axes,
-        choices.ellipsoids,
-        choices.bananas,
-        choices.orientation,
-    );
-    let pose3 = node.nominal.to_se3();
-    if axes {
-        p.scene.add_legend(legend::axes("pose frames"));
-        p.push(
-            format!("{WORLD}/{}/frame", node.name),
-            node.step,
-            ItemKind::Frame(Frame {
-                translation: v3(pose3.translation()),
-                rotation: pose3.rotation().to_quaternion_xyzw(),
-                axis_length: p.axis_length,
-                label: choices.labels.then(|| node.name.clone()),
-            }),
-        );
+    if choices.axes {
+        nominal_frame(p, node, choices.labels);
     }
     if node.role == Role::Fixed {
         return;
     }
-    let rotation_only = p.kind.is_rotation_only();
     let primary = primary_method(node);
-    let timing = at_step(node.step);
+    let primary_estimate = node
+        .estimates
+        .iter()
+        .find(|e| Some(e.result.method) == primary);
     if !detailed(&settings.steps, node) {
         // Between detailed steps only the (light) frame and the primary ellipsoid are logged,
         // so the step slider still shows the growth.
-        if let Some(e) = node
-            .estimates
-            .iter()
-            .find(|e| Some(e.result.method) == primary)
-            && ellipsoids
-            && !rotation_only
+        if let Some(e) = primary_estimate
+            && choices.ellipsoids
+            && !p.kind.is_rotation_only()
         {
             let who = e.result.method.label().to_owned();
             cartesian_legend(p, who, e.result.method, "");
             p.region_ellipsoid(
-                &format!("{WORLD}/{}/{}", node.name, e.result.method.slug()),
-                timing,
+                &paths::method(&node.name, e.result.method.slug()),
+                at_step(node.step),
                 &e.result.pose,
                 e.result.method.color(),
             );
@@ -63,119 +48,179 @@ pub(super) fn draw_node<G: LieGroup<N>, const N: usize>(
     // Every method's regions on the main method's side: a banana is a 3-D slice of the tangent
     // ellipsoid along its largest principal directions, which depend on the side, so one
     // Gaussian read on two sides would look like two.
-    let side = node
-        .estimates
-        .iter()
-        .find(|e| Some(e.result.method) == primary)
-        .map(|e| e.result.pose.side());
+    let side = primary_estimate.map(|e| e.result.pose.side());
     // The Cartesian ellipses drawn for this pose.
     let mut cartesian: Vec<Drawn> = Vec::new();
     for evaluated in &node.estimates {
-        let pose = side.map_or(evaluated.result.pose, |s| evaluated.result.pose.to_side(s));
         let method = evaluated.result.method;
         if method == Method::MonteCarlo && node.particles.is_some() {
             continue; // the cloud itself shows Monte Carlo
         }
-        let is_primary = Some(method) == primary;
-        // An input's own Gaussian is given, not computed by a method.
-        let estimate = if node.role == Role::Input && method == Method::Exact {
-            views::Estimate::Given
-        } else {
-            views::Estimate::Method(method)
+        let pose = side.map_or(evaluated.result.pose, |s| evaluated.result.pose.to_side(s));
+        let shown = DrawnAs {
+            estimate: record_method(p, node, method, Some(method) == primary),
+            primary: Some(method) == primary,
         };
-        let segment = estimate.segment();
-        let drawn = match p.methods.iter().position(|(n, _)| *n == node.name) {
-            Some(i) => &mut p.methods[i].1,
-            None => {
-                p.methods
-                    .push((node.name.clone(), views::PoseMethods::default()));
-                &mut p.methods.last_mut().expect("just pushed").1
-            }
-        };
-        if is_primary {
-            drawn.main = Some(estimate);
-        } else if method != Method::MonteCarlo && !drawn.others.contains(&estimate) {
-            drawn.others.push(estimate);
-        }
-        let base = format!("{WORLD}/{}/{segment}", node.name);
-        let color = method.color();
-        // The Cartesian ellipsoid: the primary method's (to contrast with its banana) and the
-        // vector-space baseline's (a Gaussian in (x, y, θ) is exactly that ellipse).
-        let who = legend::who(estimate, method.label());
-        if !rotation_only && ellipsoids && (is_primary || method == Method::VectorSpace) {
-            let ellipse_held = held(node, evaluated, &[Region::Cartesian, Region::VectorSpace]);
-            cartesian_legend(p, who.clone(), method, &ellipse_held);
-            if let Some(cov) = pose.position_cov_in_world_3d() {
-                let centre = v3(pose.mean().to_se3().translation());
-                cartesian.push((method, who.clone(), centre, cov, ellipse_held));
-            }
-            p.region_ellipsoid(&base, timing, &pose, color);
-        }
-        let region = p.confidence().to_string();
-        if bananas && !rotation_only && method != Method::VectorSpace {
-            let point_of = |x: &G| *x.to_se3().translation();
-            if is_primary || p.layout == Layout::PerMethod {
-                p.legend_with(
-                    format!("{who}: Exp-mapped {region} region"),
-                    held(node, evaluated, &[Region::Tangent]),
-                    color,
-                    Swatch::Region,
-                );
-                p.region_banana(&base, timing, &pose, color, point_of);
-            } else {
-                p.legend(
-                    format!("{who}: Exp-mapped {region} region, principal outlines"),
-                    color,
-                    Swatch::Line,
-                );
-                p.region_outlines(
-                    &format!("{base}/banana_outline"),
-                    timing,
-                    &pose,
-                    color,
-                    point_of,
-                );
-            }
-        }
-        if orientation && rotation_only {
-            p.legend(
-                format!("{who}: {region} region of each axis tip"),
-                color,
-                Swatch::Line,
-            );
-            for (k, axis) in ["axis_x", "axis_y", "axis_z"].iter().enumerate() {
-                let len = p.axis_length;
-                let path = format!("{base}/{axis}");
-                p.region_outlines(&path, timing, &pose, color, move |x| {
-                    let s = x.to_se3();
-                    s.translation() + s.rotation().act(&(Vector3::ith(k, 1.0) * len))
-                });
-            }
-        }
+        cartesian.extend(regions(p, node, evaluated, &pose, shown, choices));
     }
-    coinciding(p, &node.name, &cartesian);
+    coinciding(p, &node.name, &cartesian, &node.coinciding_ellipses());
     if let Some(particles) = &node.particles {
         draw_particles(p, node, particles, None, choices);
     }
 }
 
-/// A Cartesian ellipse drawn for a pose: (method, who, centre, covariance, the share of
-/// samples its legend entry states).
-type Drawn = (Method, String, Vec3, nalgebra::Matrix3<f64>, String);
+/// A pose's nominal frame as axes, with its name when `labels`.
+fn nominal_frame<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G, N>, labels: bool) {
+    let pose3 = node.nominal.to_se3();
+    p.scene.add_legend(legend::axes("pose frames"));
+    p.push(
+        paths::pose_frame(&node.name),
+        node.step,
+        ItemKind::Frame(Frame {
+            translation: v3(pose3.translation()),
+            rotation: pose3.rotation().to_quaternion_xyzw(),
+            axis_length: p.axis_length,
+            label: labels.then(|| node.name.clone()),
+        }),
+    );
+}
 
-/// Says when the vector-space ellipse and another method's Cartesian ellipse of one pose are
-/// the same (same centre and matrix to 1e-9 relative): one hides the other exactly, and a
-/// reader would conclude the hidden one is missing. Once per pose name, in the text panel, and
-/// in the legend in place of the hidden ellipse's own entry (one entry per line drawn).
-fn coinciding(p: &mut Painter, pose: &str, drawn: &[Drawn]) {
-    let Some((_, _, c0, m0, _)) = drawn.iter().find(|d| d.0 == Method::VectorSpace) else {
-        return;
+/// Records that `method`'s estimate of `node` is drawn (the main one, or one of the others:
+/// what the views show and hide); returns what it is drawn as (an input's own Gaussian is
+/// given, not computed by a method).
+fn record_method<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    node: &Node<G, N>,
+    method: Method,
+    is_primary: bool,
+) -> views::Estimate {
+    let estimate = if node.role == Role::Input && method == Method::Exact {
+        views::Estimate::Given
+    } else {
+        views::Estimate::Method(method)
     };
-    for (method, who, c, m, held) in drawn.iter().filter(|d| d.0 != Method::VectorSpace) {
-        let scale = m0.amax().max(f64::MIN_POSITIVE);
-        let same_matrix = (m - m0).amax() <= 1e-9 * scale;
-        let same_centre = (0..3).all(|k| (c[k] - c0[k]).abs() <= 1e-9 * (1.0 + c0[k].abs()));
-        if !(same_matrix && same_centre) {
+    let drawn = match p.methods.iter().position(|(n, _)| *n == node.name) {
+        Some(i) => &mut p.methods[i].1,
+        None => {
+            p.methods
+                .push((node.name.clone(), views::PoseMethods::default()));
+            &mut p.methods.last_mut().expect("just pushed").1
+        }
+    };
+    if is_primary {
+        drawn.main = Some(estimate);
+    } else if method != Method::MonteCarlo && !drawn.others.contains(&estimate) {
+        drawn.others.push(estimate);
+    }
+    estimate
+}
+
+/// How one estimate of a pose is drawn: as what, and whether it is the pose's main method.
+#[derive(Clone, Copy)]
+struct DrawnAs {
+    /// What it is drawn as.
+    estimate: views::Estimate,
+    /// The pose's main method (its banana is a mesh, its ellipsoid drawn).
+    primary: bool,
+}
+
+/// One estimate's regions (`pose`: on the main method's side): the Cartesian ellipsoid (the
+/// main method's, to contrast with its banana, and the vector-space baseline's: a Gaussian in
+/// (x, y, θ) is exactly that ellipse), the Exp-mapped region (a mesh for the main method or
+/// every method of a per-method layout, principal outlines otherwise) and, for rotations, each
+/// axis tip's region. Returns the Cartesian ellipse drawn, if one was.
+fn regions<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    node: &Node<G, N>,
+    evaluated: &crate::eval::Estimate<G, N>,
+    pose: &UncertainPose<G, N>,
+    shown: DrawnAs,
+    choices: &DrawChoices,
+) -> Option<Drawn> {
+    let method = evaluated.result.method;
+    let rotation_only = p.kind.is_rotation_only();
+    let timing = at_step(node.step);
+    let base = paths::method(&node.name, &shown.estimate.segment());
+    let color = method.color();
+    let who = legend::who(shown.estimate, method.label());
+    let mut cartesian = None;
+    if !rotation_only && choices.ellipsoids && (shown.primary || method == Method::VectorSpace) {
+        let ellipse_held = held(node, evaluated, &[Region::Cartesian, Region::VectorSpace]);
+        cartesian_legend(p, who.clone(), method, &ellipse_held);
+        if pose.position_cov_in_world_3d().is_some() {
+            cartesian = Some(Drawn {
+                method,
+                who: who.clone(),
+                held: ellipse_held,
+            });
+        }
+        p.region_ellipsoid(&base, timing, pose, color);
+    }
+    let region = p.confidence().to_string();
+    if choices.bananas && !rotation_only && method != Method::VectorSpace {
+        let point_of = |x: &G| *x.to_se3().translation();
+        if shown.primary || p.layout == Layout::PerMethod {
+            p.legend_with(
+                format!("{who}: Exp-mapped {region} region"),
+                held(node, evaluated, &[Region::Tangent]),
+                color,
+                Swatch::Region,
+            );
+            p.region_banana(&base, timing, pose, color, point_of);
+        } else {
+            p.legend(
+                format!("{who}: Exp-mapped {region} region, principal outlines"),
+                color,
+                Swatch::Line,
+            );
+            p.region_outlines(
+                &paths::child(&base, "banana_outline"),
+                timing,
+                pose,
+                color,
+                point_of,
+            );
+        }
+    }
+    if choices.orientation && rotation_only {
+        p.legend(
+            format!("{who}: {region} region of each axis tip"),
+            color,
+            Swatch::Line,
+        );
+        for (k, axis) in ["axis_x", "axis_y", "axis_z"].iter().enumerate() {
+            let len = p.axis_length;
+            let path = paths::child(&base, axis);
+            p.region_outlines(&path, timing, pose, color, move |x| {
+                let s = x.to_se3();
+                s.translation() + s.rotation().act(&(Vector3::ith(k, 1.0) * len))
+            });
+        }
+    }
+    cartesian
+}
+
+/// A Cartesian ellipse drawn for a pose.
+struct Drawn {
+    /// Its method.
+    method: Method,
+    /// Whose it is, in the legend's words.
+    who: String,
+    /// The share of samples its legend entry states.
+    held: String,
+}
+
+/// Says when the vector-space ellipse and another drawn method's Cartesian ellipse of one pose
+/// are the same (`same`: the evaluation's [`Node::coinciding_ellipses`]): one hides the other
+/// exactly, and a reader would conclude the hidden one is missing. Once per pose name, in the
+/// text panel, and in the legend in place of the hidden ellipse's own entry (one entry per
+/// line drawn).
+fn coinciding(p: &mut Painter, pose: &str, drawn: &[Drawn], same: &[Method]) {
+    if !drawn.iter().any(|d| d.method == Method::VectorSpace) {
+        return;
+    }
+    for Drawn { method, who, held } in drawn.iter().filter(|d| d.method != Method::VectorSpace) {
+        if !same.contains(method) {
             continue;
         }
         let region = p.confidence().to_string();
@@ -254,7 +299,7 @@ pub(super) fn draw_particles<G: LieGroup<N>, const N: usize>(
     part: Option<usize>,
     choices: &DrawChoices,
 ) {
-    let base = format!("{WORLD}/{}/monte_carlo", node.name);
+    let base = paths::monte_carlo(&node.name);
     // Later blocks of a blocked sample: their points only, as children of the first block's.
     let suffix = part.map_or_else(String::new, |k| format!("/block_{k}"));
     let poses: Vec<Se3> = particles.iter().map(LieGroup::to_se3).collect();
@@ -266,7 +311,7 @@ pub(super) fn draw_particles<G: LieGroup<N>, const N: usize>(
             Swatch::Dots,
         );
         p.push(
-            format!("{base}/cloud{suffix}"),
+            paths::child(&base, &format!("cloud{suffix}")),
             node.step,
             ItemKind::Points(PointCloud {
                 positions: poses.iter().map(|x| v3(x.translation())).collect(),
@@ -287,7 +332,7 @@ pub(super) fn draw_particles<G: LieGroup<N>, const N: usize>(
             Swatch::Line,
         );
         p.push(
-            format!("{base}/headings"),
+            paths::child(&base, "headings"),
             node.step,
             ItemKind::Arrows(Arrows {
                 origins: subsample.iter().map(|x| v3(x.translation())).collect(),
@@ -303,7 +348,7 @@ pub(super) fn draw_particles<G: LieGroup<N>, const N: usize>(
         p.scene
             .add_legend(legend::axes("Monte Carlo samples' axes (a subsample)"));
         p.push(
-            format!("{base}/triads"),
+            paths::child(&base, "triads"),
             node.step,
             ItemKind::Triads(Triads {
                 translations: subsample.iter().map(|x| v3(x.translation())).collect(),
@@ -327,7 +372,7 @@ pub(super) fn draw_particles<G: LieGroup<N>, const N: usize>(
                 })
                 .collect();
             p.push(
-                format!("{base}/{name}{suffix}"),
+                paths::child(&base, &format!("{name}{suffix}")),
                 node.step,
                 ItemKind::Points(PointCloud {
                     positions: tips,

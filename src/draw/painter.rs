@@ -10,7 +10,8 @@ use crate::lie::{GroupKind, LieGroup};
 use crate::plan::StepPolicy;
 use crate::plan::choices::Layout;
 use crate::scene::{
-    Color, Ellipsoids, FillMode, ItemKind, LineStrips, Scene, SceneItem, Surface, Swatch, Timing,
+    Color, Ellipsoids, FillMode, ItemKind, LineStrips, Origin, Scene, SceneItem, Surface, Swatch,
+    Timing, paths,
 };
 use crate::uncertain::{Confidence, UncertainPose};
 
@@ -30,6 +31,9 @@ pub(super) struct Painter {
     pub layout: Layout,
     /// Per drawn uncertain pose, the methods drawn for it (for the views).
     pub methods: Vec<(String, views::PoseMethods)>,
+    /// What the items placed now are drawn from (a robot log's topic and message), stamped on
+    /// each of them ([`SceneItem::origin`]); `None` for a plan's scene.
+    pub origin: Option<Origin>,
 }
 
 /// A step's timing: on the step timeline, or static for results without a step.
@@ -73,6 +77,7 @@ impl Painter {
             extent,
             methods: Vec::new(),
             layout: settings.choices.layout.unwrap_or(Layout::Main),
+            origin: None,
         }
     }
 
@@ -104,7 +109,9 @@ impl Painter {
 
     /// An item at a time.
     pub(super) fn place(&mut self, path: String, timing: Timing, kind: ItemKind) {
-        self.scene.push(SceneItem::new(path, timing, kind));
+        let mut item = SceneItem::new(path, timing, kind);
+        item.origin.clone_from(&self.origin);
+        self.scene.push(item);
     }
 
     /// A pose's Cartesian position region ([`shapes::position_region`]) at `base/ellipsoid`.
@@ -120,7 +127,7 @@ impl Painter {
         };
         let line_radius = 0.002 * self.axis_length / 0.15;
         self.place(
-            format!("{base}/ellipsoid"),
+            paths::child(&base, "ellipsoid"),
             timing,
             ItemKind::Ellipsoids(Ellipsoids {
                 shapes: vec![shape],
@@ -150,9 +157,13 @@ impl Painter {
             color: color.with_alpha(70),
         }
         .with_computed_normals();
-        self.place(format!("{base}/banana"), timing, ItemKind::Surface(surface));
+        self.place(
+            paths::child(&base, "banana"),
+            timing,
+            ItemKind::Surface(surface),
+        );
         self.region_outlines(
-            &format!("{base}/banana_outline"),
+            &paths::child(&base, "banana_outline"),
             timing,
             pose,
             color,

@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 use crate::eval::{Evaluation, Node, Role};
 use crate::lie::LieGroup;
 use crate::plan::OpKind;
-use crate::scene::{self, Corner, Plot, ScalarSeries};
+use crate::scene::{self, Corner, Plot, PlotId, ScalarSeries};
 use crate::uncertain::{Method, Region};
 
 /// A kind of plot: entity id, title (what and in which frame), unit, and the corner its legend
@@ -338,13 +338,13 @@ pub(super) fn plots<G: LieGroup<N>, const N: usize>(
             _ => orthogonality_lines(e, name, &mut lines),
         }
     }
-    let mut plots: Vec<(PlotKind, String)> = Vec::new();
+    let mut plots: Vec<(PlotKind, PlotId)> = Vec::new();
     let mut series = Vec::new();
     for line in lines {
         let id = match plots.iter().find(|(k, _)| *k == line.kind) {
             Some((_, id)) => id.clone(),
             None => {
-                let id = format!("{}_{}", plots.len(), line.kind.id);
+                let id = PlotId::new(format!("{}_{}", plots.len(), line.kind.id));
                 plots.push((line.kind, id.clone()));
                 id
             }
@@ -357,13 +357,14 @@ pub(super) fn plots<G: LieGroup<N>, const N: usize>(
         if let Some(tail) = line.tail {
             segment = format!("{segment}_{tail}");
         }
-        series.push(ScalarSeries {
-            path: format!("{}/{id}/{segment}", scene::PLOTS),
-            name: line.label,
+        series.push(ScalarSeries::new(
+            id,
+            segment,
+            line.label,
             color,
-            width: 2.0,
-            points: line.points,
-        });
+            2.0,
+            line.points,
+        ));
     }
     let plots = plots
         .into_iter()

@@ -39,7 +39,8 @@ pub(super) fn description<G: LieGroup<N>, const N: usize>(
     }
     along_track(&mut s, e);
     s.push_str(&caption);
-    let _ = writeln!(s, "{}", fill(about.description.trim()));
+    let own = super::input_description(about, &settings.choices);
+    let _ = writeln!(s, "{}", fill(own.trim()));
     if let Some(g) = &e.graph {
         s.push_str(&super::graph::describe(g));
     }

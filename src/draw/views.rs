@@ -19,8 +19,8 @@
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
 use crate::plan::choices::{CameraChoice, Layout};
-use crate::scene::WORLD;
 use crate::scene::layout::views_aspect;
+use crate::scene::paths;
 use crate::scene::{Camera, ItemKind, Scene, SceneItem, Vec3, View3d, rotate};
 use crate::uncertain::Method;
 
@@ -107,7 +107,7 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
                         .others
                         .iter()
                         .filter(|m| **m != Estimate::Method(Method::VectorSpace))
-                        .map(|m| format!("{WORLD}/{pose}/{}", m.segment())),
+                        .map(|m| paths::method(pose, &m.segment())),
                 );
             }
             vec![view]
@@ -118,7 +118,7 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
             .iter()
             .map(|(pose, _)| View3d {
                 name: pose.clone(),
-                include: vec![format!("{WORLD}/{pose}")],
+                include: vec![paths::pose(pose)],
                 ..Default::default()
             })
             .collect(),
@@ -159,7 +159,7 @@ pub(super) fn before_after(scene: &Scene, plan: &ViewInputs, after: &str) -> Vec
         .states
         .as_ref()
         .and_then(|s| s.steps.last())
-        .map(|(_, k)| *k);
+        .map(|s| s.step);
     let keep = |i: &SceneItem| match i.timing {
         crate::scene::Timing::Step(k) => {
             !scene.states.as_ref().is_some_and(|s| s.contains(&i.path)) || Some(k) == last
@@ -257,7 +257,7 @@ fn per_method(plan: &ViewInputs) -> Vec<View3d> {
                         .iter()
                         .chain(&m.others)
                         .filter(move |e| matches!(e, Estimate::Method(o) if *o != shown))
-                        .map(move |e| format!("{WORLD}/{pose}/{}", e.segment()))
+                        .map(move |e| paths::method(pose, &e.segment()))
                 })
                 .collect(),
             ..Default::default()

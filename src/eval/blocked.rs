@@ -99,8 +99,8 @@ impl<G: LieGroup<N>, const N: usize> BlockedStats<G, N> {
             .map(|p| {
                 p.estimates
                     .iter()
-                    .find(|(m, ..)| *m == Method::MonteCarlo)
-                    .map(|(_, mean, _)| VectorSums::new(*mean))
+                    .find(|e| e.method == Method::MonteCarlo)
+                    .map(|e| VectorSums::new(e.mean))
             })
             .collect();
         Self { nodes, points }

@@ -11,7 +11,7 @@ use super::blocked::{BlockedStats, VectorSums};
 use super::consistency::ConsistencySums;
 use super::groups::EvalGroup;
 use super::model::{
-    Estimate, Evaluation, FailureReason, Finding, McSummary, Node, PointNode, Role,
+    Estimate, Evaluation, FailureReason, Finding, McSummary, Node, PointEstimate, PointNode, Role,
 };
 use super::{EvalError, EvalSettings};
 use crate::lie::LieGroup;
@@ -524,7 +524,11 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
                 method: Method::FirstOrder.label(),
             });
         }
-        let mut estimates = vec![(Method::FirstOrder, mean, cov)];
+        let mut estimates = vec![PointEstimate {
+            method: Method::FirstOrder,
+            mean,
+            cov,
+        }];
         let index = self.out.points.len();
         if let Some(points) = &cloud {
             let stats = match &mut self.stats {
@@ -542,7 +546,11 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
             };
             if let Some((m, c)) = stats {
                 if m.iter().chain(c.iter()).all(|v| v.is_finite()) {
-                    estimates.push((Method::MonteCarlo, m, c));
+                    estimates.push(PointEstimate {
+                        method: Method::MonteCarlo,
+                        mean: m,
+                        cov: c,
+                    });
                 } else {
                     self.method_failed(
                         None,

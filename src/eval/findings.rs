@@ -198,3 +198,50 @@ pub enum Finding {
         reason: String,
     },
 }
+
+impl<G: crate::lie::LieGroup<N>, const N: usize> super::Node<G, N> {
+    /// The methods whose Cartesian position ellipse is the vector-space one exactly: the same
+    /// centre and first-order world position covariance R Σ_ρρ Rᵀ
+    /// ([`position_cov_in_world_3d`](crate::uncertain::UncertainPose::position_cov_in_world_3d))
+    /// to 1e-9 relative (to the largest entry of the vector-space matrix; centres to
+    /// 1e-9 · (1 + |c|)). Drawn, one hides the other; the text panel says so. Empty without a
+    /// vector-space estimate or without positions.
+    ///
+    /// ```
+    /// use posecov::eval::{Estimate, Node, Role};
+    /// use posecov::lie::{LieGroup, Se2};
+    /// use posecov::propagate::Propagated;
+    /// use posecov::uncertain::{Method, Side, UncertainPose};
+    /// let pose = UncertainPose::<Se2, 3>::try_from_std_devs(Se2::identity(), [0.1, 0.2, 0.05], Side::Right).unwrap();
+    /// let estimate = |method, pose| Estimate { result: Propagated { pose, method }, error_vs_monte_carlo: None, consistency: None };
+    /// let mut node = Node { name: "X".into(), role: Role::Output, op: None, step: None, last_step: None,
+    ///     nominal: Se2::identity(), estimates: vec![estimate(Method::VectorSpace, pose), estimate(Method::FirstOrder, pose)],
+    ///     monte_carlo: None, particles: None };
+    /// assert_eq!(node.coinciding_ellipses(), vec![Method::FirstOrder]);
+    /// node.estimates[1].result.pose = UncertainPose::try_from_std_devs(Se2::identity(), [0.1, 0.3, 0.05], Side::Right).unwrap();
+    /// assert!(node.coinciding_ellipses().is_empty());
+    /// ```
+    pub fn coinciding_ellipses(&self) -> Vec<Method> {
+        let ellipse = |method: Method| {
+            let e = self.estimates.iter().find(|e| e.result.method == method)?;
+            let cov = e.result.pose.position_cov_in_world_3d()?;
+            let centre = e.result.pose.mean().to_se3().translation().to_owned();
+            Some((centre, cov))
+        };
+        let Some((c0, m0)) = ellipse(Method::VectorSpace) else {
+            return Vec::new();
+        };
+        let scale = m0.amax().max(f64::MIN_POSITIVE);
+        self.estimates
+            .iter()
+            .map(|e| e.result.method)
+            .filter(|m| *m != Method::VectorSpace)
+            .filter(|m| {
+                ellipse(*m).is_some_and(|(c, m)| {
+                    (m - m0).amax() <= 1e-9 * scale
+                        && (0..3).all(|k| (c[k] - c0[k]).abs() <= 1e-9 * (1.0 + c0[k].abs()))
+                })
+            })
+            .collect()
+    }
+}

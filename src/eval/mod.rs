@@ -102,7 +102,7 @@ pub use consistency::{Anees, Consistency, CoverageSummary};
 pub use error::EvalError;
 pub use model::{
     AlongTrack, AnyEvaluation, Estimate, Evaluation, FailureReason, Finding, MatrixFrame,
-    McSummary, MonteCarloRecord, Node, PathKind, PointNode, PosePath, RanWith, Role,
+    McSummary, MonteCarloRecord, Node, PathKind, PointEstimate, PointNode, PosePath, RanWith, Role,
     orthogonality_error,
 };
 

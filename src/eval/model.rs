@@ -120,10 +120,21 @@ pub struct Node<G: LieGroup<N>, const N: usize> {
 pub struct PointNode {
     /// Name.
     pub name: String,
-    /// Per method: (method, mean in world, 3×3 covariance in world).
-    pub estimates: Vec<(Method, Vector3<f64>, Matrix3<f64>)>,
+    /// One estimate per method.
+    pub estimates: Vec<PointEstimate>,
     /// Monte Carlo particles, world coordinates.
     pub particles: Option<Vec<[f64; 3]>>,
+}
+
+/// One method's estimate of an uncertain point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointEstimate {
+    /// The method.
+    pub method: Method,
+    /// Mean, world coordinates.
+    pub mean: Vector3<f64>,
+    /// 3×3 covariance, world coordinates.
+    pub cov: Matrix3<f64>,
 }
 
 /// What a path of poses shows.

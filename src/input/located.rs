@@ -70,6 +70,30 @@ impl InputError {
         }
         self
     }
+
+    /// The file it names, and what follows its name (`file: reason`) when the place is not a
+    /// line and column (`file:line:column: …` has no separate reason): for a line per input
+    /// that names the input first itself.
+    ///
+    /// ```
+    /// use posecov::input::InputError;
+    /// let e = InputError::In { file: "a.bag".into(), place: "topic /odom".into(), message: "cut".into() };
+    /// assert_eq!(e.reason(), ("a.bag", Some("topic /odom: cut".to_owned())));
+    /// ```
+    pub fn reason(&self) -> (&str, Option<String>) {
+        match self {
+            InputError::Read { path, reason } => {
+                (path, Some(format!("cannot read input: {reason}")))
+            }
+            InputError::Format { file, message } => (file, Some(message.clone())),
+            InputError::In {
+                file,
+                place,
+                message,
+            } => (file, Some(format!("{place}: {message}"))),
+            InputError::At { file, .. } => (file, None),
+        }
+    }
 }
 
 impl fmt::Display for InputError {

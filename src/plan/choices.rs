@@ -40,14 +40,17 @@ pub struct DrawChoices {
     pub top_view: Option<bool>,
     /// Per pose name, whether to draw it (overrides the default rule).
     pub shown: BTreeMap<String, bool>,
-    /// Pairs of pose names joined by a line (a pose graph's loop closures).
-    pub links: Vec<(String, String)>,
+    /// Pairs of poses joined by a line (a pose graph's loop closures).
+    pub links: Vec<Link>,
     /// Whether frames carry their names (off for a graph's many vertices).
     pub labels: bool,
     /// Where the 3-D camera looks from, if the file says; `None`: chosen per scene.
     pub camera: Option<CameraChoice>,
     /// How the 3-D views split the methods and poses; `None`: chosen per scene.
     pub layout: Option<Layout>,
+    /// A pose graph file's facts, from which the draw stage writes its description (`None`
+    /// for any other input: its own description is the file's words).
+    pub graph: Option<GraphFacts>,
 }
 
 /// A camera asked for by an input (`[draw] camera = {...}`), every part optional: the eye at
@@ -98,6 +101,53 @@ impl Default for DrawChoices {
             labels: true,
             camera: None,
             layout: None,
+            graph: None,
         }
     }
+}
+
+/// Two poses joined by a line (a pose graph's loop closure), by name.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Link {
+    /// One end's pose name.
+    pub from: String,
+    /// The other end's pose name.
+    pub to: String,
+}
+
+/// What a pose graph file holds, as facts: the draw stage writes the graph's description from
+/// them ([`crate::draw::input_description`]), the input stage writes no words.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GraphFacts {
+    /// SE(2) vertices (else SE(3)).
+    pub planar: bool,
+    /// Vertices.
+    pub vertices: usize,
+    /// Edges.
+    pub edges: usize,
+    /// Edges in the odometry chain (between consecutive vertex ids from the first).
+    pub chain_edges: usize,
+    /// Loop closures (every other edge).
+    pub loop_closures: usize,
+    /// Loop closures drawn.
+    pub loop_closures_drawn: usize,
+    /// Vertex estimates drawn.
+    pub vertices_drawn: usize,
+    /// The first vertex id: where the chain starts.
+    pub first: u64,
+    /// The vertex id the chain ends at.
+    pub chain_end: u64,
+    /// The file has no VERTEX lines: the estimates were chained from the edges.
+    pub chained: bool,
+    /// Records valid but not drawn, per tag, in the file's order.
+    pub skipped: Vec<SkippedRecords>,
+}
+
+/// Valid records of one tag that are not drawn (landmarks, parameters), counted.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SkippedRecords {
+    /// The record's tag, e.g. `VERTEX_XY`.
+    pub tag: String,
+    /// How many.
+    pub count: usize,
 }

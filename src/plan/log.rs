@@ -20,11 +20,13 @@ use crate::lie::GroupKind;
 mod decimate;
 mod reference;
 pub use decimate::Decimator;
-pub use reference::{EstimateMessage, LogObserver, ReferenceInLog, ReferenceRead, ReferenceSample};
+pub use reference::{
+    EstimateMessage, LogObserver, Reference, ReferenceInLog, ReferenceRead, ReferenceSample,
+};
 mod cut;
 pub use cut::LogCut;
 mod tf;
-pub use tf::{MAX_TF_EDGES, MAX_TF_SAMPLES, TfEdge, TfTree};
+pub use tf::{MAX_TF_EDGES, MAX_TF_SAMPLES, TfEdge, TfTree, UndecodableTf};
 mod health;
 pub use health::{Class, Health, Issue, IssueCount, Stretch};
 

@@ -15,9 +15,10 @@
 //!   From nalgebra: `let q: QuatXyzw = unit_quaternion.coords.into();` (nalgebra stores
 //!   `[i, j, k, w]`).
 //! - Entity paths: 3-D geometry lives under [`WORLD`], scalar series under [`PLOTS`]; the
-//!   scenario description is drawn at [`DESCRIPTION`]. Suggested layout:
-//!   `world/<pose>/<method>/<what>` (e.g. `world/T_MC/first_order/ellipsoid`), so each pose ×
-//!   method can be toggled in the viewer.
+//!   scenario description is drawn at [`DESCRIPTION`]. Every path is built by one function of
+//!   [`paths`] (e.g. `world/T_MC/first_order/ellipsoid`, so each pose × method can be toggled
+//!   in the viewer); a sink never parses one: a series carries its plot's [`PlotId`], an item
+//!   its [`Origin`].
 //!
 //! # Example
 //! ```
@@ -38,7 +39,9 @@
 //!
 //! # What this folder owns
 //!
-//! The plain-data scene (items on entity paths, plots, series; the legend (`LegendEntry`: colour,
+//! The plain-data scene (items on entity paths, each with what it was drawn from, `Origin`;
+//! every entity path built in `paths.rs`, one function per kind; plots and their series with
+//! typed plot ids, `plot.rs`; the legend (`LegendEntry`: colour,
 //! swatch mark, words) and the confidence of its regions; `Timing::Step` / `Timing::Stamp` and the
 //! scene's `Timeline`; 3-D views with their cameras: `view.rs`; the viewer's layout at 1024 × 640 —
 //! the panes' sizes, the legend's tiles, each 3-D view's shape (a log's views above its rows of
@@ -52,12 +55,16 @@
 pub mod layout;
 mod mesh;
 mod palette;
+pub mod paths;
+mod plot;
 pub mod units;
 mod validate;
 mod view;
 
 pub use mesh::unit_sphere_mesh;
 pub use palette::{AXIS_COLORS, LINK, NOMINAL, REFERENCE, color_name};
+pub use paths::{MessageOrigin, Origin};
+pub use plot::{Corner, Plot, PlotId, ScalarSeries};
 pub use view::{Camera, View3d, grid_columns, rotate};
 
 /// A 3-vector in `f64` (a position, a vector or half sizes), in the world frame.
@@ -304,6 +311,9 @@ pub struct SceneItem {
     pub timing: Timing,
     /// What to draw.
     pub kind: ItemKind,
+    /// What it was drawn from (a robot log's topic and message), when the drawing stage knows:
+    /// the place an undrawable item is reported at.
+    pub origin: Option<Origin>,
 }
 
 impl SceneItem {
@@ -319,73 +329,9 @@ impl SceneItem {
             path: path.into(),
             timing,
             kind,
+            origin: None,
         }
     }
-}
-
-/// A plot: one time-series view of the lines under `plots/<id>/…`. Title and unit are data,
-/// written by the drawing stage and shown by the sink as they are.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Plot {
-    /// Entity segment under [`PLOTS`] (letters, digits, `_`).
-    pub id: String,
-    /// What is plotted and in which frame, e.g. "trace of position covariance, body frame".
-    pub title: String,
-    /// The unit of the values, e.g. "m²".
-    pub unit: String,
-    /// The value axis's range `[low, high]` in `unit`, fitted to the data by the drawing stage
-    /// (a constant σ is then a flat line at its level, not lost in the viewer's ±1 default);
-    /// `None`: the viewer's own fit.
-    pub range: Option<[f64; 2]>,
-    /// The corner of the plot the legend sits in, chosen by the drawing stage where the lines
-    /// are not (a growing quantity leaves the upper left empty).
-    pub legend: Corner,
-}
-
-/// A corner of a plot.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
-pub enum Corner {
-    /// Upper left.
-    #[default]
-    LeftTop,
-    /// Upper right.
-    RightTop,
-    /// Lower left.
-    LeftBottom,
-    /// Lower right.
-    RightBottom,
-}
-
-impl Plot {
-    /// The title with its unit, as a view shows it: "trace of rotation covariance (rad²)".
-    ///
-    /// ```
-    /// let p = posecov::scene::Plot { id: "t".into(), title: "trace".into(), unit: "m²".into(), range: None, legend: Default::default() };
-    /// assert_eq!(p.label(), "trace (m²)");
-    /// ```
-    pub fn label(&self) -> String {
-        if self.unit.is_empty() {
-            self.title.clone()
-        } else {
-            format!("{} ({})", self.title, self.unit)
-        }
-    }
-}
-
-/// A named scalar time series (one line in the plot), e.g. the trace of a method's covariance.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ScalarSeries {
-    /// Entity path under [`PLOTS`], e.g. `plots/trace/first_order`.
-    pub path: String,
-    /// Legend name, e.g. `"first order"`.
-    pub name: String,
-    /// Line colour (use the method's [`Method::color`](crate::uncertain::Method::color)).
-    pub color: Color,
-    /// Line width in UI points.
-    pub width: f64,
-    /// `(step, value)` samples (`(stamp ns, value)` when the scene's timeline is
-    /// [`Timeline::Stamp`]).
-    pub points: Vec<(i64, f64)>,
 }
 
 /// How a legend entry's swatch is drawn: the same mark as the thing it names.
@@ -471,7 +417,9 @@ pub struct Scene {
 /// Successive states of one subtree on the `step` timeline ([`Scene::states`]).
 ///
 /// ```
-/// let s = posecov::scene::States { path: "world/optimized".into(), steps: vec![(0, 0), (5, 12), (9, 13)] };
+/// use posecov::scene::{State, States};
+/// let at = |closures, step| State { closures, step };
+/// let s = States { path: "world/optimized".into(), steps: vec![at(0, 0), at(5, 12), at(9, 13)] };
 /// assert_eq!(s.step_after(6), Some(12));
 /// assert_eq!(s.step_after(100), Some(13));
 /// assert!(s.contains("world/optimized/marginals") && !s.contains("world/optimized_x"));
@@ -480,8 +428,17 @@ pub struct Scene {
 pub struct States {
     /// The subtree's path.
     pub path: String,
-    /// (how many loop closures the state has, its step), in order.
-    pub steps: Vec<(u64, i64)>,
+    /// Each state in order.
+    pub steps: Vec<State>,
+}
+
+/// One state of a pose graph's picture on the `step` timeline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct State {
+    /// How many loop closures the state has.
+    pub closures: u64,
+    /// Its step.
+    pub step: i64,
 }
 
 impl States {
@@ -491,15 +448,14 @@ impl States {
         self.steps
             .iter()
             .rev()
-            .find(|(k, _)| *k <= count)
+            .find(|s| s.closures <= count)
             .or(self.steps.first())
-            .map(|(_, s)| *s)
+            .map(|s| s.step)
     }
 
     /// Whether `path` is in the subtree.
     pub fn contains(&self, path: &str) -> bool {
-        path.strip_prefix(self.path.as_str())
-            .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
+        paths::is_under(path, &self.path)
     }
 }
 

@@ -351,7 +351,8 @@ fn check_item(item: &SceneItem) -> Result<(), SceneError> {
 }
 
 fn check_series(series: &ScalarSeries) -> Result<(), SceneError> {
-    let path = series.path.as_str();
+    let path = series.path();
+    let path = path.as_str();
     check_path(path)?;
     check_root(path, "scalar series", PLOTS)?;
     positive(path, "width", 0, series.width, true)?;
@@ -384,7 +385,7 @@ impl Scene {
         self.series.iter().try_for_each(check_series)?;
         for plot in &self.plots {
             for (i, v) in plot.range.iter().flatten().enumerate() {
-                finite(&format!("{PLOTS}/{}", plot.id), "range", i, *v)?;
+                finite(&super::paths::plot(&plot.id), "range", i, *v)?;
             }
         }
         self.views.iter().try_for_each(super::View3d::check)?;
@@ -457,13 +458,14 @@ mod tests {
     #[test]
     fn rejects_nan_in_series() {
         let mut scene = Scene::new("t", "");
-        scene.series.push(ScalarSeries {
-            path: "plots/trace/a".into(),
-            name: "a".into(),
-            color: Color::rgb(0, 0, 0),
-            width: 2.0,
-            points: vec![(0, 1.0), (1, f64::NAN)],
-        });
+        scene.series.push(ScalarSeries::new(
+            crate::scene::PlotId::new("trace"),
+            "a",
+            "a",
+            Color::rgb(0, 0, 0),
+            2.0,
+            vec![(0, 1.0), (1, f64::NAN)],
+        ));
         assert!(matches!(
             scene.validate(),
             Err(SceneError::NonFinite { index: 1, .. })

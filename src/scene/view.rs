@@ -2,7 +2,7 @@
 //! its camera stands. Plain data, chosen by the drawing stage; the sink turns each into a Rerun
 //! 3-D view with its eye controls and entity visibility in the blueprint.
 
-use super::{QuatXyzw, SceneError, Vec3, WORLD};
+use super::{QuatXyzw, SceneError, Vec3, WORLD, paths};
 
 /// Rotates `v` by the unit quaternion `q` = `[x, y, z, w]`: v + 2w(u×v) + 2u×(u×v), u = (x, y, z).
 ///
@@ -129,12 +129,21 @@ impl View3d {
     /// assert!(v.shows("world/a/y/cloud") && !v.shows("world/a/x/cloud") && !v.shows("world/ab"));
     /// ```
     pub fn shows(&self, path: &str) -> bool {
-        let under = |root: &String| {
-            path.strip_prefix(root.as_str())
-                .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
-        };
+        let under = |root: &String| paths::is_under(path, root);
         (self.include.is_empty() || self.include.iter().any(under))
             && !self.exclude.iter().any(under)
+    }
+
+    /// Whether the view draws the entity at `path`: it [`shows`](Self::shows) it and does not
+    /// hide it (a hidden entity stays in the view's tree, switched off).
+    ///
+    /// ```
+    /// use posecov::scene::View3d;
+    /// let v = View3d { hidden: vec!["world/a/x".into()], ..Default::default() };
+    /// assert!(v.draws("world/a/y") && !v.draws("world/a/x/cloud") && v.shows("world/a/x/cloud"));
+    /// ```
+    pub fn draws(&self, path: &str) -> bool {
+        self.shows(path) && !self.hidden.iter().any(|h| paths::is_under(path, h))
     }
 
     /// Checks the camera and that every path lies under [`WORLD`].
@@ -143,9 +152,7 @@ impl View3d {
     /// [`SceneError::BadCamera`] or [`SceneError::WrongRoot`].
     pub fn check(&self) -> Result<(), SceneError> {
         for path in self.include.iter().chain(&self.exclude).chain(&self.hidden) {
-            let under_world = path
-                .strip_prefix(WORLD)
-                .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'));
+            let under_world = paths::is_under(path, WORLD);
             if !under_world {
                 return Err(SceneError::WrongRoot {
                     path: path.clone(),

@@ -77,7 +77,8 @@ pub fn send_layout(rec: &rr::RecordingStream, scene: &Scene) -> Result<(), SinkE
     Ok(())
 }
 
-/// The blueprint messages of [`send_layout`] and their activation command.
+/// The blueprint messages of [`send_layout`] and their activation command. Ids are made in
+/// creation order (the root after its children), so one scene gives the same messages.
 fn layout_messages(
     scene: &Scene,
 ) -> Result<(Vec<rr::log::LogMsg>, BlueprintActivationCommand), SinkError> {
@@ -86,6 +87,39 @@ fn layout_messages(
         .memory()?;
     bp.set_time_sequence("blueprint", 0);
     let mut ids = Ids::default();
+    let left = views_and_legend(&bp, &mut ids, scene)?;
+    let description = log_view(
+        &bp,
+        &mut ids,
+        "TextDocument",
+        "Description",
+        scene::DESCRIPTION,
+    )?;
+    let plots = plot_views(&bp, &mut ids, scene)?;
+    let root = root_container(&bp, &mut ids, scene, left, description, &plots)?;
+    bp.log(
+        "viewport",
+        &ViewportBlueprint::new()
+            .with_root_container(RootContainer(root.uuid))
+            .with_auto_layout(false)
+            .with_auto_views(false),
+    )?;
+    panels(&bp, scene)?;
+    let messages = storage.take();
+    let store = messages
+        .first()
+        .map(|m| m.store_id().clone())
+        .ok_or_else(|| SinkError::Flush("the blueprint stream produced no messages".into()))?;
+    Ok((messages, BlueprintActivationCommand::make_active(store)))
+}
+
+/// The scene's 3-D views (one default view when it has none; several in a grid), with the
+/// legend view under them when it has one, as tall as its tiles need at 1024 × 640.
+fn views_and_legend(
+    bp: &rr::RecordingStream,
+    ids: &mut Ids,
+    scene: &Scene,
+) -> Result<String, SinkError> {
     let default_view = [View3d {
         name: "3D".to_owned(),
         ..Default::default()
@@ -97,12 +131,12 @@ fn layout_messages(
     };
     let mut left = Vec::new();
     for view in views {
-        left.push(log_view3d(&bp, &mut ids, view)?);
+        left.push(log_view3d(bp, ids, view)?);
     }
-    let mut left = match left.as_slice() {
+    let left = match left.as_slice() {
         [one] => one.clone(),
         _ => {
-            let grid = log_container(&bp, &mut ids, ContainerKind::Grid, &left, &[])?;
+            let grid = log_container(bp, ids, ContainerKind::Grid, &left, &[])?;
             bp.log(
                 grid.as_str(),
                 &ContainerBlueprint::update_fields()
@@ -111,38 +145,40 @@ fn layout_messages(
             grid
         }
     };
-    if has_legend_view(scene) {
-        // The legend under the views, as tall as its tiles need at 1024 × 640.
-        let height = tiles(&scene.legend).height;
-        let legend = log_view(&bp, &mut ids, "2D", &legend_title(scene), LEGEND)?;
-        bp.log(
-            format!("{legend}/VisualBounds2D"),
-            &VisualBounds2D::new(Range2D {
-                x_range: Range1D([0.0, DESIGN_WIDTH]),
-                y_range: Range1D([0.0, height]),
-            }),
-        )?;
-        let share = legend_share(height);
-        left = log_container(
-            &bp,
-            &mut ids,
-            ContainerKind::Vertical,
-            &[left, legend],
-            &[(DESIGN_HEIGHT - share) as f32, share as f32],
-        )?;
+    if !has_legend_view(scene) {
+        return Ok(left);
     }
-    let description = log_view(
-        &bp,
-        &mut ids,
-        "TextDocument",
-        "Description",
-        scene::DESCRIPTION,
+    let height = tiles(&scene.legend).height;
+    let legend = log_view(bp, ids, "2D", &legend_title(scene), LEGEND)?;
+    bp.log(
+        format!("{legend}/VisualBounds2D"),
+        &VisualBounds2D::new(Range2D {
+            x_range: Range1D([0.0, DESIGN_WIDTH]),
+            y_range: Range1D([0.0, height]),
+        }),
     )?;
+    let share = legend_share(height);
+    log_container(
+        bp,
+        ids,
+        ContainerKind::Vertical,
+        &[left, legend],
+        &[(DESIGN_HEIGHT - share) as f32, share as f32],
+    )
+}
+
+/// One time-series view per plot, origin `plots/<id>`: its time axis over the whole log (a
+/// robot log's), its value range and its legend's corner.
+fn plot_views(
+    bp: &rr::RecordingStream,
+    ids: &mut Ids,
+    scene: &Scene,
+) -> Result<Vec<String>, SinkError> {
     let mut plots = Vec::new();
     for plot in &scene.plots {
-        let origin = format!("{}/{}", scene::PLOTS, plot.id);
-        let view = log_view(&bp, &mut ids, "TimeSeries", &plot.label(), &origin)?;
-        if let Some(range) = stamp_range(scene, &origin) {
+        let origin = scene::paths::plot(&plot.id);
+        let view = log_view(bp, ids, "TimeSeries", &plot.label(), &origin)?;
+        if let Some(range) = stamp_range(scene, &plot.id) {
             bp.log(
                 format!("{view}/TimeAxis"),
                 &TimeAxis::new().with_view_range(range),
@@ -160,71 +196,68 @@ fn layout_messages(
         )?;
         plots.push(view);
     }
-    // Ids in creation order; the root is created after its children.
-    let root = if scene.plots_below && !plots.is_empty() {
-        // The views above rows of plots on the left, the text panel the whole right column.
+    Ok(plots)
+}
+
+/// The root container: with `plots_below`, the views above rows of plots on the left and the
+/// text panel the whole right column; otherwise the views on the left and the text panel over
+/// the plots on the right (several plots are tabs of one pane, so the one shown is tall enough
+/// for its legend to sit beside its lines).
+fn root_container(
+    bp: &rr::RecordingStream,
+    ids: &mut Ids,
+    scene: &Scene,
+    left: String,
+    description: String,
+    plots: &[String],
+) -> Result<Id, SinkError> {
+    let (left, right) = if scene.plots_below && !plots.is_empty() {
         let mut column = vec![left];
         for row in plots.chunks(PLOTS_PER_ROW) {
-            column.push(log_container(
-                &bp,
-                &mut ids,
-                ContainerKind::Horizontal,
-                row,
-                &[],
-            )?);
+            column.push(log_container(bp, ids, ContainerKind::Horizontal, row, &[])?);
         }
         // The views keep three fifths of the height with one row, half with more.
         let shares = views_over_plots(column.len() - 1);
-        let left = log_container(&bp, &mut ids, ContainerKind::Vertical, &column, &shares)?;
-        let root = ids.next();
-        log_container_at(
-            &bp,
-            &root,
-            ContainerKind::Horizontal,
-            &[left, description],
-            &[LEFT_SHARE, RIGHT_SHARE],
-        )?;
-        root
+        let left = log_container(bp, ids, ContainerKind::Vertical, &column, &shares)?;
+        (left, description)
     } else {
-        // The text panel over the plots; several plots are tabs of one pane, so the one shown
-        // is tall enough for its legend to sit beside its lines.
-        let right = match plots.as_slice() {
+        let right = match plots {
             [] => description,
             [one] => log_container(
-                &bp,
-                &mut ids,
+                bp,
+                ids,
                 ContainerKind::Vertical,
                 &[description, one.clone()],
                 &[3.0, 2.0],
             )?,
             _ => {
-                let tabs = log_container(&bp, &mut ids, ContainerKind::Tabs, &plots, &[])?;
+                let tabs = log_container(bp, ids, ContainerKind::Tabs, plots, &[])?;
                 log_container(
-                    &bp,
-                    &mut ids,
+                    bp,
+                    ids,
                     ContainerKind::Vertical,
                     &[description, tabs],
                     &[3.0, 2.0],
                 )?
             }
         };
-        let root = ids.next();
-        log_container_at(
-            &bp,
-            &root,
-            ContainerKind::Horizontal,
-            &[left, right],
-            &[LEFT_SHARE, RIGHT_SHARE],
-        )?;
-        root
+        (left, right)
     };
-    bp.log(
-        "viewport",
-        &ViewportBlueprint::new()
-            .with_root_container(RootContainer(root.uuid))
-            .with_auto_layout(false)
-            .with_auto_views(false),
+    // The root is created after its children.
+    let root = ids.next();
+    log_container_at(
+        bp,
+        &root,
+        ContainerKind::Horizontal,
+        &[left, right],
+        &[LEFT_SHARE, RIGHT_SHARE],
     )?;
+    Ok(root)
+}
+
+/// The panels around the views: blueprint and selection collapsed, the time panel collapsed
+/// on the scene's timeline, following the latest data (a recording opens on its last step).
+fn panels(bp: &rr::RecordingStream, scene: &Scene) -> Result<(), SinkError> {
     let collapsed = PanelBlueprint::new().with_state(PanelState::Collapsed);
     bp.log("blueprint_panel", &collapsed)?;
     bp.log("selection_panel", &collapsed)?;
@@ -241,12 +274,7 @@ fn layout_messages(
             ))
             .with_play_state(PlayState::Following),
     )?;
-    let messages = storage.take();
-    let store = messages
-        .first()
-        .map(|m| m.store_id().clone())
-        .ok_or_else(|| SinkError::Flush("the blueprint stream produced no messages".into()))?;
-    Ok((messages, BlueprintActivationCommand::make_active(store)))
+    Ok(())
 }
 
 /// The legend view's title: what its regions hold.
@@ -268,17 +296,16 @@ fn corner(c: Corner) -> Corner2D {
 }
 
 /// A robot log's plot shows the whole log: the time axis spans the first to the last stamp of
-/// the series under `origin` (without it the viewer opens a time plot on a window around the
+/// the series of plot `plot` (without it the viewer opens a time plot on a window around the
 /// time cursor, cutting off the start). Step plots keep the viewer's own fit (`None`).
-fn stamp_range(scene: &Scene, origin: &str) -> Option<TimeRange> {
+fn stamp_range(scene: &Scene, plot: &scene::PlotId) -> Option<TimeRange> {
     if scene.timeline == scene::Timeline::Step {
         return None;
     }
-    let prefix = format!("{origin}/");
     let stamps = scene
         .series
         .iter()
-        .filter(|s| s.path.starts_with(&prefix))
+        .filter(|s| s.plot == *plot)
         .flat_map(|s| s.points.iter().map(|p| p.0));
     let (first, last) = stamps.fold(None, |r: Option<(i64, i64)>, t| {
         Some(r.map_or((t, t), |(a, b)| (a.min(t), b.max(t))))

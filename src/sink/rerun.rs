@@ -335,12 +335,8 @@ fn log_series(
         .with_names([series.name.as_str()])
         .with_colors([color(series.color)])
         .with_widths([f(series.width)]);
-    send(
-        rec,
-        series.path.as_str(),
-        rr::TimePoint::default(),
-        &[&style],
-    )?;
+    let path = series.path();
+    send(rec, path.as_str(), rr::TimePoint::default(), &[&style])?;
     if series.points.is_empty() {
         return Ok(());
     }
@@ -355,7 +351,7 @@ fn log_series(
     let values = rr::Scalars::new(series.points.iter().map(|p| p.1))
         .columns_of_unit_batches()
         .map_err(rr::RecordingStreamError::from)?;
-    rec.send_columns(series.path.as_str(), [steps], values)?;
+    rec.send_columns(path.as_str(), [steps], values)?;
     Ok(())
 }
 

@@ -126,8 +126,8 @@ impl Restream {
         self.layout = Some(key);
         self.shadow_series(rec)?;
         for series in &mut scene.series {
-            series.path = generation_path(&series.path, generation);
-            self.series.insert(series.path.clone());
+            series.generation = Some(generation);
+            self.series.insert(series.path());
         }
         let outcome = log_scene_cancellable(rec, &scene, cancel)?;
         self.touch(&scene);
@@ -338,20 +338,4 @@ pub fn layout_key(scene: &Scene) -> String {
         scene.timeline,
         crate::scene::layout::has_legend_view(scene)
     )
-}
-
-/// `plots/<plot>/<rest>` → `plots/<plot>/g<N>/<rest>`.
-///
-/// ```
-/// assert_eq!(posecov::sink::restream::generation_path("plots/trace/first_order", 3), "plots/trace/g3/first_order");
-/// ```
-pub fn generation_path(path: &str, generation: u64) -> String {
-    let prefix = format!("{}/", scene::PLOTS);
-    match path
-        .strip_prefix(&prefix)
-        .and_then(|rest| rest.split_once('/'))
-    {
-        Some((plot, rest)) => format!("{prefix}{plot}/g{generation}/{rest}"),
-        None => path.to_owned(),
-    }
 }

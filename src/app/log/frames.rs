@@ -24,8 +24,8 @@ pub(super) fn frames_json(tf: &TfTree, e: &LogEvaluation) -> Value {
             "static": edge.samples.is_empty() && edge.static_value.is_some(),
             "dropped": edge.dropped,
         })).collect::<Vec<_>>(),
-        "undecodable": tf.undecodable.iter().map(|(topic, count, first)| json!({
-            "topic": topic, "count": count, "first_log_time_s": stamp_seconds(*first),
+        "undecodable": tf.undecodable.iter().map(|u| json!({
+            "topic": u.topic, "count": u.count, "first_log_time_s": stamp_seconds(u.first_log_time_ns),
         })).collect::<Vec<_>>(),
         "problems": e.frames.problems.iter().map(|p| json!({
             "kind": p.kind.issue().name(),

@@ -12,7 +12,7 @@ use crate::eval::log::nees::{NeesObserver, NeesSettings, TopicConsistency};
 use crate::input::InputError;
 use crate::input::tum::read_tum;
 use crate::interop::RosReading;
-use crate::plan::log::{LogSummary, ReferenceInLog};
+use crate::plan::log::{LogSummary, Reference, ReferenceInLog};
 
 /// A reference ready for the read: the observer, and what the reader must look for.
 pub(super) struct Prepared {
@@ -35,18 +35,17 @@ pub(super) fn prepare(
     reading: RosReading,
     every: Option<u64>,
 ) -> Result<Prepared, AppError> {
-    let settings = |label: String, topic: Option<&str>, tf: bool| NeesSettings {
-        reference: label,
-        reference_topic: topic.map(str::to_owned),
-        tf_parent_required: tf,
+    let align = reference.align;
+    let settings = |reference: Reference| NeesSettings {
+        reference,
         reading,
-        align: reference.align,
+        align,
         every,
     };
     let tum = |path: &str, value: &str| {
         let samples = read_tum(Path::new(path))?;
         let observer =
-            NeesObserver::with_trajectory(settings(format!("file:{path}"), None, false), &samples);
+            NeesObserver::with_trajectory(settings(Reference::File(path.to_owned())), &samples);
         Ok::<_, AppError>(Prepared {
             observer,
             in_log: None,
@@ -58,14 +57,18 @@ pub(super) fn prepare(
     Ok(match &reference.arg {
         ReferenceArg::File(path) => tum(path, &format!("file:{path}"))?,
         ReferenceArg::Topic(name) => Prepared {
-            observer: NeesObserver::new(settings(format!("topic:{name}"), Some(name), false)),
+            observer: NeesObserver::new(settings(Reference::InLog(ReferenceInLog::Topic(
+                name.clone(),
+            )))),
             in_log: Some(ReferenceInLog::Topic(name.clone())),
             value: format!("topic:{name}"),
             either_file: false,
             bare: false,
         },
         ReferenceArg::Tf(child) => Prepared {
-            observer: NeesObserver::new(settings(format!("tf:{child}"), None, true)),
+            observer: NeesObserver::new(settings(Reference::InLog(ReferenceInLog::Tf {
+                child: child.clone(),
+            }))),
             in_log: Some(ReferenceInLog::Tf {
                 child: child.clone(),
             }),
@@ -81,7 +84,9 @@ pub(super) fn prepare(
             p
         }
         ReferenceArg::Either(value) => Prepared {
-            observer: NeesObserver::new(settings(format!("topic:{value}"), Some(value), false)),
+            observer: NeesObserver::new(settings(Reference::InLog(ReferenceInLog::Topic(
+                value.clone(),
+            )))),
             in_log: Some(ReferenceInLog::Topic(value.clone())),
             value: value.clone(),
             either_file: false,
@@ -212,7 +217,7 @@ pub(super) fn consistency_json(c: &TopicConsistency) -> serde_json::Value {
         })
     };
     serde_json::json!({
-        "reference": c.reference,
+        "reference": c.reference.to_string(),
         "reading": c.reading,
         "align": c.align,
         "alignment": c.alignment.map(|t| serde_json::json!({

@@ -11,12 +11,9 @@ use crate::eval::graph::{ClosureStep, GraphEvaluation, LoopClosure};
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::scene::{
     self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, QuatXyzw, Timing,
-    Triads, Vec3, WORLD,
+    Triads, Vec3, paths,
 };
 use crate::uncertain::{Side, UncertainPose};
-
-/// The subtree of the "after" picture, under [`WORLD`].
-pub(in crate::draw) const AFTER: &str = "optimized";
 
 /// Most optimised poses drawn with their marginal ellipse (evenly chosen, plus the loop
 /// closures' ends).
@@ -86,10 +83,13 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
             let at = if i == 0 { 0 } else { chain_end + i as u64 };
             state(p, g, &step.poses, &step.covariances, Some(at), &look);
             closed_so_far(p, g, step, at, radius);
-            states.push((step.closures as u64, at as i64));
+            states.push(scene::State {
+                closures: step.closures as u64,
+                step: at as i64,
+            });
         }
         p.scene.states = Some(scene::States {
-            path: format!("{WORLD}/{AFTER}"),
+            path: paths::optimized(),
             steps: states,
         });
     }
@@ -105,7 +105,7 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         }
         let ends = |l: &LoopClosure<N>| (index_of[&l.from], index_of[&l.to]);
         p.push(
-            format!("{WORLD}/{AFTER}/loop_closures/{name}"),
+            paths::child(&paths::optimized(), &format!("loop_closures/{name}")),
             None,
             ItemKind::LineStrips(LineStrips {
                 strips: chosen
@@ -122,16 +122,17 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         let (origins, vectors): (Vec<Vec3>, Vec<Vec3>) = chosen
             .iter()
             .map(|l| {
-                let (i, j) = ends(l);
-                // X_j = X_i · Z · Exp(r): the predicted pose is X_j · Exp(−r).
-                let predicted = position(&s.poses[j].compose(&G::exp(&-l.residual)));
+                let (_, j) = ends(l);
+                let predicted = l.predicted_position;
                 let estimated = position(&s.poses[j]);
-                let _ = i;
                 (v3(&predicted), v3(&(estimated - predicted)))
             })
             .unzip();
         p.push(
-            format!("{WORLD}/{AFTER}/loop_closures/{name}_residuals"),
+            paths::child(
+                &paths::optimized(),
+                &format!("loop_closures/{name}_residuals"),
+            ),
             None,
             ItemKind::Arrows(Arrows {
                 origins,
@@ -165,7 +166,7 @@ fn state<G: LieGroup<N>, const N: usize>(
 ) {
     let position = |x: &G| x.to_se3().translation().to_owned();
     p.push(
-        format!("{WORLD}/{AFTER}/trajectory"),
+        paths::child(&paths::optimized(), "trajectory"),
         step,
         ItemKind::LineStrips(LineStrips {
             strips: vec![poses.iter().map(|x| v3(&position(x))).collect()],
@@ -191,7 +192,7 @@ fn state<G: LieGroup<N>, const N: usize>(
         .collect();
     if !shapes.is_empty() {
         p.push(
-            format!("{WORLD}/{AFTER}/marginals"),
+            paths::child(&paths::optimized(), "marginals"),
             step,
             ItemKind::Ellipsoids(Ellipsoids {
                 shapes,
@@ -203,7 +204,7 @@ fn state<G: LieGroup<N>, const N: usize>(
         );
     }
     p.push(
-        format!("{WORLD}/{AFTER}/poses"),
+        paths::child(&paths::optimized(), "poses"),
         step,
         ItemKind::Triads(Triads {
             translations: look
@@ -219,7 +220,7 @@ fn state<G: LieGroup<N>, const N: usize>(
     for &k in look.bananas {
         if let Some(pose) = uncertain(k) {
             p.region_banana(
-                &format!("{WORLD}/{AFTER}/bananas/v{}", g.ids[k]),
+                &paths::vertex(&paths::child(&paths::optimized(), "bananas"), g.ids[k]),
                 step.map_or(Timing::Static, |k| Timing::Step(k as i64)),
                 &pose,
                 OPTIMIZED,
@@ -246,7 +247,7 @@ fn closed_so_far<G: LieGroup<N>, const N: usize>(
         .collect();
     if !strips.is_empty() {
         p.push(
-            format!("{WORLD}/{AFTER}/closed"),
+            paths::child(&paths::optimized(), "closed"),
             Some(at),
             ItemKind::LineStrips(LineStrips {
                 strips,
@@ -288,7 +289,7 @@ fn relative<G: LieGroup<N>, const N: usize>(
         let (xa, xb) = (&g.solution.poses[ia], &g.solution.poses[ib]);
         let at = xa.compose(&xa.inverse().compose(xb));
         p.region_banana(
-            &format!("{WORLD}/{AFTER}/relative/v{a}_v{b}"),
+            &paths::relative(a, b),
             Timing::Static,
             &UncertainPose::new_unchecked(at, cov, Side::Right),
             RELATIVE,
@@ -314,9 +315,12 @@ fn labels<G: LieGroup<N>, const N: usize>(
     after: bool,
 ) {
     let (poses, prefix) = if after {
-        (&g.solution.poses, format!("{WORLD}/{AFTER}/labels"))
+        (
+            &g.solution.poses,
+            paths::child(&paths::optimized(), "labels"),
+        )
     } else {
-        (&g.initial, format!("{WORLD}/labels"))
+        (&g.initial, paths::initial_labels())
     };
     let n = poses.len();
     let index_of = |id: u64| g.ids.iter().position(|&x| x == id);
@@ -353,7 +357,7 @@ fn labels<G: LieGroup<N>, const N: usize>(
         placed.push(at);
         placed_poses.insert(k);
         p.push(
-            format!("{prefix}/v{}", g.ids[k]),
+            paths::vertex(&prefix, g.ids[k]),
             None,
             ItemKind::Frame(Frame {
                 translation: v3(&at),

@@ -8,9 +8,11 @@ use crate::eval::Finding;
 use crate::eval::graph::{Anchor, GraphEvaluation, MAX_TIMELINE_POSES, Optimizer, Part, Stop};
 use crate::lie::LieGroup;
 
+mod about;
 mod after;
 
-pub(super) use after::{AFTER, draw_optimized};
+pub(super) use about::description as file_description;
+pub(super) use after::draw_optimized;
 
 /// The sentence of a graph finding (`None` for any other finding).
 pub(super) fn finding_text(f: &Finding) -> Option<String> {

@@ -13,7 +13,8 @@ use super::{INVALID, MEANING, RVIZ, flat};
 use crate::eval::log::{PoseEvaluation, PoseState, TopicEvaluation};
 use crate::lie::{GroupKind, LieGroup, Se2, Se3};
 use crate::scene::{
-    Ellipsoid, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, PointCloud, Swatch, Timing, Vec3,
+    Ellipsoid, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, MessageOrigin, Origin,
+    PointCloud, Swatch, Timing, Vec3, paths,
 };
 use crate::uncertain::{Method, Side, UncertainPose};
 
@@ -40,6 +41,13 @@ pub(super) fn message(
     pose: &PoseEvaluation,
     mean: &Se3,
 ) {
+    // Every item of this message carries it as its origin (an undrawable one is reported there).
+    if let Some(Origin::Topic { message, .. }) = &mut p.origin {
+        *message = Some(MessageOrigin {
+            index: pose.index,
+            stamp_ns: pose.stamp_ns,
+        });
+    }
     let base = place.base;
     let at = Timing::Stamp(pose.stamp_ns);
     let origin = flat(t.group.is_planar(), &(mean.translation() - place.shift));
@@ -72,7 +80,7 @@ pub(super) fn message(
         UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z))
     };
     p.place(
-        format!("{base}/pose"),
+        paths::child(&base, "pose"),
         at,
         ItemKind::Frame(Frame {
             translation: origin,
@@ -92,7 +100,7 @@ pub(super) fn message(
             let s = Vector2::new(shift.x, shift.y);
             let moved = |x: &Se2| Se2::from_parts(x.translation() - s, *x.rotation());
             let g = UncertainPose::new_unchecked(moved(g.mean()), *g.cov(), Side::Right);
-            let meaning = format!("{base}/meaning");
+            let meaning = paths::child(&base, "meaning");
             p.region_banana(&meaning, at, &g, MEANING, |x| {
                 x.to_se3().translation().to_owned()
             });
@@ -108,7 +116,7 @@ pub(super) fn message(
         PoseState::Spatial { pose: g, cloud } => {
             let moved = |x: &Se3| Se3::from_parts(x.translation() - shift, *x.rotation());
             let g = UncertainPose::new_unchecked(moved(g.mean()), *g.cov(), Side::Right);
-            let meaning = format!("{base}/meaning");
+            let meaning = paths::child(&base, "meaning");
             p.region_banana(&meaning, at, &g, MEANING, |x| *x.translation());
             p.region_ellipsoid(&meaning, at, &g, MEANING);
             let cloud: Vec<Se3> = cloud.iter().map(moved).collect();
@@ -118,6 +126,9 @@ pub(super) fn message(
             clear_invalid(p, base, at);
         }
         PoseState::Invalid { .. } => invalid(p, base, at, origin),
+    }
+    if let Some(Origin::Topic { message, .. }) = &mut p.origin {
+        *message = None;
     }
 }
 
@@ -153,7 +164,7 @@ pub(super) fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
         Swatch::Line,
     );
     p.place(
-        format!("{base}/history/rviz"),
+        paths::child(&base, "history/rviz"),
         Timing::Static,
         ItemKind::Ellipsoids(Ellipsoids {
             shapes: shapes_rviz,
@@ -179,7 +190,7 @@ pub(super) fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
         })
         .collect();
     p.place(
-        format!("{base}/history/meaning"),
+        paths::child(&base, "history/meaning"),
         Timing::Static,
         ItemKind::LineStrips(LineStrips {
             strips,
@@ -198,7 +209,7 @@ fn cloud_item(p: &mut Painter, base: &str, at: Timing, positions: Vec<Vec3>) {
         );
     }
     p.place(
-        format!("{base}/meaning/cloud"),
+        paths::child(&base, "meaning/cloud"),
         at,
         ItemKind::Points(PointCloud {
             positions,
@@ -220,7 +231,7 @@ fn sprays(p: &mut Painter, base: &str, at: Timing, cloud: &[Se3]) {
             .map(|x| v3(&(x.translation() + l * x.rotation().to_matrix().column(axis))))
             .collect();
         p.place(
-            format!("{base}/meaning/spray_{name}"),
+            paths::child(base, &format!("meaning/spray_{name}")),
             at,
             ItemKind::Points(PointCloud {
                 positions,
@@ -241,7 +252,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
     let s = 0.5 * p.axis_length;
     let [x, y, z] = origin;
     p.place(
-        format!("{base}/invalid"),
+        paths::child(&base, "invalid"),
         at,
         ItemKind::LineStrips(LineStrips {
             strips: vec![
@@ -259,9 +270,13 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
             radius: 0.001,
         })
     };
-    p.place(format!("{base}/meaning/banana_outline"), at, empty_strips());
     p.place(
-        format!("{base}/meaning/ellipsoid"),
+        paths::child(&base, "meaning/banana_outline"),
+        at,
+        empty_strips(),
+    );
+    p.place(
+        paths::child(&base, "meaning/ellipsoid"),
         at,
         ItemKind::Ellipsoids(Ellipsoids {
             shapes: Vec::new(),
@@ -272,7 +287,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
         }),
     );
     p.place(
-        format!("{base}/meaning/banana"),
+        paths::child(&base, "meaning/banana"),
         at,
         ItemKind::Surface(crate::scene::Surface {
             vertices: Vec::new(),
@@ -287,7 +302,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
 
 fn clear_invalid(p: &mut Painter, base: &str, at: Timing) {
     p.place(
-        format!("{base}/invalid"),
+        paths::child(&base, "invalid"),
         at,
         ItemKind::LineStrips(LineStrips {
             strips: Vec::new(),

@@ -6,9 +6,9 @@ use std::fmt::Write as _;
 
 use crate::eval::log::LogEvaluation;
 use crate::eval::log::nees::{Align, TopicConsistency, Verdict};
-use crate::scene::{Color, Corner, PLOTS, Plot, REFERENCE, ScalarSeries, Scene};
+use crate::scene::{Color, Corner, Plot, PlotId, REFERENCE, ScalarSeries, Scene};
 
-use super::topic_path;
+use crate::scene::paths::topic_segments;
 
 /// The NEES line: first order's sky blue, the colour of what the numbers mean in the log's
 /// view; the bounds are the reference yellow.
@@ -56,8 +56,8 @@ pub(super) fn plots(scene: &mut Scene, e: &LogEvaluation) {
         return;
     }
     for (name, c) in topics {
-        let topic = topic_path(name);
-        let plot = format!("nees_{}", topic.replace(['/', '-', '.'], "_"));
+        let topic = topic_segments(name);
+        let plot = PlotId::new(format!("nees_{}", topic.replace(['/', '-', '.'], "_")));
         let verdict = c.verdict.map_or("", verdict_word);
         // From 0 to the largest of the NEES, the bound and the band: all in view.
         let top = c
@@ -77,13 +77,14 @@ pub(super) fn plots(scene: &mut Scene, e: &LogEvaluation) {
         let (first, last) = (c.series[0].0, c.series[c.series.len() - 1].0);
         let flat = |v: f64| vec![(first, v), (last, v)];
         let mut push = |segment: &str, label: String, color: Color, width: f64, points| {
-            scene.series.push(ScalarSeries {
-                path: format!("{PLOTS}/{plot}/{segment}"),
-                name: label,
+            scene.series.push(ScalarSeries::new(
+                plot.clone(),
+                segment,
+                label,
                 color,
                 width,
                 points,
-            });
+            ));
         };
         push(
             "nees",

@@ -4,10 +4,11 @@
 //! a flat line at its level, not lost in a ±1 default).
 
 use super::super::shapes::AXIS_COLORS;
-use super::{MEANING, topic_path};
+use super::MEANING;
 use crate::eval::log::LogEvaluation;
 use crate::plan::log::ROS_AXES;
-use crate::scene::{Corner, PLOTS, Plot, ScalarSeries, Scene};
+use crate::scene::paths::{self, topic_segments};
+use crate::scene::{Corner, Plot, PlotId, ScalarSeries, Scene};
 
 /// Room above the largest value.
 const HEADROOM: f64 = 1.15;
@@ -44,7 +45,7 @@ pub(super) fn plots(scene: &mut Scene, e: &LogEvaluation) {
         }
     };
     for t in &e.topics {
-        let topic = topic_path(&t.name);
+        let topic = topic_segments(&t.name);
         for (axis, name) in ROS_AXES.iter().enumerate() {
             let points: Vec<(i64, f64)> = t
                 .series
@@ -55,7 +56,7 @@ pub(super) fn plots(scene: &mut Scene, e: &LogEvaluation) {
                 continue;
             }
             let line = (
-                format!("{topic}/{name}"),
+                paths::child(&topic, name),
                 named(&t.name, &format!("σ{name}")),
                 AXIS_COLORS[axis % 3],
                 points,
@@ -99,7 +100,7 @@ pub(super) fn plots(scene: &mut Scene, e: &LogEvaluation) {
             1.0
         };
         scene.plots.push(Plot {
-            id: id.into(),
+            id: PlotId::new(id),
             title: title.into(),
             unit: unit.into(),
             range: Some([0.0, top]),
@@ -107,13 +108,14 @@ pub(super) fn plots(scene: &mut Scene, e: &LogEvaluation) {
             legend: Corner::LeftBottom,
         });
         for (tail, name, color, points) in lines {
-            scene.series.push(ScalarSeries {
-                path: format!("{PLOTS}/{id}/{tail}"),
+            scene.series.push(ScalarSeries::new(
+                PlotId::new(id),
+                tail,
                 name,
                 color,
-                width: 1.5,
-                points: points.into_iter().map(|(t, v)| (t, v * factor)).collect(),
-            });
+                1.5,
+                points.into_iter().map(|(t, v)| (t, v * factor)).collect(),
+            ));
         }
     }
 }

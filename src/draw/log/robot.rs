@@ -10,9 +10,7 @@ use super::super::Painter;
 use super::message::{Placement, message};
 use crate::eval::log::{PoseEvaluation, PoseState, TopicEvaluation};
 use crate::plan::log::{PLACEHOLDER, ROS_AXES};
-
-/// The entity segment of a topic's robot view, under the topic's path.
-pub(super) const ROBOT: &str = "robot";
+use crate::scene::paths;
 
 /// A σ in words at its scale: mm below 1 m, else m; degrees for angles (mrad below 0.1°).
 fn sigma_words(axis: usize, sigma: f64) -> String {
@@ -63,11 +61,12 @@ fn scale(pose: &PoseEvaluation, r: f64) -> Option<f64> {
     (largest > 0.0).then(|| (r * largest.sqrt()).max(1e-3))
 }
 
-/// Draws topic `t`'s robot view under `base/robot` (see the [module docs](self)).
-pub(super) fn robot_view(p: &mut Painter, base: &str, t: &TopicEvaluation) {
+/// Draws topic `t`'s robot view under its topic's `robot` entity ([`paths::robot`], see the
+/// [module docs](self)).
+pub(super) fn robot_view(p: &mut Painter, t: &TopicEvaluation) {
     let world_axis = p.axis_length;
     let r = p.confidence().radius(t.group.position_dims());
-    let robot_base = format!("{base}/{ROBOT}");
+    let robot_base = paths::robot(&t.name);
     let mut last_scale = None;
     for pose in &t.poses {
         let Some(mean) = pose.mean else {

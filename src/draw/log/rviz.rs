@@ -11,7 +11,7 @@ use super::RVIZ;
 use crate::eval::log::RvizNumbers;
 use crate::lie::{LieGroup, Se3};
 use crate::plan::log::{PLACEHOLDER, ROS_AXES};
-use crate::scene::{Ellipsoid, Ellipsoids, FillMode, ItemKind, LineStrips, Timing, Vec3};
+use crate::scene::{Ellipsoid, Ellipsoids, FillMode, ItemKind, LineStrips, Timing, Vec3, paths};
 
 /// RViz bounds the drawn angular spread at 89°.
 const RVIZ_MAX_ANGLE: f64 = 89.0 * std::f64::consts::PI / 180.0;
@@ -103,7 +103,7 @@ pub(super) fn rviz_picture(
     let l = p.axis_length;
     let (shape, note) = rviz_position(rviz, &center, r_pos, l, planar);
     p.place(
-        format!("{base}/rviz/position"),
+        paths::child(&base, "rviz/position"),
         at,
         ItemKind::Ellipsoids(Ellipsoids {
             shapes: vec![shape],
@@ -125,7 +125,7 @@ pub(super) fn rviz_picture(
         fan.extend(arc);
         fan.push(origin);
         p.place(
-            format!("{base}/rviz/orientation"),
+            paths::child(&base, "rviz/orientation"),
             at,
             ItemKind::LineStrips(LineStrips {
                 strips: vec![fan],
@@ -169,7 +169,7 @@ pub(super) fn rviz_picture(
         let h = [spread(eig.eigenvalues[0]), spread(eig.eigenvalues[1])];
         let thin = 0.01 * h[0].max(h[1]).max(1e-6);
         p.place(
-            format!("{base}/rviz/orientation_{}", ["x", "y", "z"][axis]),
+            paths::child(base, &format!("rviz/orientation_{}", ["x", "y", "z"][axis])),
             at,
             ItemKind::Ellipsoids(Ellipsoids {
                 shapes: vec![Ellipsoid {

@@ -78,6 +78,10 @@ pub struct LoopClosure<const N: usize> {
     pub residual: Tangent<N>,
     /// d at the optimised poses.
     pub mahalanobis: f64,
+    /// Where the loop closure puts X_j at the optimised poses, X_i · Z = X_j · Exp(−r): the
+    /// position of that predicted pose in the world (the residual is the step from it to
+    /// X_j's own position).
+    pub predicted_position: nalgebra::Vector3<f64>,
     /// The covariance of X_i⁻¹ X_j from the joint marginal (None without marginals).
     pub relative_cov: Option<TangentMatrix<N>>,
 }
@@ -202,6 +206,8 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         let distance = |r: &Tangent<N>| (r.transpose() * lambda * r)[(0, 0)].max(0.0).sqrt();
         let residual_before = e.residual(&initial);
         let residual = e.residual(&solution.poses);
+        // X_j = X_i · Z · Exp(r): the predicted pose is X_j · Exp(−r).
+        let predicted = solution.poses[e.to].compose(&G::exp(&-residual));
         loop_closures.push(LoopClosure {
             edge: k,
             from: i,
@@ -210,6 +216,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
             mahalanobis_before: distance(&residual_before),
             residual_before,
             mahalanobis: distance(&residual),
+            predicted_position: predicted.to_se3().translation().to_owned(),
             residual,
             relative_cov: solution.edge_joints[k].as_ref().map(|joint| {
                 relative_covariance(&solution.poses[e.from], &solution.poses[e.to], joint)

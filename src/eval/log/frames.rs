@@ -181,8 +181,50 @@ pub fn join_plan(tf: &TfTree, topics: &[(&str, &str, Option<i64>)]) -> FrameJoin
     if tf.edges.is_empty() {
         return plan;
     }
-    let frame = |f: &str| f.trim_start_matches('/').to_owned();
-    // tf's one-parent rule: a child with several parents keeps none.
+    let (parents, broken) = one_parent_each(tf, &mut plan.problems);
+    // One frame among the topics: nothing to join, nothing to say of frames /tf lacks.
+    let distinct: BTreeSet<String> = topics
+        .iter()
+        .map(|t| bare_frame(t.1))
+        .filter(|f| !f.is_empty())
+        .collect();
+    if distinct.len() < 2 {
+        return plan;
+    }
+    let mut trees = chains_to_roots(tf, topics, &parents, &broken, &mut plan.problems);
+    // Per tree: each topic's chain up to the lowest common ancestor of its topics' frames.
+    for members in trees.roots.values() {
+        if let Some(common) = common_frame(&trees.chains, members) {
+            for &i in members {
+                if let Some(c) = &trees.chains[i]
+                    && let Some(end) = c.iter().position(|f| *f == common)
+                    && end > 0
+                {
+                    plan.chains[i] = Some(c[..=end].to_vec());
+                }
+            }
+        }
+    }
+    // Frames in /tf but in trees apart (not apart by a broken link, said above): a missing
+    // link.
+    trees.roots.retain(|root, _| !broken.contains(root));
+    if trees.roots.len() > 1 {
+        plan.problems.push(missing_link(&trees, topics));
+    }
+    plan
+}
+
+/// A frame id without its leading `/` (tf2 drops it).
+fn bare_frame(f: &str) -> String {
+    f.trim_start_matches('/').to_owned()
+}
+
+/// tf's one-parent rule: each child's one parent; a child with several parents keeps none
+/// (returned apart, its problem noted with the transform that gave the second parent).
+fn one_parent_each<'t>(
+    tf: &'t TfTree,
+    problems: &mut Vec<FrameProblem>,
+) -> (BTreeMap<&'t str, &'t str>, BTreeSet<String>) {
     let mut seen: BTreeMap<&str, Vec<&crate::plan::log::TfEdge>> = BTreeMap::new();
     for e in &tf.edges {
         seen.entry(e.child.as_str()).or_default().push(e);
@@ -197,7 +239,7 @@ pub fn join_plan(tf: &TfTree, topics: &[(&str, &str, Option<i64>)]) -> FrameJoin
             let second = edges.iter().max_by_key(|e| e.first_stamp_ns);
             let mut frames = vec![(*child).to_owned()];
             frames.extend(edges.iter().map(|e| e.parent.clone()));
-            plan.problems.push(FrameProblem {
+            problems.push(FrameProblem {
                 kind: FrameProblemKind::SeveralParents,
                 frames,
                 roots: Vec::new(),
@@ -207,42 +249,48 @@ pub fn join_plan(tf: &TfTree, topics: &[(&str, &str, Option<i64>)]) -> FrameJoin
             });
         }
     }
-    // One frame among the topics: nothing to join, nothing to say of frames /tf lacks.
-    let distinct: BTreeSet<String> = topics
-        .iter()
-        .map(|t| frame(t.1))
-        .filter(|f| !f.is_empty())
-        .collect();
-    if distinct.len() < 2 {
-        return plan;
-    }
+    (parents, broken)
+}
+
+/// The topics' frames in /tf's trees.
+struct Trees {
+    /// Per topic, its chain of frames up to its tree's root (`None`: no frame, not in /tf, or
+    /// in a cycle).
+    chains: Vec<Option<Vec<String>>>,
+    /// Per root, the topics (indices) under it.
+    roots: BTreeMap<String, Vec<usize>>,
+}
+
+/// Each topic's chain up to its root, grouped by root; a frame /tf lacks and a cycle are
+/// noted (a cycle once, with every topic it keeps apart), and a topic below a frame with
+/// several parents is added to that problem.
+fn chains_to_roots(
+    tf: &TfTree,
+    topics: &[(&str, &str, Option<i64>)],
+    parents: &BTreeMap<&str, &str>,
+    broken: &BTreeSet<String>,
+    problems: &mut Vec<FrameProblem>,
+) -> Trees {
     let known: BTreeSet<&str> = tf
         .edges
         .iter()
         .flat_map(|e| [e.parent.as_str(), e.child.as_str()])
         .collect();
-    // Per topic its chain to the root; per root the topics under it.
     let mut chains: Vec<Option<Vec<String>>> = vec![None; topics.len()];
     let mut roots: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     for (i, (name, frame_id, first)) in topics.iter().enumerate() {
-        let f = frame(frame_id);
+        let f = bare_frame(frame_id);
         if f.is_empty() {
             continue;
         }
         if !known.contains(f.as_str()) {
-            note_topic(
-                &mut plan.problems,
-                FrameProblemKind::NoTransform,
-                &f,
-                name,
-                *first,
-            );
+            note_topic(problems, FrameProblemKind::NoTransform, &f, name, *first);
             continue;
         }
-        match chain_up(&parents, &f) {
+        match chain_up(parents, &f) {
             Ok(c) => {
                 if c.iter().any(|g| broken.contains(g)) {
-                    for p in &mut plan.problems {
+                    for p in problems.iter_mut() {
                         if p.kind == FrameProblemKind::SeveralParents && c.contains(&p.frames[0]) {
                             p.topics.push((*name).to_owned());
                         }
@@ -251,89 +299,86 @@ pub fn join_plan(tf: &TfTree, topics: &[(&str, &str, Option<i64>)]) -> FrameJoin
                 roots.entry(c[c.len() - 1].clone()).or_default().push(i);
                 chains[i] = Some(c);
             }
-            Err(cycle) => {
-                let mut sorted = cycle[..cycle.len() - 1].to_vec();
-                sorted.sort();
-                let same = |p: &FrameProblem| {
-                    let mut s = p.frames[..p.frames.len() - 1].to_vec();
-                    s.sort();
-                    p.kind == FrameProblemKind::Cycle && s == sorted
-                };
-                match plan.problems.iter_mut().find(|p| same(p)) {
-                    Some(p) => p.topics.push((*name).to_owned()),
-                    None => {
-                        let closing = cycle
-                            .windows(2)
-                            .filter_map(|w| tf.edge(&w[1], &w[0]))
-                            .max_by_key(|e| e.first_stamp_ns);
-                        plan.problems.push(FrameProblem {
-                            kind: FrameProblemKind::Cycle,
-                            frames: cycle.into_iter().rev().collect(),
-                            roots: Vec::new(),
-                            topics: vec![(*name).to_owned()],
-                            source: closing.map(|e| e.topic.clone()).unwrap_or_default(),
-                            stamp_ns: closing.map(|e| e.first_stamp_ns),
-                        });
-                    }
-                }
-            }
+            Err(cycle) => note_cycle(tf, problems, cycle, name),
         }
     }
-    // Per tree: the lowest common ancestor of its topics' frames.
-    for members in roots.values() {
-        let firsts: BTreeSet<&str> = members
-            .iter()
-            .filter_map(|&i| chains[i].as_ref().map(|c| c[0].as_str()))
-            .collect();
-        if firsts.len() < 2 {
-            continue;
-        }
-        let Some(first) = chains[members[0]].as_ref() else {
-            continue;
-        };
-        let common = first
-            .iter()
-            .find(|f| {
-                members
-                    .iter()
-                    .all(|&i| chains[i].as_ref().is_some_and(|c| c.contains(f)))
-            })
-            .cloned();
-        let Some(common) = common else { continue };
-        for &i in members {
-            if let Some(c) = &chains[i]
-                && let Some(end) = c.iter().position(|f| *f == common)
-                && end > 0
-            {
-                plan.chains[i] = Some(c[..=end].to_vec());
-            }
+    Trees { chains, roots }
+}
+
+/// Notes topic `name` kept apart by `cycle` (its frames, the first repeated at the end): added
+/// to the problem of the same cycle, or a new problem with the transform that closed it.
+fn note_cycle(tf: &TfTree, problems: &mut Vec<FrameProblem>, cycle: Vec<String>, name: &str) {
+    let mut sorted = cycle[..cycle.len() - 1].to_vec();
+    sorted.sort();
+    let same = |p: &FrameProblem| {
+        let mut s = p.frames[..p.frames.len() - 1].to_vec();
+        s.sort();
+        p.kind == FrameProblemKind::Cycle && s == sorted
+    };
+    match problems.iter_mut().find(|p| same(p)) {
+        Some(p) => p.topics.push(name.to_owned()),
+        None => {
+            let closing = cycle
+                .windows(2)
+                .filter_map(|w| tf.edge(&w[1], &w[0]))
+                .max_by_key(|e| e.first_stamp_ns);
+            problems.push(FrameProblem {
+                kind: FrameProblemKind::Cycle,
+                frames: cycle.into_iter().rev().collect(),
+                roots: Vec::new(),
+                topics: vec![name.to_owned()],
+                source: closing.map(|e| e.topic.clone()).unwrap_or_default(),
+                stamp_ns: closing.map(|e| e.first_stamp_ns),
+            });
         }
     }
-    // Frames in /tf but in trees apart (not apart by a broken link, said above): a missing
-    // link.
-    roots.retain(|root, _| !broken.contains(root));
-    if roots.len() > 1 {
-        let (frames, trees): (Vec<String>, Vec<String>) = roots
-            .iter()
-            .filter_map(|(root, members)| {
-                let c = chains[members[0]].as_ref()?;
-                Some((c[0].clone(), root.clone()))
-            })
-            .unzip();
-        plan.problems.push(FrameProblem {
-            kind: FrameProblemKind::MissingLink,
-            frames,
-            roots: trees,
-            topics: roots
-                .values()
-                .flatten()
-                .map(|&i| topics[i].0.to_owned())
-                .collect(),
-            source: "/tf".to_owned(),
-            stamp_ns: None,
-        });
+}
+
+/// The lowest frame of a tree common to the chains of its topics `members`; `None` when they
+/// are all in one frame (nothing to join).
+fn common_frame(chains: &[Option<Vec<String>>], members: &[usize]) -> Option<String> {
+    let firsts: BTreeSet<&str> = members
+        .iter()
+        .filter_map(|&i| chains[i].as_ref().map(|c| c[0].as_str()))
+        .collect();
+    if firsts.len() < 2 {
+        return None;
     }
-    plan
+    let first = chains[members[0]].as_ref()?;
+    first
+        .iter()
+        .find(|f| {
+            members
+                .iter()
+                .all(|&i| chains[i].as_ref().is_some_and(|c| c.contains(f)))
+        })
+        .cloned()
+}
+
+/// The problem of topics in /tf trees apart: per tree one topic's frame and the tree's root,
+/// and every topic under them.
+fn missing_link(trees: &Trees, topics: &[(&str, &str, Option<i64>)]) -> FrameProblem {
+    let (frames, roots): (Vec<String>, Vec<String>) = trees
+        .roots
+        .iter()
+        .filter_map(|(root, members)| {
+            let c = trees.chains[members[0]].as_ref()?;
+            Some((c[0].clone(), root.clone()))
+        })
+        .unzip();
+    FrameProblem {
+        kind: FrameProblemKind::MissingLink,
+        frames,
+        roots,
+        topics: trees
+            .roots
+            .values()
+            .flatten()
+            .map(|&i| topics[i].0.to_owned())
+            .collect(),
+        source: "/tf".to_owned(),
+        stamp_ns: None,
+    }
 }
 
 /// Notes a topic's frame problem, one per frame (further topics added to it).

@@ -23,8 +23,9 @@
 //!
 //! ```
 //! use posecov::eval::log::nees::{Align, NeesObserver, NeesSettings};
-//! use posecov::plan::log::{EstimateMessage, LogObserver, ReferenceSample};
-//! let mut nees = NeesObserver::new(NeesSettings::new("topic:/truth"));
+//! use posecov::plan::log::{EstimateMessage, LogObserver, Reference, ReferenceInLog, ReferenceSample};
+//! let truth = Reference::InLog(ReferenceInLog::Topic("/truth".into()));
+//! let mut nees = NeesObserver::new(NeesSettings::new(truth));
 //! for k in 0..3 {
 //!     let q = [0.0, 0.0, 0.0, 1.0];
 //!     nees.reference("map", ReferenceSample { stamp_ns: k * 100, position: [k as f64, 0.0, 0.0], orientation_xyzw: q });
@@ -157,9 +158,9 @@ impl NeesObserver {
     ///
     /// ```
     /// use posecov::eval::log::nees::{NeesObserver, NeesSettings};
-    /// use posecov::plan::log::ReferenceSample;
+    /// use posecov::plan::log::{Reference, ReferenceSample};
     /// let s = ReferenceSample { stamp_ns: 0, position: [0.0; 3], orientation_xyzw: [0.0, 0.0, 0.0, 1.0] };
-    /// let nees = NeesObserver::with_trajectory(NeesSettings::new("file:gt.txt"), &[s]);
+    /// let nees = NeesObserver::with_trajectory(NeesSettings::new(Reference::File("gt.txt".into())), &[s]);
     /// assert_eq!(nees.reference_samples(), 1);
     /// ```
     pub fn with_trajectory(settings: NeesSettings, samples: &[ReferenceSample]) -> Self {
@@ -235,7 +236,8 @@ impl NeesObserver {
         let align = self.settings.align;
         let tf_parent = self
             .settings
-            .tf_parent_required
+            .reference
+            .is_tf()
             .then(|| self.reference_frame.as_deref().unwrap_or_default());
         let Some(state) = self.topics.get_mut(topic) else {
             return;
@@ -313,7 +315,7 @@ impl LogObserver for NeesObserver {
         match &self.reference_frame {
             None => self.reference_frame = Some(frame.to_owned()),
             // `/tf`: the first parent seen is the reference's; other parents are left out.
-            Some(f) if self.settings.tf_parent_required && f != frame => return,
+            Some(f) if self.settings.reference.is_tf() && f != frame => return,
             Some(_) => {}
         }
         self.reference.insert(sample.stamp_ns, x);
@@ -321,7 +323,7 @@ impl LogObserver for NeesObserver {
     }
 
     fn estimate(&mut self, m: &EstimateMessage<'_>) {
-        if self.settings.reference_topic.as_deref() == Some(m.topic) {
+        if self.settings.reference.topic() == Some(m.topic) {
             return;
         }
         let every = self.settings.every;

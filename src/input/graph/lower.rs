@@ -13,6 +13,7 @@ use super::problem::{Edge, Prior, chain_initial_guess, pose_graph};
 use super::{InputError, Locator, Summary};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
+use crate::plan::choices::{GraphFacts, Link, SkippedRecords};
 use crate::plan::{
     AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, StepPolicy, limits,
 };
@@ -310,6 +311,9 @@ fn vertex_name(id: u64) -> String {
     format!("v{id}")
 }
 
+/// The plan, the drawing choices and the facts of a read graph: the drawn vertex estimates as
+/// known poses, the odometry chain as one odometry operation, each drawn loop closure as the
+/// pose it puts its second vertex at; with the line of each operation's edge.
 fn assemble<G: GraphGroup<N>, const N: usize>(
     locator: &Locator,
     records: &Records,
@@ -321,21 +325,7 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
     let chain = chain(vertices, edges);
     let in_chain: BTreeSet<usize> = chain.iter().map(|c| c.0).collect();
     let loops: Vec<usize> = (0..edges.len()).filter(|i| !in_chain.contains(i)).collect();
-    let drawn_loops: Vec<usize> = evenly(loops.len(), MAX_LOOP_CLOSURES)
-        .into_iter()
-        .map(|k| loops[k])
-        .collect();
-    let ids: Vec<u64> = vertices.keys().copied().collect();
-    let mut drawn_ids: BTreeSet<u64> = evenly(ids.len(), MAX_DRAWN_VERTICES)
-        .into_iter()
-        .map(|k| ids[k])
-        .collect();
-    drawn_ids.extend(
-        drawn_loops
-            .iter()
-            .flat_map(|&i| [edges[i].from, edges[i].to]),
-    );
-
+    let (drawn_loops, drawn_ids) = drawn(vertices, edges, &loops);
     let mut plan = Plan::<G, N> {
         graph: Some(graph),
         ..Plan::default()
@@ -352,7 +342,8 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         plan.known(&name, vertices[id].0);
         choices.shown.insert(name, true);
     }
-    let first = ids[0];
+    // The first vertex id (a graph without vertices is refused when read).
+    let first = vertices.keys().next().copied().unwrap_or_default();
     if let Some(&(first_edge, ..)) = chain.first() {
         plan.operation(
             "odometry_chain",
@@ -373,39 +364,10 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         choices.shown.insert("odometry_chain".to_owned(), true);
     }
     for &i in &drawn_loops {
-        let e = &edges[i];
-        let measured = format!("v{}_to_v{}_measured", e.from, e.to);
-        let mut via = format!("v{}_via_v{}", e.to, e.from);
-        if choices.shown.contains_key(&via) {
-            via = format!("{via}_line{}", e.line);
-        }
-        let input = plan.uncertain(
-            &measured,
-            UncertainPose::new_unchecked(e.measurement, e.cov, Side::Right),
-        );
-        choices.shown.insert(measured, false);
-        plan.operation(
-            &via,
-            Op::ChangeFrame {
-                input,
-                by: vertices[&e.from].0,
-                side: FrameSide::Left,
-            },
-        );
-        operation_lines.push(e.line);
-        choices.shown.insert(via, true);
-        choices.links.push((vertex_name(e.from), vertex_name(e.to)));
+        loop_closure(&mut plan, &mut choices, &edges[i], vertices);
+        operation_lines.push(edges[i].line);
     }
-    let mut steps: Vec<f64> = chain
-        .iter()
-        .map(|(_, z, _)| z.to_se3().translation().norm())
-        .filter(|d| *d > 0.0)
-        .collect();
-    steps.sort_by(f64::total_cmp);
-    if let Some(median) = steps.get(steps.len() / 2) {
-        choices.axis_length =
-            Some((0.3 * median).clamp(limits::MIN_AXIS_LENGTH, limits::MAX_AXIS_LENGTH));
-    }
+    choices.axis_length = axis_length(&chain);
     let summary = Summary {
         vertices: vertices.len(),
         edges: edges.len(),
@@ -414,7 +376,26 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         loop_closures_drawn: drawn_loops.len(),
         vertices_drawn: drawn_ids.len(),
     };
-    let chain_end = first + chain.len() as u64;
+    choices.graph = Some(GraphFacts {
+        planar: G::KIND.is_planar(),
+        vertices: summary.vertices,
+        edges: summary.edges,
+        chain_edges: summary.chain_edges,
+        loop_closures: summary.loop_closures,
+        loop_closures_drawn: summary.loop_closures_drawn,
+        vertices_drawn: summary.vertices_drawn,
+        first,
+        chain_end: first + chain.len() as u64,
+        chained,
+        skipped: records
+            .skipped
+            .iter()
+            .map(|(tag, count)| SkippedRecords {
+                tag: tag.clone(),
+                count: *count,
+            })
+            .collect(),
+    });
     let about = About {
         title: format!(
             "Pose graph {}: {} {} poses, {} odometry edges, {} loop closures",
@@ -428,14 +409,7 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
             summary.chain_edges,
             summary.loop_closures
         ),
-        description: describe(
-            G::KIND.is_planar(),
-            &summary,
-            first,
-            chain_end,
-            records,
-            chained,
-        ),
+        description: String::new(),
         source: String::new(),
     };
     let input = Input {
@@ -451,77 +425,77 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
     (input, operation_lines, summary)
 }
 
-fn describe(
-    planar: bool,
-    s: &Summary,
-    first: u64,
-    chain_end: u64,
-    records: &Records,
-    chained: bool,
-) -> String {
-    let chain = if s.chain_edges == 0 {
-        format!(
-            "- **No odometry chain**: no edge joins v{first} to v{}, so nothing is propagated.\n",
-            first.saturating_add(1)
-        )
-    } else {
-        format!(
-            "- **Odometry chain** `odometry_chain`: the {} edges between consecutive vertex ids, \
-             v{first} → v{chain_end}, composed from v{first}'s estimate with each edge's \
-             covariance (first order in colour, Monte Carlo as the cloud). Scrub the `step` \
-             timeline: step k is vertex v{first}+k, and the banana grows as the errors of every \
-             edge add up.\n",
-            s.chain_edges
-        )
-    };
-    let mut d = format!(
-        "**{} vertices, {} edges** ({}).\n\n{chain}\
-         - **Vertex estimates** `v<id>`: the file's poses, as axes. Where they part from the \
-         chain's mean, the file's estimate is not dead reckoning (e.g. it was optimised).\n\
-         - **Loop closures** (the other {} edges): a grey line between the two vertices, and \
-         `v<j>_via_v<i>` = X_i · Z, where edge i → j puts vertex j, with the edge's own uncertainty.\n",
-        s.vertices,
-        s.edges,
-        if planar { "SE(2)" } else { "SE(3)" },
-        s.loop_closures,
+/// What is drawn of a graph: the loop closures (indices into `edges`, at most
+/// [`MAX_LOOP_CLOSURES`] of `loops`, evenly chosen) and the vertex ids (at most
+/// [`MAX_DRAWN_VERTICES`], evenly chosen, plus the drawn loop closures' ends).
+fn drawn<G: LieGroup<N>, const N: usize>(
+    vertices: &BTreeMap<u64, (G, usize)>,
+    edges: &[Edge<G, N>],
+    loops: &[usize],
+) -> (Vec<usize>, BTreeSet<u64>) {
+    let drawn_loops: Vec<usize> = evenly(loops.len(), MAX_LOOP_CLOSURES)
+        .into_iter()
+        .map(|k| loops[k])
+        .collect();
+    let ids: Vec<u64> = vertices.keys().copied().collect();
+    let mut drawn_ids: BTreeSet<u64> = evenly(ids.len(), MAX_DRAWN_VERTICES)
+        .into_iter()
+        .map(|k| ids[k])
+        .collect();
+    drawn_ids.extend(
+        drawn_loops
+            .iter()
+            .flat_map(|&i| [edges[i].from, edges[i].to]),
     );
-    if s.vertices_drawn < s.vertices {
-        d.push_str(&format!(
-            "\n{} of the {} vertex estimates are drawn (evenly chosen, and the drawn loop closures' ends).\n",
-            s.vertices_drawn, s.vertices
-        ));
+    (drawn_loops, drawn_ids)
+}
+
+/// A drawn loop closure i → j: its measurement `v<i>_to_v<j>_measured` (an uncertain input,
+/// not drawn) and `v<j>_via_v<i>` = X_i · Z, where it puts vertex j (drawn, linked to both
+/// vertices).
+fn loop_closure<G: LieGroup<N>, const N: usize>(
+    plan: &mut Plan<G, N>,
+    choices: &mut DrawChoices,
+    e: &Edge<G, N>,
+    vertices: &BTreeMap<u64, (G, usize)>,
+) {
+    let measured = format!("v{}_to_v{}_measured", e.from, e.to);
+    let mut via = format!("v{}_via_v{}", e.to, e.from);
+    if choices.shown.contains_key(&via) {
+        via = format!("{via}_line{}", e.line);
     }
-    if s.loop_closures_drawn < s.loop_closures {
-        d.push_str(&format!(
-            "\n{} of the {} loop closures are drawn (evenly chosen).\n",
-            s.loop_closures_drawn, s.loop_closures
-        ));
-    }
-    if s.chain_edges > 0 && s.vertices as u64 > chain_end - first + 1 {
-        d.push_str(&format!(
-            "\nThe chain stops at v{chain_end}: no edge joins it to v{} (the later vertices are \
-             drawn, not propagated).\n",
-            chain_end.saturating_add(1)
-        ));
-    }
-    if chained {
-        d.push_str(
-            "\nThe file has no VERTEX lines: the estimates are chained from the edges (the \
-             odometry edges first, then the others, each placing a vertex not yet placed), as \
-             GTSAM's reader does.\n",
-        );
-    }
-    for (tag, n) in &records.skipped {
-        d.push_str(&format!("\nSkipped {n} `{tag}` record(s) (not drawn).\n"));
-    }
-    d.push_str(if planar {
-        "\nEdge covariance: g2o's EDGE_SE2 information over (x, y, θ) of Z⁻¹ X_i⁻¹ X_j, \
-         inverted: posecov's right-perturbation Σ over [ρx, ρy, θ] (GTSAM reads it the same way).\n"
-    } else {
-        "\nEdge covariance: g2o's EDGE_SE3:QUAT information is over (t, q.xyz) of \
-         Z⁻¹ X_i⁻¹ X_j; q.xyz ≈ θ/2, so posecov's Σ over [ρ; θ] has the rotation block ×4 and \
-         the cross block ×2 of Ω⁻¹. GTSAM's readG2o applies no such factor: its rotation σ is \
-         half of this.\n"
+    let input = plan.uncertain(
+        &measured,
+        UncertainPose::new_unchecked(e.measurement, e.cov, Side::Right),
+    );
+    choices.shown.insert(measured, false);
+    plan.operation(
+        &via,
+        Op::ChangeFrame {
+            input,
+            by: vertices[&e.from].0,
+            side: FrameSide::Left,
+        },
+    );
+    choices.shown.insert(via, true);
+    choices.links.push(Link {
+        from: vertex_name(e.from),
+        to: vertex_name(e.to),
     });
-    d
+}
+
+/// The frames' axis length: 0.3 of the chain's median step (within the limits); `None`
+/// without a step that moves.
+fn axis_length<G: LieGroup<N>, const N: usize>(
+    chain: &[(usize, G, TangentMatrix<N>)],
+) -> Option<f64> {
+    let mut steps: Vec<f64> = chain
+        .iter()
+        .map(|(_, z, _)| z.to_se3().translation().norm())
+        .filter(|d| *d > 0.0)
+        .collect();
+    steps.sort_by(f64::total_cmp);
+    steps
+        .get(steps.len() / 2)
+        .map(|median| (0.3 * median).clamp(limits::MIN_AXIS_LENGTH, limits::MAX_AXIS_LENGTH))
 }

@@ -6,7 +6,9 @@ use std::collections::HashMap;
 
 use super::reference::{self, ReferenceType};
 use super::{Codec, Stream};
-use crate::plan::log::{Decimator, MAX_TF_EDGES, MAX_TF_SAMPLES, ReferenceSample, TfEdge, TfTree};
+use crate::plan::log::{
+    Decimator, MAX_TF_EDGES, MAX_TF_SAMPLES, ReferenceSample, TfEdge, TfTree, UndecodableTf,
+};
 
 /// The topics whose transforms join frames.
 pub(super) const TF_TOPICS: [&str; 2] = ["/tf", "/tf_static"];
@@ -19,7 +21,7 @@ pub(super) struct TfCollector {
     /// Parent → child → index in `edges`: looked up by `&str`, so a transform of a known edge
     /// (every `/tf` message after the first) allocates nothing.
     by_name: HashMap<String, HashMap<String, usize>>,
-    undecodable: Vec<(String, u64, i64)>,
+    undecodable: Vec<UndecodableTf>,
 }
 
 impl TfCollector {
@@ -43,9 +45,13 @@ impl TfCollector {
         let poses = match reference::decode_reference(*kind, codec, bytes) {
             Ok(poses) => poses,
             Err(_) => {
-                match self.undecodable.iter_mut().find(|u| u.0 == topic) {
-                    Some(u) => u.1 += 1,
-                    None => self.undecodable.push((topic.to_owned(), 1, log_time_ns)),
+                match self.undecodable.iter_mut().find(|u| u.topic == topic) {
+                    Some(u) => u.count += 1,
+                    None => self.undecodable.push(UndecodableTf {
+                        topic: topic.to_owned(),
+                        count: 1,
+                        first_log_time_ns: log_time_ns,
+                    }),
                 }
                 return;
             }
@@ -162,6 +168,13 @@ mod tests {
                 .all(|w| w[1].stamp_ns - w[0].stamp_ns == step)
         );
         assert!(tree.edges[1].static_value.is_some() && tree.edges[1].samples.is_empty());
-        assert_eq!(tree.undecodable, [("/tf".to_owned(), 1, 7)]);
+        assert_eq!(
+            tree.undecodable,
+            [UndecodableTf {
+                topic: "/tf".to_owned(),
+                count: 1,
+                first_log_time_ns: 7
+            }]
+        );
     }
 }

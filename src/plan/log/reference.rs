@@ -44,6 +44,49 @@ impl fmt::Display for ReferenceInLog {
     }
 }
 
+/// The truth a log's estimates are compared with (`--reference`, typed from the flag to the
+/// NEES settings): something in the log, or a TUM trajectory file. Shown as the user names it.
+///
+/// ```
+/// use posecov::plan::log::{Reference, ReferenceInLog};
+/// let r = Reference::InLog(ReferenceInLog::Topic("/truth".into()));
+/// assert_eq!((r.to_string(), r.topic()), ("topic:/truth".to_owned(), Some("/truth")));
+/// assert!(Reference::InLog(ReferenceInLog::Tf { child: "base".into() }).is_tf());
+/// assert_eq!(Reference::File("gt.txt".into()).to_string(), "file:gt.txt");
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Reference {
+    /// A topic of the log, or its `/tf` transforms of one child frame.
+    InLog(ReferenceInLog),
+    /// A TUM trajectory file (its path as given).
+    File(String),
+}
+
+impl Reference {
+    /// The topic of the log that is the reference itself (left out of the estimates), if any.
+    pub fn topic(&self) -> Option<&str> {
+        match self {
+            Reference::InLog(ReferenceInLog::Topic(name)) => Some(name),
+            Reference::InLog(ReferenceInLog::Tf { .. }) | Reference::File(_) => None,
+        }
+    }
+
+    /// Whether the samples are `/tf` transforms: only estimate topics whose `frame_id` is
+    /// their parent are compared.
+    pub fn is_tf(&self) -> bool {
+        matches!(self, Reference::InLog(ReferenceInLog::Tf { .. }))
+    }
+}
+
+impl fmt::Display for Reference {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Reference::InLog(r) => r.fmt(f),
+            Reference::File(path) => write!(f, "file:{path}"),
+        }
+    }
+}
+
 /// One pose of the reference trajectory: parent_from_child at `stamp_ns`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReferenceSample {

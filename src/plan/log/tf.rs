@@ -82,9 +82,19 @@ impl TfEdge {
 pub struct TfTree {
     /// The edges.
     pub edges: Vec<TfEdge>,
-    /// `/tf` or `/tf_static` messages that could not be decoded: (topic, count, first log
-    /// time in ns).
-    pub undecodable: Vec<(String, u64, i64)>,
+    /// `/tf` or `/tf_static` messages that could not be decoded, per topic.
+    pub undecodable: Vec<UndecodableTf>,
+}
+
+/// The `/tf` or `/tf_static` messages of one topic that could not be decoded.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UndecodableTf {
+    /// `/tf` or `/tf_static`.
+    pub topic: String,
+    /// How many.
+    pub count: u64,
+    /// The first one's log time, ns.
+    pub first_log_time_ns: i64,
 }
 
 impl TfTree {

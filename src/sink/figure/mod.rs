@@ -29,9 +29,10 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::scene::{ItemKind, Scene, SceneItem, Timeline, Timing};
+use crate::scene::{ItemKind, Scene, SceneItem, Timeline};
 
 pub mod chart;
+mod layout;
 mod panel;
 mod raster;
 mod region;
@@ -45,6 +46,7 @@ use steps::{drawn_steps, selected};
 pub use world::Plane;
 
 use chart::{Axes, PlotPanel, Rect};
+use layout::PAGE;
 use panel::{cells, panels, title_lines};
 use svg::{Anchor, Svg};
 use world::{Mapping, Pen};
@@ -159,32 +161,83 @@ pub enum FigureError {
 pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
     let (w, h) = (f64::from(options.size.0), f64::from(options.size.1));
     let pen = Pen {
-        unit: (w.min(h) / 800.0).max(0.6),
-        font: (w.min(h) / 800.0 * 15.0).clamp(8.0, 40.0),
+        unit: (w.min(h) / PAGE.reference_side).max(PAGE.min_unit),
+        font: (w.min(h) / PAGE.reference_side * PAGE.font_at_reference)
+            .clamp(PAGE.font_range[0], PAGE.font_range[1]),
     };
     let f = pen.font;
     let mut out = Svg::new(options.size.0, options.size.1);
     let panels = panels(scene, options.steps);
     // Title and what the figure shows.
     out.text(
-        [0.8 * f, 1.9 * f],
-        1.5 * f,
+        [PAGE.title_at[0] * f, PAGE.title_at[1] * f],
+        PAGE.title_size * f,
         Anchor::Start,
         "#000",
         &scene.title,
     );
+    let steps = scene.steps();
+    let mut about = about_steps(scene, options, &steps);
+    // Body: the world on the left, the legend and the plots on the right.
+    let top = PAGE.top * f;
+    let column = if scene.legend.is_empty() && scene.plots.is_empty() {
+        0.0
+    } else {
+        (PAGE.column_share * w).max(PAGE.column_min * f)
+    };
+    let body = Rect {
+        x: 0.0,
+        y: top,
+        w: (w - column).max(PAGE.min_size),
+        h: h - top,
+    };
+    let grids = draw_panels(&mut out, &panels, options, body, pen, steps.len() > 1);
+    if let [grid] = grids.as_slice() {
+        about.push(format!("grid {}", chart::length_label(*grid)));
+    }
+    if panels.len() > 1 {
+        about.push("one panel per view, grid lines a scale bar apart".to_owned());
+    }
+    // A robot log's scene is on a time line (the scene says so: its timeline).
+    let log = scene.timeline != Timeline::Step;
+    if log && options.steps == Steps::All {
+        about.push("the last message, every drawn one's outline faint".to_owned());
+    }
+    out.text(
+        [PAGE.title_at[0] * f, PAGE.about_y * f],
+        PAGE.about_size * f,
+        Anchor::Start,
+        "#444",
+        &about.join(" · "),
+    );
+    if column > 0.0 {
+        let col = Rect {
+            x: w - column + PAGE.column_inset * f,
+            y: top,
+            w: column - PAGE.column_trim * f,
+            h: h - top - PAGE.column_bottom * f,
+        };
+        draw_column(&mut out, scene, options, col, pen);
+    }
+    out.finish()
+}
+
+/// What the figure shows, in words, before its worlds are drawn: the confidence, the plane,
+/// and which states or steps (a graph's before and after, a propagation's steps at once or
+/// one step).
+fn about_steps(scene: &Scene, options: &FigureOptions, steps: &[i64]) -> Vec<String> {
     let (right, up) = options.plane.names();
     let mut about = vec![format!("{right}–{up} plane")];
     if let Some(p) = scene.confidence {
         about.insert(0, format!("regions at {} confidence", p));
     }
-    let steps = scene.steps();
     let graph_states = scene.states.as_ref().map(|s| &s.steps);
     match (options.steps, graph_states) {
         (Steps::All, Some(states)) => {
-            if let Some((k, _)) = states.last() {
+            if let Some(last) = states.last() {
                 about.push(format!(
-                    "before, and after: the final solution ({k} loop closures)"
+                    "before, and after: the final solution ({} loop closures)",
+                    last.closures
                 ));
             }
         }
@@ -193,8 +246,11 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
                 .states
                 .as_ref()
                 .and_then(|s| s.step_after(k.max(0) as u64));
-            if let Some((count, _)) = states.iter().find(|(_, s)| Some(*s) == step) {
-                about.push(format!("after {count} loop closures (--step {k})"));
+            if let Some(state) = states.iter().find(|s| Some(s.step) == step) {
+                about.push(format!(
+                    "after {} loop closures (--step {k})",
+                    state.closures
+                ));
             }
         }
         _ => {}
@@ -213,45 +269,45 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
         (Steps::At(k), Some(_), Some(_)) => about.push(format!("step {k}")),
         _ => {}
     }
-    // Body: the world on the left, the legend and the plots on the right.
-    let top = 3.6 * f;
-    let plots: Vec<(usize, &crate::scene::Plot)> = scene.plots.iter().enumerate().collect();
-    let column = if scene.legend.is_empty() && plots.is_empty() {
-        0.0
-    } else {
-        (0.34 * w).max(14.0 * f)
-    };
-    let cells = cells(
-        Rect {
-            x: 0.0,
-            y: top,
-            w: (w - column).max(10.0),
-            h: h - top,
-        },
-        panels.len(),
-    );
-    // Each panel's name (several panels) in at most two lines over its world; every panel
-    // keeps the same room for it, so the worlds line up.
+    about
+}
+
+/// Draws each world panel in its cell of `body`, its name (several panels) in at most two
+/// lines above it; returns each panel's grid spacing (metres). Every panel keeps the same room
+/// for its name, so the worlds line up.
+fn draw_panels(
+    out: &mut Svg,
+    panels: &[panel::Panel<'_>],
+    options: &FigureOptions,
+    body: Rect,
+    pen: Pen,
+    steps: bool,
+) -> Vec<f64> {
+    let f = pen.font;
+    let cells = cells(body, panels.len());
     let titles: Vec<Vec<String>> = panels
         .iter()
         .zip(&cells)
         .map(|(panel, cell)| {
-            panel
-                .title
-                .map_or_else(Vec::new, |t| title_lines(t, f, cell.w - 6.0 * f))
+            panel.title.map_or_else(Vec::new, |t| {
+                title_lines(t, f, cell.w - PAGE.world_across * f)
+            })
         })
         .collect();
-    let title_room = titles.iter().map(Vec::len).max().unwrap_or(0) as f64 * 1.2 * f;
+    let title_room =
+        titles.iter().map(Vec::len).max().unwrap_or(0) as f64 * PAGE.panel_title_line * f;
+    let mut grids = Vec::with_capacity(panels.len());
     for (i, ((panel, cell), title)) in panels.iter().zip(cells).zip(&titles).enumerate() {
         // The world inside the cell, with room for the axes' ticks and titles.
         let area = Rect {
-            x: cell.x + 5.0 * f,
+            x: cell.x + PAGE.world_left * f,
             y: cell.y + title_room,
-            w: (cell.w - 6.0 * f).max(10.0),
-            h: (cell.h - title_room - 4.0 * f).max(10.0),
+            w: (cell.w - PAGE.world_across * f).max(PAGE.min_size),
+            h: (cell.h - title_room - PAGE.world_below * f).max(PAGE.min_size),
         };
         for (k, line) in title.iter().enumerate() {
-            let y = cell.y + 1.2 * f * (k as f64 + 1.0) - 0.4 * f;
+            let y =
+                cell.y + PAGE.panel_title_line * f * (k as f64 + 1.0) - PAGE.panel_title_raise * f;
             out.text([area.x, y], f, Anchor::Start, "#222", line);
         }
         let clip = if i == 0 {
@@ -259,65 +315,47 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
         } else {
             format!("world{i}")
         };
-        let grid = draw_world(
-            &mut out,
+        grids.push(draw_world(
+            out,
             &panel.items,
             options,
             (area, &clip),
             pen,
-            steps.len() > 1,
-        );
-        if panels.len() == 1 {
-            about.push(format!("grid {}", chart::length_label(grid)));
-        }
+            steps,
+        ));
     }
-    if panels.len() > 1 {
-        about.push("one panel per view, grid lines a scale bar apart".to_owned());
-    }
-    let log = scene
-        .items
-        .iter()
-        .any(|i| matches!(i.timing, Timing::Stamp(_)));
-    if log && options.steps == Steps::All {
-        about.push("the last message, every drawn one's outline faint".to_owned());
-    }
-    out.text(
-        [0.8 * f, 3.0 * f],
-        0.9 * f,
-        Anchor::Start,
-        "#444",
-        &about.join(" · "),
+    grids
+}
+
+/// Draws the right column `col`: the legend, then the plots below it (the legend takes at
+/// most half the column when there are plots).
+fn draw_column(out: &mut Svg, scene: &Scene, options: &FigureOptions, col: Rect, pen: Pen) {
+    let f = pen.font;
+    let max_legend = if scene.plots.is_empty() {
+        col.h
+    } else {
+        PAGE.legend_share * col.h
+    };
+    let used = chart::legend(
+        out,
+        Rect {
+            h: max_legend,
+            ..col
+        },
+        &scene.legend,
+        pen,
     );
-    if column > 0.0 {
-        let col = Rect {
-            x: w - column + 0.5 * f,
-            y: top,
-            w: column - 1.3 * f,
-            h: h - top - 0.8 * f,
-        };
-        let max_legend = if plots.is_empty() { col.h } else { 0.5 * col.h };
-        let used = chart::legend(
-            &mut out,
-            Rect {
-                h: max_legend,
-                ..col
-            },
-            &scene.legend,
-            pen,
-        );
-        draw_plots(
-            &mut out,
-            scene,
-            options,
-            Rect {
-                y: col.y + used + f,
-                h: col.h - used - f,
-                ..col
-            },
-            pen,
-        );
-    }
-    out.finish()
+    draw_plots(
+        out,
+        scene,
+        options,
+        Rect {
+            y: col.y + used + PAGE.legend_gap * f,
+            h: col.h - used - PAGE.legend_gap * f,
+            ..col
+        },
+        pen,
+    );
 }
 
 /// Draws the world panel; returns the grid spacing (metres).
@@ -423,7 +461,7 @@ fn draw_world(
 /// Draws the scene's plots stacked in `area` (as many as fit at a readable height).
 fn draw_plots(out: &mut Svg, scene: &Scene, options: &FigureOptions, area: Rect, pen: Pen) {
     let f = pen.font;
-    let fit = ((area.h / (10.5 * f)).floor() as usize).min(scene.plots.len());
+    let fit = ((area.h / (PAGE.plot_height * f)).floor() as usize).min(scene.plots.len());
     if fit == 0 {
         return;
     }
@@ -443,12 +481,8 @@ fn draw_plots(out: &mut Svg, scene: &Scene, options: &FigureOptions, area: Rect,
     };
     let height = area.h / fit as f64;
     for (i, plot) in scene.plots.iter().take(fit).enumerate() {
-        let prefix = format!("{}/{}", crate::scene::PLOTS, plot.id);
-        let series: Vec<&crate::scene::ScalarSeries> = scene
-            .series
-            .iter()
-            .filter(|s| s.path == prefix || s.path.starts_with(&format!("{prefix}/")))
-            .collect();
+        let series: Vec<&crate::scene::ScalarSeries> =
+            scene.series.iter().filter(|s| s.plot == plot.id).collect();
         let panel = PlotPanel {
             title: plot.label(),
             series,

@@ -21,13 +21,7 @@ pub(super) struct Panel<'a> {
 /// gets: never a figure without its world).
 pub(super) fn panels(scene: &Scene, steps: Steps) -> Vec<Panel<'_>> {
     let items = super::selected(scene, steps);
-    let in_view = |view: &crate::scene::View3d, path: &str| {
-        view.shows(path)
-            && !view.hidden.iter().any(|h| {
-                path.strip_prefix(h.as_str())
-                    .is_some_and(|rest| rest.is_empty() || rest.starts_with('/'))
-            })
-    };
+    let in_view = |view: &crate::scene::View3d, path: &str| view.draws(path);
     match scene.views.as_slice() {
         [] => vec![Panel { title: None, items }],
         [view] => vec![Panel {

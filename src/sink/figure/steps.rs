@@ -16,7 +16,7 @@ pub(super) fn selected(scene: &Scene, steps: Steps) -> Vec<&SceneItem> {
                 .states
                 .as_ref()
                 .and_then(|s| s.steps.last())
-                .map(|(_, k)| *k);
+                .map(|s| s.step);
             let drawn = drawn_steps(scene);
             let states = scene.states.as_ref();
             scene
@@ -123,15 +123,15 @@ mod tests {
     use crate::scene::{Color, LineStrips, States};
 
     fn line(path: &str, timing: Timing) -> SceneItem {
-        SceneItem {
-            path: path.to_owned(),
+        SceneItem::new(
+            path,
             timing,
-            kind: ItemKind::LineStrips(LineStrips {
+            ItemKind::LineStrips(LineStrips {
                 strips: vec![vec![[0.0; 3], [1.0, 0.0, 0.0]]],
                 color: Color::rgb(0, 0, 0),
                 radius: 0.01,
             }),
-        }
+        )
     }
 
     /// A graph: the chain at steps 0–3, the after view's states at 0 (no loop closures),
@@ -151,7 +151,9 @@ mod tests {
             .push(line("world/optimized/loop_closures", Timing::Static));
         scene.states = Some(States {
             path: "world/optimized".into(),
-            steps: vec![(0, 0), (2, 4), (6, 5)],
+            steps: [(0, 0), (2, 4), (6, 5)]
+                .map(|(closures, step)| crate::scene::State { closures, step })
+                .to_vec(),
         });
         scene
     }

@@ -176,10 +176,10 @@ pub fn run_pipeline(
         out: &mut Vec<(String, DMatrix<f64>)>,
     ) {
         for p in &e.points {
-            for (method, _, cov) in &p.estimates {
+            for estimate in &p.estimates {
                 out.push((
-                    format!("point {} ({method:?})", p.name),
-                    DMatrix::from_fn(3, 3, |i, j| cov[(i, j)]),
+                    format!("point {} ({:?})", p.name, estimate.method),
+                    DMatrix::from_fn(3, 3, |i, j| estimate.cov[(i, j)]),
                 ));
             }
         }
@@ -262,7 +262,7 @@ pub fn scene_nonfinite(scene: &Scene) -> Vec<(String, &'static str, f64)> {
     }
     for s in &scene.series {
         check(
-            &s.path,
+            &s.path(),
             "series",
             &mut s.points.iter().map(|p| p.1).chain([s.width]),
         );

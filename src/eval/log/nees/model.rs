@@ -6,6 +6,7 @@ use serde::Serialize;
 use crate::eval::consistency::Anees;
 use crate::interop::RosReading;
 use crate::lie::Se3;
+use crate::plan::log::Reference;
 
 /// The probability of the per-message bound whose share of messages is reported
 /// (`inside_95`).
@@ -66,13 +67,10 @@ impl std::str::FromStr for Align {
 /// What the NEES of a log needs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NeesSettings {
-    /// The reference as the user names it (`topic:/truth`, `tf:base_link`, `file:gt.txt`).
-    pub reference: String,
-    /// A topic of the log that is the reference itself (left out of the estimates).
-    pub reference_topic: Option<String>,
-    /// The reference's samples are `/tf` transforms: only estimate topics whose `frame_id` is
-    /// their parent are compared.
-    pub tf_parent_required: bool,
+    /// The reference: its topic is left out of the estimates; `/tf` samples compare only
+    /// estimate topics whose `frame_id` is their parent; shown as the user names it
+    /// (`topic:/truth`, `tf:base_link`, `file:gt.txt`).
+    pub reference: Reference,
     /// How each message's covariance is read.
     pub reading: RosReading,
     /// Alignment.
@@ -82,12 +80,10 @@ pub struct NeesSettings {
 }
 
 impl NeesSettings {
-    /// Defaults for a reference named `reference`: tf2's reading, no alignment.
-    pub fn new(reference: &str) -> Self {
+    /// Defaults for `reference`: tf2's reading, no alignment.
+    pub fn new(reference: Reference) -> Self {
         Self {
-            reference: reference.to_owned(),
-            reference_topic: None,
-            tf_parent_required: false,
+            reference,
             reading: RosReading::default(),
             align: Align::None,
             every: None,
@@ -146,8 +142,8 @@ pub struct Skipped {
 /// One topic's NEES against the reference.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TopicConsistency {
-    /// The reference as named.
-    pub reference: String,
+    /// The reference (shown as named).
+    pub reference: Reference,
     /// The ROS reading of the estimates' covariances.
     pub reading: RosReading,
     /// The alignment asked for.

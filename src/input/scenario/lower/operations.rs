@@ -15,6 +15,8 @@ use crate::propagate::first_order::CorrelatedPair;
 use crate::uncertain::{Side, UncertainPose};
 
 impl Lowering<'_> {
+    /// Lowers operation `op` (at `field`, e.g. `operation[2]`) by its kind: its operands
+    /// looked up in `t`, its values checked and located.
     pub(super) fn operation<G: SpecGroup<N>, const N: usize>(
         &self,
         t: &Table<G, N>,
@@ -44,44 +46,7 @@ impl Lowering<'_> {
                 },
             },
             "compose" | "between" | "compose_correlated" | "between_correlated" => {
-                let (lhs, rhs) = (pose(&op.lhs, "lhs")?, pose(&op.rhs, "rhs")?);
-                if let (Operand::Defined(a), Operand::Defined(b)) = (lhs, rhs)
-                    && a == b
-                    && op.cross_cov.is_none()
-                    && let Some(rhs_name) = &op.rhs
-                {
-                    let base = kind.trim_end_matches("_correlated");
-                    return Err(self.err(
-                        rhs_name.span(),
-                        &f("rhs"),
-                        format!(
-                            "`lhs` and `rhs` are the same uncertain pose `{}`: `{kind}` treats its two sides as independent, but they are one draw ({}); use two poses, or `{base}_correlated` with `cross_cov` equal to its covariance",
-                            rhs_name.get_ref(),
-                            if base == "between" {
-                                "X⁻¹·X is exactly the identity"
-                            } else {
-                                "X·X is not X·Y with Y drawn apart"
-                            }
-                        ),
-                    ));
-                }
-                let cross_cov = match &op.cross_cov {
-                    None => None,
-                    Some(c) => Some(self.cross_cov(t, field, lhs, rhs, c)?),
-                };
-                if kind.starts_with("compose") {
-                    Op::Compose {
-                        lhs,
-                        rhs,
-                        cross_cov,
-                    }
-                } else {
-                    Op::Between {
-                        lhs,
-                        rhs,
-                        cross_cov,
-                    }
-                }
+                self.binary(t, op, field, pose(&op.lhs, "lhs")?, pose(&op.rhs, "rhs")?)?
             }
             "odometry" => self.odometry(op, field, pose(&op.input, "input")?)?,
             "compound" => {
@@ -100,69 +65,8 @@ impl Lowering<'_> {
             "point_through_pose" => {
                 self.point_through_pose(op, field, pose(&op.input, "input")?)?
             }
-            "fuse" => {
-                let inputs = op.inputs.as_deref().unwrap_or(&[]);
-                if inputs.len() < 2 {
-                    return Err(self.err(
-                        op.kind.span(),
-                        &f("inputs"),
-                        format!("`fuse` needs at least 2 estimates, got {}", inputs.len()),
-                    ));
-                }
-                let inputs = inputs
-                    .iter()
-                    .enumerate()
-                    .map(|(i, name)| self.operand(t, name, &f(&format!("inputs[{i}]")), kind))
-                    .collect::<Result<_, _>>()?;
-                Op::Fuse { inputs }
-            }
-            "euler_vs_exp" => {
-                if G::KIND != GroupKind::So3 {
-                    return Err(self.err(
-                        op.kind.span(),
-                        &f("kind"),
-                        format!(
-                            "`euler_vs_exp` integrates a 3D body rate: it needs group = \"so3\", not {}",
-                            G::NAME
-                        ),
-                    ));
-                }
-                if let Some(input) = &op.input
-                    && !self
-                        .known(t, input, &f("input"))?
-                        .is_approx(&G::identity(), 1e-12)
-                {
-                    return Err(self.err(
-                        input.span(),
-                        &f("input"),
-                        "`euler_vs_exp` starts at the identity: give a start pose equal to it, or drop `input`",
-                    ));
-                }
-                let rate_spec = self.need(&op.rate, op, field, "rate")?;
-                let rate = rate_spec.get_ref();
-                if rate.len() != 3 || rate.iter().any(|v| !v.is_finite() || v.abs() > 1e6) {
-                    return Err(self.err(
-                        rate_spec.span(),
-                        &f("rate"),
-                        format!("needs 3 finite numbers (rad/s, |ω| ≤ 1e6), got {rate:?}"),
-                    ));
-                }
-                Op::EulerVsExp {
-                    rate: Vector3::new(rate[0], rate[1], rate[2]),
-                    dt: self.number(
-                        &op.dt,
-                        op,
-                        field,
-                        "dt",
-                        Bounds {
-                            low: 0.0,
-                            open_low: true,
-                            high: 1e3,
-                        },
-                    )?,
-                    steps: self.steps(op, field)?.unwrap_or(1),
-                }
-            }
+            "fuse" => self.fuse(t, op, field)?,
+            "euler_vs_exp" => self.euler_vs_exp(t, op, field)?,
             other => {
                 return Err(self.err(
                     op.kind.span(),
@@ -170,6 +74,135 @@ impl Lowering<'_> {
                     format!("`{other}` is not available for {} yet", G::NAME),
                 ));
             }
+        })
+    }
+
+    /// `compose`, `between` and their `_correlated` forms of `lhs` and `rhs`: one uncertain
+    /// pose on both sides is refused unless its correlation is given (`cross_cov`, checked).
+    fn binary<G: SpecGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        op: &OperationSpec,
+        field: &str,
+        lhs: Operand<G>,
+        rhs: Operand<G>,
+    ) -> Result<Op<G, N>, ScenarioError> {
+        let kind = op.kind.get_ref().as_str();
+        if let (Operand::Defined(a), Operand::Defined(b)) = (lhs, rhs)
+            && a == b
+            && op.cross_cov.is_none()
+            && let Some(rhs_name) = &op.rhs
+        {
+            let base = kind.trim_end_matches("_correlated");
+            return Err(self.err(
+                rhs_name.span(),
+                &format!("{field}.rhs"),
+                format!(
+                    "`lhs` and `rhs` are the same uncertain pose `{}`: `{kind}` treats its two sides as independent, but they are one draw ({}); use two poses, or `{base}_correlated` with `cross_cov` equal to its covariance",
+                    rhs_name.get_ref(),
+                    if base == "between" {
+                        "X⁻¹·X is exactly the identity"
+                    } else {
+                        "X·X is not X·Y with Y drawn apart"
+                    }
+                ),
+            ));
+        }
+        let cross_cov = match &op.cross_cov {
+            None => None,
+            Some(c) => Some(self.cross_cov(t, field, lhs, rhs, c)?),
+        };
+        Ok(if kind.starts_with("compose") {
+            Op::Compose {
+                lhs,
+                rhs,
+                cross_cov,
+            }
+        } else {
+            Op::Between {
+                lhs,
+                rhs,
+                cross_cov,
+            }
+        })
+    }
+
+    /// `fuse`: at least two estimates, each an operand.
+    fn fuse<G: SpecGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        op: &OperationSpec,
+        field: &str,
+    ) -> Result<Op<G, N>, ScenarioError> {
+        let kind = op.kind.get_ref().as_str();
+        let inputs = op.inputs.as_deref().unwrap_or(&[]);
+        if inputs.len() < 2 {
+            return Err(self.err(
+                op.kind.span(),
+                &format!("{field}.inputs"),
+                format!("`fuse` needs at least 2 estimates, got {}", inputs.len()),
+            ));
+        }
+        let inputs = inputs
+            .iter()
+            .enumerate()
+            .map(|(i, name)| self.operand(t, name, &format!("{field}.inputs[{i}]"), kind))
+            .collect::<Result<_, _>>()?;
+        Ok(Op::Fuse { inputs })
+    }
+
+    /// `euler_vs_exp`: SO(3) only, from the identity, a finite body rate, its `dt` and steps.
+    fn euler_vs_exp<G: SpecGroup<N>, const N: usize>(
+        &self,
+        t: &Table<G, N>,
+        op: &OperationSpec,
+        field: &str,
+    ) -> Result<Op<G, N>, ScenarioError> {
+        let f = |k: &str| format!("{field}.{k}");
+        if G::KIND != GroupKind::So3 {
+            return Err(self.err(
+                op.kind.span(),
+                &f("kind"),
+                format!(
+                    "`euler_vs_exp` integrates a 3D body rate: it needs group = \"so3\", not {}",
+                    G::NAME
+                ),
+            ));
+        }
+        if let Some(input) = &op.input
+            && !self
+                .known(t, input, &f("input"))?
+                .is_approx(&G::identity(), 1e-12)
+        {
+            return Err(self.err(
+                input.span(),
+                &f("input"),
+                "`euler_vs_exp` starts at the identity: give a start pose equal to it, or drop `input`",
+            ));
+        }
+        let rate_spec = self.need(&op.rate, op, field, "rate")?;
+        let rate = rate_spec.get_ref();
+        if rate.len() != 3 || rate.iter().any(|v| !v.is_finite() || v.abs() > 1e6) {
+            return Err(self.err(
+                rate_spec.span(),
+                &f("rate"),
+                format!("needs 3 finite numbers (rad/s, |ω| ≤ 1e6), got {rate:?}"),
+            ));
+        }
+        Ok(Op::EulerVsExp {
+            rate: Vector3::new(rate[0], rate[1], rate[2]),
+            dt: self.number(
+                &op.dt,
+                op,
+                field,
+                "dt",
+                Bounds {
+                    low: 0.0,
+                    open_low: true,
+                    high: 1e3,
+                },
+            )?,
+            steps: self.steps(op, field)?.unwrap_or(1),
         })
     }
 
