@@ -228,6 +228,21 @@ fn a_ros2_sqlite_bag_report_validates_with_its_format() {
 }
 
 #[test]
+fn an_ov_eval_trajectory_report_validates_with_its_format() {
+    let schema: Value = serde_json::from_str(SCHEMA).unwrap();
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ov_eval");
+    let overrides = Overrides {
+        reference: Some(format!("{data}/gt.txt")),
+        ..Default::default()
+    };
+    let text = report(&format!("{data}/estimate.txt"), &overrides, true).unwrap();
+    let value: Value = serde_json::from_str(&text).unwrap();
+    let found = dedup(problems(&schema, &value, "estimate"));
+    assert!(found.is_empty(), "{found:#?}");
+    assert_eq!(value["format"], "ov_eval");
+}
+
+#[test]
 fn a_log_report_with_a_reference_validates_and_documents_its_consistency_keys() {
     let schema: Value = serde_json::from_str(SCHEMA).unwrap();
     let dir = std::env::temp_dir().join(format!("posecov-schema-nees-{}", std::process::id()));

@@ -22,7 +22,8 @@ use super::settings::LogSettings;
 use crate::draw::log::{LogDrawSettings, description, draw_log, issue_sentence, issue_word};
 use crate::eval::log::{LogEvaluation, evaluate_log};
 use crate::input::log::{LogOptions, bundled, read_located_observed};
-use crate::input::{About, InputError, Located, Place};
+use crate::input::{About, Format, InputError, Located, Place};
+use crate::interop::RosReading;
 use crate::plan::log::LogObserver;
 use crate::plan::log::{Class, Issue, LogSummary};
 use crate::scene::{Origin, Scene, SceneError, Timing};
@@ -56,6 +57,15 @@ pub(super) fn run(
 ) -> Result<LogRun, AppError> {
     let (cancel, bar, drawn) = (options.cancel.as_deref(), options.progress, options.draw);
     let file = located.origin();
+    if located.format == Format::OvEval && settings.eval.reading != RosReading::Tf2 {
+        // Its blocks' frames are ov_eval's, stored in tf2's layout (CONVENTIONS §12).
+        return Err(AppError::Input(InputError::Format {
+            file,
+            message: "--ros-reading applies to ROS messages; an ov_eval trajectory says its \
+                      own frames (position in the global frame, rotation in the body)"
+                .to_owned(),
+        }));
+    }
     let mut reference = match &settings.reference {
         Some(r) => Some(nees::prepare(
             r,

@@ -61,7 +61,11 @@ pub fn expand(args: &[String]) -> Result<Inputs, AppError> {
     let extensions: Vec<&str> = Format::ALL
         .iter()
         .filter(|f| f.kind() == InputKind::Log)
-        .flat_map(|f| f.extensions().iter().copied())
+        // An extension another format owns (`.txt`, a graph's) is not a log's by name.
+        .flat_map(|f| {
+            let own = move |e: &&str| Format::from_extension(e) == Some(*f);
+            f.extensions().iter().copied().filter(own)
+        })
         .collect();
     let mut names = Vec::new();
     let mut directory = false;

@@ -94,7 +94,7 @@ pub const EXIT_CODES_HELP: &str = "\
 Exit codes (every command; `check` differs where shown):
   0    success (notes in a log are allowed); stdout closed by the reader (`… | head`): quiet
   1    check: defects found in a log (other commands show and report them, exit 0);
-       every command: a scenario or graph error located at file:line:column
+       every command: a scenario, graph or text trajectory error located at file:line:column
   2    cannot process: unreadable file, unknown format, no pose-with-covariance topic,
        a damaged log, a usage error
   130  interrupted (Ctrl-C)

@@ -10,6 +10,7 @@
 //! | ROS 2 bag in SQLite | `.db3` | starts with `SQLite format 3\0` |
 //! | ROS 2 bag directory | (a directory) | holds `metadata.yaml`; its `storage_identifier` says `sqlite3` (a ROS 2 SQLite bag) or `mcap` (MCAP) |
 //! | g2o / GTSAM / TORO pose graph | `.g2o`, `.txt`, `.graph` | text whose first token that is not a comment is `VERTEX_SE2`, `EDGE_SE2`, `VERTEX_SE3:QUAT`, `EDGE_SE3:QUAT`, `VERTEX2` or `EDGE2` |
+//! | ov_eval trajectory with covariance | `.txt` | text whose first line that is not a comment has 20 numbers, or 8 after ov_eval's header comment ([`ov_eval::recognise`](super::log::ov_eval::recognise)) |
 
 use std::io::Read as _;
 use std::path::Path;
@@ -33,6 +34,9 @@ pub enum Format {
     Ros2Sqlite,
     /// A g2o / GTSAM text pose graph ([`crate::input::graph`]).
     Graph,
+    /// An OpenVINS `ov_eval` text trajectory with covariance
+    /// ([`crate::input::log::ov_eval`]): read as a log of one topic.
+    OvEval,
 }
 
 /// What posecov does with an input: evaluate a typed plan, or stream a robot log. Decided
@@ -94,12 +98,13 @@ pub const SNIFF_BYTES: usize = 64 * 1024;
 
 impl Format {
     /// Every format, in the order `posecov list` shows them.
-    pub const ALL: [Format; 5] = [
+    pub const ALL: [Format; 6] = [
         Format::Scenario,
         Format::Graph,
         Format::Ros1Bag,
         Format::Mcap,
         Format::Ros2Sqlite,
+        Format::OvEval,
     ];
 
     /// The format in words.
@@ -115,6 +120,7 @@ impl Format {
             Format::Mcap => "MCAP file (ROS 2 bag)",
             Format::Ros2Sqlite => "ROS 2 bag in SQLite (.db3)",
             Format::Graph => "g2o / GTSAM pose graph",
+            Format::OvEval => "ov_eval trajectory with covariance",
         }
     }
 
@@ -128,7 +134,7 @@ impl Format {
     pub fn kind(self) -> InputKind {
         match self {
             Format::Scenario | Format::Graph => InputKind::Plan,
-            Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite => InputKind::Log,
+            Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite | Format::OvEval => InputKind::Log,
         }
     }
 
@@ -145,6 +151,7 @@ impl Format {
             Format::Mcap => "MCAP files (ROS 2 bags)",
             Format::Ros2Sqlite => "ROS 2 bags in SQLite (.db3)",
             Format::Graph => "g2o / GTSAM pose graphs",
+            Format::OvEval => "ov_eval trajectories with covariance",
         }
     }
 
@@ -161,10 +168,12 @@ impl Format {
             Format::Mcap => &["mcap"],
             Format::Ros2Sqlite => &["db3"],
             Format::Graph => &["g2o", "txt", "graph"],
+            Format::OvEval => &["txt"],
         }
     }
 
-    /// The format an extension stands for (case-insensitive), if any.
+    /// The format an extension stands for (case-insensitive), if any; `.txt`, which graphs
+    /// and ov_eval trajectories share, stands for a graph (content tells them apart).
     ///
     /// ```
     /// use posecov::input::Format;
@@ -188,6 +197,7 @@ impl Format {
     /// assert_eq!(Format::from_content(b"SQLite format 3\0..."), Some(Format::Ros2Sqlite));
     /// assert_eq!(Format::from_content(b"# a graph\nVERTEX_SE2 0 0 0 0\n"), Some(Format::Graph));
     /// assert_eq!(Format::from_content(b"# a scenario\n[scenario]\n"), Some(Format::Scenario));
+    /// assert_eq!(Format::from_content(b"1.5 0 0 0 0 0 0 1 1 0 0 1 0 1 1 0 0 1 0 1\n"), Some(Format::OvEval));
     /// assert_eq!(Format::from_content(b"\x00\x01binary"), None);
     /// ```
     pub fn from_content(head: &[u8]) -> Option<Format> {
@@ -204,6 +214,8 @@ impl Format {
         let token = line.split_whitespace().next().unwrap_or("");
         if GRAPH_TAGS.contains(&token) {
             Some(Format::Graph)
+        } else if super::log::ov_eval::recognise(head) {
+            Some(Format::OvEval)
         } else if line.starts_with('[') || line.contains('=') {
             Some(Format::Scenario)
         } else {
@@ -268,6 +280,7 @@ fn expected() -> String {
 /// let e = detect("a.bag", b"\x89MCAP0\r\n").unwrap_err().to_string();
 /// assert!(e.starts_with("a.bag: the extension .bag says ROS 1 bag, but its content is a MCAP file"), "{e}");
 /// assert_eq!(detect("run_0.db3", b"SQLite format 3\0...").unwrap(), Format::Ros2Sqlite);
+/// assert_eq!(detect("est.txt", b"1 0 0 0 0 0 0 1 1 0 0 1 0 1 1 0 0 1 0 1\n").unwrap(), Format::OvEval);
 /// let e = detect("notes.csv", b"1,2,3\n").unwrap_err().to_string();
 /// assert!(e.starts_with("notes.csv: not a file posecov reads"), "{e}");
 /// ```
@@ -287,6 +300,13 @@ pub fn detect(file: &str, head: &[u8]) -> Result<Format, InputError> {
     };
     match (by_extension, by_content) {
         (Some(e), Some(c)) if e == c => Ok(e),
+        // An extension two formats share (`.txt`): the content says which.
+        (Some(_), Some(c))
+            if c.extensions()
+                .contains(&extension.to_ascii_lowercase().as_str()) =>
+        {
+            Ok(c)
+        }
         (Some(e), Some(c)) => Err(error(format!(
             "the extension .{extension} says {}, but its content is a {} ({}); rename the file or check that it is the one you meant",
             e.name(),
@@ -325,6 +345,7 @@ fn what_identifies(format: Format) -> &'static str {
         Format::Ros2Sqlite => "SQLite's `SQLite format 3`",
         Format::Graph => "its first record is a g2o vertex or edge",
         Format::Scenario => "its first line is a TOML table or key",
+        Format::OvEval => "its first line has 20 numbers",
     }
 }
 

@@ -333,7 +333,7 @@ fn open_file_as(path: &Path, format: Format) -> Result<(Source, Input), InputErr
             let (g, input) = graph::read_file(path)?;
             Ok((Source::Graph(g), input))
         }
-        Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite => {
+        Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite | Format::OvEval => {
             Err(not_a_plan(&path.display().to_string(), format))
         }
     }
@@ -357,7 +357,9 @@ pub fn open_text(text: &str, origin: &str, format: Format) -> Result<(Source, In
             let (g, input) = graph::read_text(text, origin)?;
             Ok((Source::Graph(g), input))
         }
-        Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite => Err(not_a_plan(origin, format)),
+        Format::Ros1Bag | Format::Mcap | Format::Ros2Sqlite | Format::OvEval => {
+            Err(not_a_plan(origin, format))
+        }
     }
 }
 

@@ -56,6 +56,9 @@ pub enum PoseMessageKind {
     PoseWithCovarianceStamped,
     /// `geometry_msgs/PoseWithCovariance` (no header: stamps are the log time).
     PoseWithCovariance,
+    /// A line of an OpenVINS `ov_eval` text trajectory (`input::log::ov_eval`), read into
+    /// ROS's layout.
+    OvEval,
 }
 
 impl PoseMessageKind {
@@ -70,6 +73,7 @@ impl PoseMessageKind {
             PoseMessageKind::Odometry => "nav_msgs/Odometry",
             PoseMessageKind::PoseWithCovarianceStamped => "geometry_msgs/PoseWithCovarianceStamped",
             PoseMessageKind::PoseWithCovariance => "geometry_msgs/PoseWithCovariance",
+            PoseMessageKind::OvEval => "ov_eval trajectory line",
         }
     }
 
@@ -86,10 +90,11 @@ impl PoseMessageKind {
                 "geometry_msgs/msg/PoseWithCovarianceStamped"
             }
             PoseMessageKind::PoseWithCovariance => "geometry_msgs/msg/PoseWithCovariance",
+            PoseMessageKind::OvEval => "ov_eval trajectory line",
         }
     }
 
-    /// Every kind.
+    /// Every kind a ROS message is read as (not [`OvEval`](Self::OvEval), a text line).
     pub const ALL: [PoseMessageKind; 3] = [
         PoseMessageKind::Odometry,
         PoseMessageKind::PoseWithCovarianceStamped,

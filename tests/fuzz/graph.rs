@@ -80,7 +80,12 @@ impl Family for Graphs {
         let mut lines: Vec<String> = SEEDS[k].lines().map(str::to_owned).collect();
         let mut log = vec![format!("from seed {k}")];
         for _ in 0..[1, 1, 1, 2, 3][rng.random_range(0..5)] {
-            log.push(mutate_lines(&mut rng, &mut lines));
+            log.push(mutate_lines(
+                &mut rng,
+                &mut lines,
+                TOKENS,
+                "VERTEX_SE2 0 0 0 0",
+            ));
         }
         let mut bytes = (lines.join("\n") + "\n").into_bytes();
         if rng.random_bool(0.25) {
@@ -99,16 +104,23 @@ impl Family for Graphs {
     }
 }
 
-/// One mutation of a graph's lines: a token replaced, dropped or added, a line dropped,
-/// repeated or swapped, ids exchanged.
-fn mutate_lines(rng: &mut ChaCha8Rng, lines: &mut Vec<String>) -> String {
+/// One mutation of a text's lines (a graph's, a trajectory's): a token replaced by one of
+/// `replacements`, dropped or added, a line dropped or repeated, the third token (a graph
+/// edge's second id) changed; an empty text becomes `first`.
+pub fn mutate_lines(
+    rng: &mut ChaCha8Rng,
+    lines: &mut Vec<String>,
+    replacements: &[&str],
+    first: &str,
+) -> String {
     if lines.is_empty() {
-        lines.push("VERTEX_SE2 0 0 0 0".into());
+        lines.push(first.into());
         return "was empty".into();
     }
     let i = rng.random_range(0..lines.len());
     let mut tokens: Vec<String> = lines[i].split_whitespace().map(str::to_owned).collect();
-    let pick = |rng: &mut ChaCha8Rng| TOKENS[rng.random_range(0..TOKENS.len())].to_owned();
+    let pick =
+        |rng: &mut ChaCha8Rng| replacements[rng.random_range(0..replacements.len())].to_owned();
     let what = match rng.random_range(0..8) {
         0..=2 if !tokens.is_empty() => {
             let t = rng.random_range(0..tokens.len());
@@ -183,7 +195,7 @@ fn judge(text: &str, run: Run<Result<Output, String>>, limits: &Limits) -> Vec<F
         Err(ended) => return ended,
     };
     match result {
-        Err(e) => found.extend(located(text, &e)),
+        Err(e) => found.extend(located(ORIGIN, text, &e)),
         Ok(out) => {
             let optional = [
                 "step",
@@ -226,10 +238,11 @@ fn judge(text: &str, run: Run<Result<Output, String>>, limits: &Limits) -> Vec<F
     found
 }
 
-/// An error names the file, and where it gives `line:column`, a place inside the text.
-fn located(text: &str, e: &str) -> Vec<Finding> {
+/// An error names the file `origin`, and where it gives `line:column`, a place inside the
+/// text.
+pub fn located(origin: &str, text: &str, e: &str) -> Vec<Finding> {
     let first = e.lines().next().unwrap_or("");
-    let Some(rest) = first.strip_prefix(ORIGIN) else {
+    let Some(rest) = first.strip_prefix(origin) else {
         return vec![finding("error_unlocated", first)];
     };
     let mut parts = rest.strip_prefix(':').unwrap_or("").splitn(3, ':');

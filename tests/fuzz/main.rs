@@ -11,6 +11,7 @@
 //! | `ros1` | the bundled bz2 bag and a small uncompressed bag written here, mutated by byte (lengths and counts set to edge values) | read → evaluate → draw → validate → `report --json` |
 //! | `mcap` | the bundled MCAP, mutated by byte | the same |
 //! | `db3` | three ROS 2 SQLite bags of tests/data/ros2 (version 9, Humble's 5, zstd messages), mutated by byte | the same |
+//! | `ov_eval` | the OpenVINS text trajectories of tests/data/ov_eval (cut) and one mixing 8- and 20-column lines, mutated by token, line and byte | read as an estimate → evaluate → draw → validate → `report --json`; read as a NEES reference (the TUM reader) |
 //! | `live_api` | raw HTTP requests to the live page's server: methods, paths, `Host`, `Origin`, content types, edits of every control to edge values | a real server on loopback |
 //!
 //! # Invariants
@@ -32,7 +33,7 @@
 //!    the place inside the text, the field in the file's words and no Rust words
 //!    (`error_unlocated`, `error_bad_location`, `error_field_*`, `error_rust_speak`); a graph
 //!    error names the file (and a place inside it when it gives one); a log error names the
-//!    file. The live API answers every request, never with a 5xx (`server_error`).
+//!    file (an ov_eval trajectory's: a place inside the text). The live API answers every request, never with a 5xx (`server_error`).
 //!
 //! # Running
 //!
@@ -57,6 +58,7 @@ mod harness;
 mod live_api;
 mod logs;
 mod oracle;
+mod ov_eval;
 mod scenario;
 
 use harness::{Family, Summary, campaign, env_u64};
@@ -70,6 +72,7 @@ fn families() -> Vec<Box<dyn Family>> {
         Box::new(logs::Logs::new(logs::LogKind::Ros1)),
         Box::new(logs::Logs::new(logs::LogKind::Mcap)),
         Box::new(logs::Logs::new(logs::LogKind::Db3)),
+        Box::new(ov_eval::OvEval::new()),
     ];
     // The page server needs the viewer feature (axum, tokio).
     #[cfg(feature = "viewer")]
@@ -143,6 +146,14 @@ fn seeds_are_valid() {
     for seed in logs::DB3_SEEDS {
         let (found, _) = db3.check(seed, &limits);
         assert!(found.iter().all(|f| f.class == "ok"), "db3 seed: {found:?}");
+    }
+    let ov_eval = ov_eval::OvEval::new();
+    for seed in ov_eval.seeds() {
+        let (found, _) = ov_eval.check(seed.as_bytes(), &limits);
+        assert!(
+            found.iter().all(|f| f.class == "ok"),
+            "ov_eval seed: {found:?}"
+        );
     }
 }
 

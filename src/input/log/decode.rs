@@ -139,6 +139,7 @@ fn stamp(secs: i64, nsecs: u32) -> Option<i64> {
 /// assert!(e.to_string().starts_with("truncated: header.seq"), "{e}");
 /// ```
 pub fn decode_ros1(kind: PoseMessageKind, bytes: &[u8]) -> Result<PoseMessage, DecodeError> {
+    not_text(kind)?;
     let mut r = Ros1 { bytes, at: 0 };
     let (stamp_ns, frame_id) = match kind {
         PoseMessageKind::PoseWithCovariance => (None, String::new()),
@@ -168,6 +169,16 @@ pub fn decode_ros1(kind: PoseMessageKind, bytes: &[u8]) -> Result<PoseMessage, D
         covariance,
         twist_covariance,
     })
+}
+
+/// A text line's kind is no message's: never decoded from bytes.
+fn not_text(kind: PoseMessageKind) -> Result<(), DecodeError> {
+    match kind {
+        PoseMessageKind::OvEval => Err(DecodeError(
+            "an ov_eval text line is not a ROS message".to_owned(),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// A message whose position lies beyond ±[`MAX_COORDINATE`](crate::plan::limits::MAX_COORDINATE)
@@ -314,6 +325,7 @@ pub(super) fn header_stamp(t: Time) -> Option<i64> {
 /// assert!(decode_cdr(PoseMessageKind::Odometry, &bytes[..20]).is_err());
 /// ```
 pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<PoseMessage, DecodeError> {
+    not_text(kind)?;
     let what = kind.ros2_name();
     let (stamp_ns, frame_id, child_frame_id, pose, twist) = match kind {
         PoseMessageKind::Odometry => {
@@ -332,7 +344,7 @@ pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<PoseMessage, De
             let s = header_stamp(m.header.stamp);
             (s, m.header.frame_id, String::new(), m.pose, None)
         }
-        PoseMessageKind::PoseWithCovariance => {
+        PoseMessageKind::PoseWithCovariance | PoseMessageKind::OvEval => {
             let m: PoseWithCovariance = cdr(bytes, what)?;
             (None, String::new(), String::new(), m, None)
         }

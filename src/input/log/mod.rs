@@ -22,7 +22,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::plan::log::{
-    EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessageKind, ReferenceInLog,
+    EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessage, PoseMessageKind, ReferenceInLog,
     ReferenceRead, SkippedTopic,
 };
 
@@ -35,6 +35,7 @@ pub mod decode;
 pub mod health;
 mod mcap;
 mod mcap_records;
+pub mod ov_eval;
 pub mod reference;
 mod ros1;
 mod ros1_linear;
@@ -197,6 +198,7 @@ fn read_path(
         Format::Ros1Bag => ros1::read(path, &mut collector, progress)?,
         Format::Mcap => mcap::read(path, &mut collector, progress)?,
         Format::Ros2Sqlite => sqlite::read(path, None, &mut collector, progress)?,
+        Format::OvEval => ov_eval::read(path, &mut collector, progress)?,
         other => {
             return Err(InputError::Format {
                 file: origin.to_owned(),
@@ -450,6 +452,23 @@ impl<'a, 'o> Collector<'a, 'o> {
                 return;
             }
         };
+        let decode = |kind| match codec {
+            Codec::Ros1 => decode::decode_ros1(kind, bytes),
+            Codec::Cdr => decode::decode_cdr(kind, bytes),
+        };
+        self.message_decoded(topic, type_name, kind, log_time_ns, decode);
+    }
+
+    /// One message of a pose `kind` (type `type_name`) on `topic`, `decode`d once it is to be
+    /// read (a text line is decoded already: `ov_eval.rs`).
+    fn message_decoded(
+        &mut self,
+        topic: &str,
+        type_name: &str,
+        kind: PoseMessageKind,
+        log_time_ns: i64,
+        decode: impl FnOnce(PoseMessageKind) -> Result<PoseMessage, decode::DecodeError>,
+    ) {
         if !self.selected(topic) {
             self.not_selected.insert(topic.to_owned(), ());
             return;
@@ -466,10 +485,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             state.other_type(type_name, log_time_ns);
             return;
         }
-        let decoded = match codec {
-            Codec::Ros1 => decode::decode_ros1(state.kind, bytes),
-            Codec::Cdr => decode::decode_cdr(state.kind, bytes),
-        };
+        let decoded = decode(state.kind);
         let observer = self.observer.as_deref_mut();
         state.add(decoded, log_time_ns, |a, m| {
             if let Some(observer) = observer {
