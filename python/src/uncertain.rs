@@ -22,8 +22,10 @@ use crate::groups::{PyGroup, element};
 /// At most this many samples per call (8 × 10⁶ SE(3) samples are 1 GiB of matrices).
 const MAX_SAMPLES: usize = 10_000_000;
 
-/// One uncertain pose of any of the four groups.
+/// One uncertain pose of any of the four groups. It only lives inside a Python object (already
+/// one heap allocation of its own), so the SE(3) variant's size is not boxed away.
 #[derive(Clone, Copy, Debug)]
+#[allow(clippy::large_enum_variant)]
 enum Any {
     So2(Pose<So2, 1>),
     So3(Pose<So3, 3>),

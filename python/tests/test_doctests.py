@@ -7,18 +7,19 @@ import numpy as np
 import pytest
 
 import posecov
+import posecov.notebook
 from posecov import _posecov
 
-OBJECTS = [posecov] + [getattr(_posecov, n) for n in ("SO2", "SO3", "SE2", "SE3", "UncertainPose")]
+OBJECTS = [posecov, posecov.notebook] + [getattr(_posecov, n) for n in ("SO2", "SO3", "SE2", "SE3", "UncertainPose")]
 
 
 @pytest.mark.parametrize("obj", OBJECTS, ids=lambda o: getattr(o, "__name__", str(o)))
 def test_docstring_examples(obj):
     finder = doctest.DocTestFinder(exclude_empty=True)
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
-    globs = None if obj is posecov else {"posecov": posecov, "np": np}
+    globs = None if obj in (posecov, posecov.notebook) else {"posecov": posecov, "np": np}
     tests = finder.find(obj, getattr(obj, "__name__", "posecov"), globs=globs)
-    if obj is not posecov:
+    if isinstance(obj, type):
         # Methods of a native class: DocTestFinder does not descend into them.
         for name in dir(obj):
             member = getattr(obj, name)

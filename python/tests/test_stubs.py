@@ -42,3 +42,19 @@ def test_every_public_callable_has_a_docstring_with_an_example():
             assert ">>>" in (getattr(cls, m).__doc__ or ""), f"{name}.{m}"
     for f in (posecov.report, posecov.check, posecov.figure, posecov.figure_svg, posecov.examples, posecov.expand):
         assert ">>>" in f.__doc__, f.__name__
+
+
+def test_the_installed_wheel_is_tested(root):
+    """.ci/python-venv installs the wheel and runs these tests against it (it sets
+    POSECOV_TESTING_WHEEL), not against python/posecov: the package is imported from the
+    virtualenv's site-packages, with the native module inside it."""
+    import os
+
+    import pytest
+
+    if not os.environ.get("POSECOV_TESTING_WHEEL"):
+        pytest.skip("not run by .ci/python-venv (a `maturin develop` build may be under test)")
+    package = Path(posecov.__file__).resolve().parent
+    assert root / "python" not in package.parents
+    assert "site-packages" in package.parts
+    assert Path(_posecov.__file__).resolve().parent == package

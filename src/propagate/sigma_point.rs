@@ -284,8 +284,8 @@ impl<G: LieGroup<N>, const N: usize> JointInputs<G, N> {
         (tuples, wm, wc)
     }
 
-    /// The sigma points of [`JointInputs::map`]: 2L + 1 tuples of k inputs (the means first),
-    /// mean and covariance weights. Errors: bad parameters ([`Unscented::weights`]).
+    /// The sigma points of [`JointInputs::map`]: 2L + 1 tuples of k inputs, flattened (k
+    /// inputs per tuple, the means' tuple first), and their mean and covariance weights. Errors: bad parameters ([`Unscented::weights`]).
     /// ```
     /// use posecov::lie::{LieGroup, So2};
     /// use posecov::propagate::sigma_point::{JointInputs, Unscented};
