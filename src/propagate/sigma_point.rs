@@ -284,6 +284,21 @@ impl<G: LieGroup<N>, const N: usize> JointInputs<G, N> {
         (tuples, wm, wc)
     }
 
+    /// The sigma points of [`JointInputs::map`]: 2L + 1 tuples of k inputs, flattened (k
+    /// inputs per tuple, the means' tuple first), and their mean and covariance weights. Errors: bad parameters ([`Unscented::weights`]).
+    /// ```
+    /// use posecov::lie::{LieGroup, So2};
+    /// use posecov::propagate::sigma_point::{JointInputs, Unscented};
+    /// use posecov::uncertain::{Side, UncertainPose};
+    /// let a = [UncertainPose::try_from_std_devs(So2::identity(), [0.1], Side::Right).unwrap()];
+    /// let (x, wm, _) = JointInputs::independent(&a).unwrap().points(&Unscented::default()).unwrap();
+    /// assert!(x.len() == 3 && (x[1].angle() - 0.1).abs() < 1e-15 && wm[0] == 0.0);
+    /// ```
+    pub fn points(&self, params: &Unscented) -> Result<(Vec<G>, Vec<f64>, Vec<f64>)> {
+        let weights = params.weights(self.dim())?;
+        Ok(self.sigma_points(&weights))
+    }
+
     /// The unscented transform of Y = f(X₁, …, X_k) over these inputs
     /// ([module docs](self#algorithm)); the output group may differ from the inputs'. Method
     /// [`Method::SigmaPoints`], covariance on `params.side`.
