@@ -78,7 +78,7 @@ pub(super) fn run(
     }
     let title = match &located.place {
         Place::Bundled(e) => bundled::find(e.name).map_or(e.name, |l| l.title).to_owned(),
-        Place::File(_) => file.clone(),
+        Place::File(_) | Place::Live(_) => file.clone(),
     };
     let draw = LogDrawSettings {
         about: About {

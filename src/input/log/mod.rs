@@ -42,6 +42,7 @@ pub mod rosbag2;
 mod sqlite;
 mod tf;
 mod topic;
+pub mod ws;
 
 use reference::ReferenceType;
 use topic::{TopicState, no_pose_topic};
@@ -68,6 +69,9 @@ pub struct LogOptions {
     /// The reference in the log (`--reference`): its samples go to the observer of
     /// [`read_located_observed`], and what was seen of it to [`LogSummary::reference`].
     pub reference: Option<ReferenceInLog>,
+    /// A live stream's limits and recording (`--duration`, `--messages`, `--record`); refused
+    /// for a file.
+    pub live: ws::LiveOptions,
 }
 
 /// Reads a log file into a [`LogSummary`], its format by content and extension
@@ -145,37 +149,57 @@ pub fn read_located_observed(
     observer: Option<&mut dyn LogObserver>,
 ) -> Result<LogSummary, InputError> {
     let origin = located.origin();
-    let read = |path: &Path, progress: &mut dyn FnMut(u64, u64)| {
-        read_path(
-            path,
-            located.format,
-            &origin,
-            options,
-            progress,
-            cancel,
-            observer,
-        )
-    };
-    match &located.place {
-        Place::File(path) => read(path, progress),
-        Place::Bundled(example) => {
-            // The readers take a file: the bundled bytes go to a temporary one, named back
-            // to the bundled log in every message.
-            let log = bundled::find(example.name).ok_or_else(|| InputError::Read {
-                path: origin.clone(),
-                reason: "not a bundled robot log".to_owned(),
-            })?;
-            let tmp =
-                std::env::temp_dir().join(format!("posecov-{}-{}", std::process::id(), log.file));
-            std::fs::write(&tmp, log.bytes).map_err(|e| InputError::Read {
-                path: tmp.display().to_string(),
-                reason: e.to_string(),
-            })?;
-            let plan = read(&tmp, progress);
-            std::fs::remove_file(&tmp).ok();
-            plan.map_err(|e| e.renamed(&tmp.display().to_string(), &origin))
+    let example = match &located.place {
+        // A running robot: its topics until a limit, Ctrl-C or the stream's end.
+        Place::Live(url) => {
+            let mut collector = Collector::new(options, cancel, observer);
+            ws::read(url, &options.live, &mut collector, progress)?;
+            return summary(collector, ws::origin(url));
         }
-    }
+        Place::File(_) | Place::Bundled(_) if !options.live.is_empty() => {
+            let (flag, value) = options.live.first_flag().unwrap_or_default();
+            return Err(InputError::Format {
+                file: origin,
+                message: format!(
+                    "{flag} {value}: applies to a live stream (ws://HOST:PORT) only, not a log file"
+                ),
+            });
+        }
+        Place::File(path) => {
+            return read_path(
+                path,
+                located.format,
+                &origin,
+                options,
+                progress,
+                cancel,
+                observer,
+            );
+        }
+        Place::Bundled(example) => example,
+    };
+    // The readers take a file: the bundled bytes go to a temporary one, named back to the
+    // bundled log in every message.
+    let log = bundled::find(example.name).ok_or_else(|| InputError::Read {
+        path: origin.clone(),
+        reason: "not a bundled robot log".to_owned(),
+    })?;
+    let tmp = std::env::temp_dir().join(format!("posecov-{}-{}", std::process::id(), log.file));
+    std::fs::write(&tmp, log.bytes).map_err(|e| InputError::Read {
+        path: tmp.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    let plan = read_path(
+        &tmp,
+        located.format,
+        &origin,
+        options,
+        progress,
+        cancel,
+        observer,
+    );
+    std::fs::remove_file(&tmp).ok();
+    plan.map_err(|e| e.renamed(&tmp.display().to_string(), &origin))
 }
 
 /// Reads the log file at `path` in `format` (`origin` names it in errors).
@@ -204,6 +228,11 @@ fn read_path(
             });
         }
     }
+    summary(collector, path)
+}
+
+/// The collector's summary of the log at `path`; nothing to draw is an error.
+fn summary(collector: Collector<'_, '_>, path: &Path) -> Result<LogSummary, InputError> {
     let plan = collector.finish(path)?;
     // Nothing to draw is an error for every command (no empty recording), unless Ctrl-C
     // stopped the read before the first pose message.
