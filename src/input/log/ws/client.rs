@@ -192,6 +192,15 @@ pub enum Read {
     Closed(String),
 }
 
+/// Whether a read error only means "nothing yet": the read timeout passed, or a signal
+/// (Ctrl-C) interrupted the wait.
+fn waiting(e: &std::io::Error) -> bool {
+    matches!(
+        e.kind(),
+        ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
+    )
+}
+
 /// Reads one frame, waiting at most [`POLL`].
 pub fn read(socket: &mut WebSocket<TcpStream>) -> Result<Read, String> {
     use tungstenite::error::{CapacityError, Error};
@@ -201,9 +210,8 @@ pub fn read(socket: &mut WebSocket<TcpStream>) -> Result<Read, String> {
             _ => "closed by the server".to_owned(),
         })),
         Ok(message) => Ok(Read::Frame(message)),
-        Err(Error::Io(e)) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
-            Ok(Read::Idle)
-        }
+        // Nothing yet, or a signal (Ctrl-C) interrupted the wait: the caller looks again.
+        Err(Error::Io(e)) if waiting(&e) => Ok(Read::Idle),
         Err(Error::ConnectionClosed | Error::AlreadyClosed) => {
             Ok(Read::Closed("closed by the server".to_owned()))
         }
@@ -234,8 +242,7 @@ pub fn close(socket: &mut WebSocket<TcpStream>) {
     for _ in 0..10 {
         match socket.read() {
             Ok(_) => {}
-            Err(tungstenite::Error::Io(e))
-                if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+            Err(tungstenite::Error::Io(e)) if waiting(&e) => {}
             Err(_) => return,
         }
     }
