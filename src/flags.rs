@@ -94,9 +94,7 @@ pub(crate) fn parse_duration(text: &str) -> Result<std::time::Duration, String> 
         "m" | "min" => 60.0,
         "h" => 3600.0,
         other => {
-            return Err(format!(
-                "unit `{other}`: use ms, s, m or h (e.g. 30s, 2m)"
-            ));
+            return Err(format!("unit `{other}`: use ms, s, m or h (e.g. 30s, 2m)"));
         }
     };
     let value: f64 = number

@@ -493,7 +493,8 @@ fn try_main() -> anyhow::Result<ExitCode> {
             let name = &inputs.names[0];
             let report = if posecov::input::log::ws::is_live(name) {
                 let cancel = install_ctrl_c()?;
-                let report = commands::report_until(name, &scenario.overrides(), json, Arc::clone(&cancel));
+                let report =
+                    commands::report_until(name, &scenario.overrides(), json, Arc::clone(&cancel));
                 if report.is_ok() && cancel.load(Ordering::SeqCst) {
                     write_out(&report?)?;
                     return Ok(ExitCode::from(EXIT_INTERRUPTED));
@@ -532,12 +533,19 @@ fn try_main() -> anyhow::Result<ExitCode> {
             // and the exit code says it was interrupted.
             let (checked, interrupted) = if posecov::input::log::ws::is_live(name) {
                 let cancel = install_ctrl_c()?;
-                let checked =
-                    commands::check_until(name, &scenario.overrides(), &allow, Arc::clone(&cancel))?;
+                let checked = commands::check_until(
+                    name,
+                    &scenario.overrides(),
+                    &allow,
+                    Arc::clone(&cancel),
+                )?;
                 (checked, cancel.load(Ordering::SeqCst))
             } else {
                 (commands::check(name, &scenario.overrides(), &allow)?, false)
             };
+            for note in &checked.notes {
+                eprintln!("warning: {note}");
+            }
             for defect in &checked.defects {
                 eprintln!("{defect}");
             }

@@ -18,7 +18,13 @@ mod rrd;
 const BIN: &str = env!("CARGO_BIN_EXE_posecov");
 /// The peer's pose-with-covariance topics (all but its reference, `/ground_truth`): what
 /// posecov subscribes to without `--topic` or `--reference`.
-const POSE_TOPICS: [&str; 5] = ["/odometry/filtered", "/odom_nan", "/wheel/odom", "/amcl_pose", "/frozen"];
+const POSE_TOPICS: [&str; 5] = [
+    "/odometry/filtered",
+    "/odom_nan",
+    "/wheel/odom",
+    "/amcl_pose",
+    "/frozen",
+];
 
 /// The peer's python, or `None` (said) when the virtualenv is absent outside CI.
 fn peer_python() -> Option<PathBuf> {
@@ -96,7 +102,9 @@ impl Peer {
     /// its MCAP is then complete. Returns N.
     fn finish(mut self) -> (u64, PathBuf) {
         let mut line = String::new();
-        self.stdout.read_line(&mut line).expect("the peer's last line");
+        self.stdout
+            .read_line(&mut line)
+            .expect("the peer's last line");
         let sent: serde_json::Value =
             serde_json::from_str(&line).unwrap_or_else(|e| panic!("peer said {line:?}: {e}"));
         let deadline = Instant::now() + Duration::from_secs(60);
@@ -115,10 +123,7 @@ impl Drop for Peer {
 }
 
 fn posecov(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("run posecov")
+    Command::new(BIN).args(args).output().expect("run posecov")
 }
 
 fn text(o: &Output) -> String {
@@ -144,12 +149,25 @@ fn the_live_report_equals_the_report_of_the_same_messages_in_mcap() {
         let record = dir.join("run.mcap");
         let record_arg = record.display().to_string();
         let live = posecov(&[
-            "report", &url, "--messages", &n, "--duration", "60s", "--reference",
-            "/ground_truth", "--json", "--record", &record_arg,
+            "report",
+            &url,
+            "--messages",
+            &n,
+            "--duration",
+            "60s",
+            "--reference",
+            "/ground_truth",
+            "--json",
+            "--record",
+            &record_arg,
         ]);
         assert_eq!(live.status.code(), Some(0), "{server}: {}", text(&live));
         let (sent, mcap) = peer.finish();
-        assert_eq!(sent.to_string(), n, "{server}: the peer published what it announced");
+        assert_eq!(
+            sent.to_string(),
+            n,
+            "{server}: the peer published what it announced"
+        );
         let file = posecov(&[
             "report",
             &mcap.display().to_string(),
@@ -157,9 +175,18 @@ fn the_live_report_equals_the_report_of_the_same_messages_in_mcap() {
             "/ground_truth",
             "--json",
         ]);
-        let recorded = posecov(&["report", &record_arg, "--reference", "/ground_truth", "--json"]);
+        let recorded = posecov(&[
+            "report",
+            &record_arg,
+            "--reference",
+            "/ground_truth",
+            "--json",
+        ]);
         let (live, file, recorded) = (json(&live), json(&file), json(&recorded));
-        assert_eq!(live["meta"]["messages"], file["meta"]["messages"], "{server}");
+        assert_eq!(
+            live["meta"]["messages"], file["meta"]["messages"],
+            "{server}"
+        );
         assert_eq!(live["topics"].as_array().map(Vec::len), Some(5), "{server}");
         for (l, f) in live["topics"]
             .as_array()
@@ -167,13 +194,24 @@ fn the_live_report_equals_the_report_of_the_same_messages_in_mcap() {
             .iter()
             .zip(file["topics"].as_array().unwrap())
         {
-            assert_eq!(l, f, "{server}: topic {} live and in the peer's MCAP", l["name"]);
+            assert_eq!(
+                l, f,
+                "{server}: topic {} live and in the peer's MCAP",
+                l["name"]
+            );
         }
-        assert_eq!(live["topics"], recorded["topics"], "{server}: --record reads back the same");
+        assert_eq!(
+            live["topics"], recorded["topics"],
+            "{server}: --record reads back the same"
+        );
         assert_eq!(live["skipped"], file["skipped"], "{server}");
         // What the peer scripted, found live: each defect on its topic, NEES against the truth.
         let health = |topic: &str| -> Vec<String> {
-            let t = live["topics"].as_array().unwrap().iter().find(|t| t["name"] == topic);
+            let t = live["topics"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|t| t["name"] == topic);
             t.and_then(|t| t["health"].as_object())
                 .map(|h| h.keys().cloned().collect())
                 .unwrap_or_default()
@@ -183,7 +221,10 @@ fn the_live_report_equals_the_report_of_the_same_messages_in_mcap() {
         assert_eq!(health("/wheel/odom"), ["constant"]);
         assert_eq!(health("/amcl_pose"), ["not_psd"]);
         assert_eq!(health("/frozen"), ["frozen_stamp"]);
-        assert!(live["topics"][3]["consistency"]["anees"].is_number(), "{server}: NEES live");
+        assert!(
+            live["topics"][3]["consistency"]["anees"].is_number(),
+            "{server}: NEES live"
+        );
         std::fs::remove_dir_all(&dir).ok();
     }
 }
@@ -197,8 +238,16 @@ fn check_gates_on_non_finite_and_constant_and_allow_accepts_both() {
         let peer = Peer::start(&python, "sdk", &dir, &topics);
         let (url, n) = (peer.url(), peer.messages.to_string());
         let mut args = vec![
-            "check", &url, "--messages", &n, "--duration", "60s", "--topic", topics[0],
-            "--topic", topics[1],
+            "check",
+            &url,
+            "--messages",
+            &n,
+            "--duration",
+            "60s",
+            "--topic",
+            topics[0],
+            "--topic",
+            topics[1],
         ];
         if allow {
             args.extend(["--allow", "non_finite", "--allow", "constant"]);
@@ -207,11 +256,23 @@ fn check_gates_on_non_finite_and_constant_and_allow_accepts_both() {
         let said = text(&out);
         assert_eq!(out.status.code(), Some(code), "{said}");
         if allow {
-            assert!(said.contains(": ok (2 pose topic(s), 60 messages"), "{said}");
-            assert!(said.contains("defects allowed: non_finite, constant"), "{said}");
+            assert!(
+                said.contains(": ok (2 pose topic(s), 60 messages"),
+                "{said}"
+            );
+            assert!(
+                said.contains("defects allowed: non_finite, constant"),
+                "{said}"
+            );
         } else {
-            assert!(said.contains("topic /odom_nan, message 7") && said.contains("non_finite"), "{said}");
-            assert!(said.contains("topic /wheel/odom, message 0") && said.contains("constant"), "{said}");
+            assert!(
+                said.contains("topic /odom_nan, message 7") && said.contains("non_finite"),
+                "{said}"
+            );
+            assert!(
+                said.contains("topic /wheel/odom, message 0") && said.contains("constant"),
+                "{said}"
+            );
         }
         peer.finish();
     }
@@ -223,11 +284,21 @@ fn a_topic_that_never_appears_is_exit_2_with_did_you_mean() {
     let Some(python) = peer_python() else { return };
     let dir = scratch("never");
     let peer = Peer::start(&python, "sdk", &dir, &["/never"]);
-    let out = posecov(&["check", &peer.url(), "--duration", "1.5s", "--topic", "/odom_nann"]);
+    let out = posecov(&[
+        "check",
+        &peer.url(),
+        "--duration",
+        "1.5s",
+        "--topic",
+        "/odom_nann",
+    ]);
     let said = text(&out);
     assert_eq!(out.status.code(), Some(2), "{said}");
     assert!(said.contains(&format!("{}: ", peer.url())), "{said}");
-    assert!(said.contains("--topic /odom_nann: no such topic; did you mean `/odom_nan`?"), "{said}");
+    assert!(
+        said.contains("--topic /odom_nann: no such topic; did you mean `/odom_nan`?"),
+        "{said}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -238,55 +309,86 @@ fn a_live_recording_saved_as_rrd_verifies_and_se3_is_refused() {
     let peer = Peer::start(&python, "legacy", &dir, &POSE_TOPICS);
     let (url, n) = (peer.url(), peer.messages.to_string());
     let refused = posecov(&[
-        "report", &url, "--duration", "1s", "--reference", "/ground_truth", "--align", "se3",
+        "report",
+        &url,
+        "--duration",
+        "1s",
+        "--reference",
+        "/ground_truth",
+        "--align",
+        "se3",
     ]);
     let said = text(&refused);
     assert_eq!(refused.status.code(), Some(2), "{said}");
-    assert!(said.contains("--align se3 fits the reference to the whole run"), "{said}");
+    assert!(
+        said.contains("--align se3 fits the reference to the whole run"),
+        "{said}"
+    );
     let rrd = dir.join("live.rrd");
     let out = posecov(&[&url, "--messages", &n, "--save", &rrd.display().to_string()]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
-    assert!(std::fs::metadata(&rrd).is_ok_and(|m| m.len() > 0));
-    match rrd::rerun_cli() {
-        None => eprintln!("SKIPPED rrd verify: no rerun CLI (set $POSECOV_RERUN_CLI)"),
-        Some(cli) => {
-            let verify = Command::new(cli)
-                .args(["rrd", "verify"])
-                .arg(&rrd)
-                .output()
-                .expect("run rerun-cli");
-            assert!(verify.status.success(), "{}", text(&verify));
-        }
-    }
+    verify_rrd(&rrd);
     peer.finish();
     std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
-fn ctrl_c_ends_a_live_check_with_130_and_a_complete_recording() {
+fn ctrl_c_ends_a_live_view_with_130_a_verified_rrd_and_a_complete_mcap() {
     let Some(python) = peer_python() else { return };
     let dir = scratch("ctrl-c");
     let mut peer = Peer::start(&python, "sdk", &dir, &POSE_TOPICS);
-    let record = dir.join("cut.mcap");
+    let (record, rrd) = (dir.join("cut.mcap"), dir.join("cut.rrd"));
     let child = Command::new(BIN)
-        .args(["check", &peer.url(), "--duration", "120s", "--record"])
+        .args([&peer.url(), "--duration", "120s", "--record"])
         .arg(&record)
+        .arg("--save")
+        .arg(&rrd)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .expect("run posecov");
-    // Once the peer has published everything, the run holds its messages (or is about to).
+    // Ctrl-C once the peer has published everything (what the run holds then does not
+    // matter: the claim is a clean end).
     let mut line = String::new();
-    peer.stdout.read_line(&mut line).expect("the peer's last line");
+    peer.stdout
+        .read_line(&mut line)
+        .expect("the peer's last line");
     let pid = child.id().to_string();
-    let kill = Command::new("kill").args(["-INT", &pid]).status().expect("kill");
+    let kill = Command::new("kill")
+        .args(["-INT", &pid])
+        .status()
+        .expect("kill");
     assert!(kill.success());
     let out = child.wait_with_output().expect("wait");
     assert_eq!(out.status.code(), Some(130), "{}", text(&out));
-    let back = posecov(&["report", &record.display().to_string(), "--json"]);
-    assert_eq!(back.status.code(), Some(0), "the recording is complete: {}", text(&back));
-    assert!(json(&back)["meta"]["messages"].as_u64().unwrap_or(0) > 0);
+    let bytes = std::fs::read(&record).expect("the MCAP");
+    let summary = mcap::Summary::read(&bytes).expect("a readable MCAP");
+    assert!(
+        summary.is_some_and(|s| s.channels.len() == 6),
+        "a complete MCAP: its summary and every channel"
+    );
+    verify_rrd(&rrd);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `rerun rrd verify` passes on `rrd` (said and skipped without the rerun CLI).
+fn verify_rrd(rrd: &Path) {
+    assert!(
+        std::fs::metadata(rrd).is_ok_and(|m| m.len() > 0),
+        "{}",
+        rrd.display()
+    );
+    match rrd::rerun_cli() {
+        None => eprintln!("SKIPPED rrd verify: no rerun CLI (set $POSECOV_RERUN_CLI)"),
+        Some(cli) => {
+            let verify = Command::new(cli)
+                .args(["rrd", "verify"])
+                .arg(rrd)
+                .output()
+                .expect("run rerun-cli");
+            assert!(verify.status.success(), "{}", text(&verify));
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -299,7 +401,10 @@ fn refused_with(url: &str, words: &str) {
     assert_eq!(out.status.code(), Some(2), "{said}");
     assert!(said.contains(&format!("error: {url}: ")), "{said}");
     assert!(said.contains(words), "{said}");
-    assert!(started.elapsed() < Duration::from_secs(20), "no hang: {said}");
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "no hang: {said}"
+    );
 }
 
 /// A port nothing listens on (bound, then closed).
@@ -322,7 +427,10 @@ fn one_shot(serve: impl FnOnce(std::net::TcpStream) + Send + 'static) -> u16 {
 
 #[test]
 fn a_closed_port_is_connection_refused() {
-    refused_with(&format!("ws://127.0.0.1:{}", closed_port()), "connection refused");
+    refused_with(
+        &format!("ws://127.0.0.1:{}", closed_port()),
+        "connection refused",
+    );
 }
 
 #[test]
@@ -342,9 +450,8 @@ fn http_without_upgrade_is_named() {
     let port = one_shot(|mut stream| {
         let mut buf = [0u8; 4096];
         let _ = stream.read(&mut buf);
-        let _ = stream.write_all(
-            b"HTTP/1.1 200 OK\r\nContent-Length: 2\r\nConnection: close\r\n\r\nhi",
-        );
+        let _ = stream
+            .write_all(b"HTTP/1.1 200 OK\r\nContent-Length: 2\r\nConnection: close\r\n\r\nhi");
     });
     refused_with(
         &format!("ws://127.0.0.1:{port}"),
@@ -374,7 +481,10 @@ fn a_subprotocol_posecov_does_not_speak_is_named() {
 
 #[test]
 fn a_name_that_does_not_resolve_and_wss_are_said() {
-    refused_with("ws://no-such-host.invalid:8765", "the host does not resolve");
+    refused_with(
+        "ws://no-such-host.invalid:8765",
+        "the host does not resolve",
+    );
     refused_with("wss://127.0.0.1:8765", "wss:// (TLS) is not read");
 }
 
@@ -383,5 +493,186 @@ fn live_flags_on_a_log_file_are_refused() {
     let out = posecov(&["check", "covariance_health", "--messages", "5"]);
     let said = text(&out);
     assert_eq!(out.status.code(), Some(2), "{said}");
-    assert!(said.contains("--messages 5: applies to a live stream (ws://HOST:PORT) only"), "{said}");
+    assert!(
+        said.contains("--messages 5: applies to a live stream (ws://HOST:PORT) only"),
+        "{said}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------
+// A scripted server (tungstenite, `foxglove.websocket.v1`) for what no real server sends:
+// damaged frames, an oversize frame, a connection dropped.
+
+type Ws = tungstenite::WebSocket<std::net::TcpStream>;
+
+/// Serves `sessions` connections in turn on 127.0.0.1: each advertises `/pose` (ROS 2
+/// PoseWithCovarianceStamped, `cdr`), waits for the client's `subscribe` and runs
+/// `script(ws, subscription id, session)`. The listener closes as the last session starts (a
+/// client connecting again is then refused). Returns the port.
+fn scripted(sessions: u32, script: impl Fn(&mut Ws, u32, u32) + Send + 'static) -> u16 {
+    use tungstenite::handshake::server::{Request, Response};
+    let listener = TcpListener::bind("127.0.0.1:0").expect("bind");
+    let port = listener.local_addr().expect("addr").port();
+    std::thread::spawn(move || {
+        let mut listener = Some(listener);
+        for session in 0..sessions {
+            let Some(Ok((stream, _))) = listener.as_ref().map(TcpListener::accept) else {
+                return;
+            };
+            if session + 1 == sessions {
+                listener = None;
+            }
+            let answer = |_: &Request, mut response: Response| {
+                let v = "foxglove.websocket.v1".parse().expect("header");
+                response.headers_mut().insert("Sec-WebSocket-Protocol", v);
+                Ok(response)
+            };
+            let Ok(mut ws) = tungstenite::accept_hdr(stream, answer) else {
+                return;
+            };
+            let advertise = r#"{"op":"advertise","channels":[{"id":1,"topic":"/pose","encoding":"cdr","schemaName":"geometry_msgs/msg/PoseWithCovarianceStamped","schema":"","schemaEncoding":"ros2msg"}]}"#;
+            ws.send(tungstenite::Message::text(advertise))
+                .expect("advertise");
+            let subscription = loop {
+                match ws.read() {
+                    Ok(tungstenite::Message::Text(t)) if t.contains("\"subscribe\"") => {
+                        let v: serde_json::Value = serde_json::from_str(&t).expect("json");
+                        break v["subscriptions"][0]["id"].as_u64().expect("id") as u32;
+                    }
+                    Ok(_) => {}
+                    Err(_) => return,
+                }
+            };
+            script(&mut ws, subscription, session);
+        }
+    });
+    port
+}
+
+/// A message-data frame of message `i` on `subscription`: a PoseWithCovarianceStamped in
+/// CDR (written here, field by field), driving 0.1 m a message with σ growing.
+fn pose_frame(subscription: u32, i: u32) -> tungstenite::Message {
+    let mut frame = vec![1u8];
+    frame.extend(subscription.to_le_bytes());
+    frame.extend((u64::from(i) * 100_000_000).to_le_bytes());
+    frame.extend([0, 1, 0, 0]); // CDR, little endian
+    frame.extend((100 + i as i32).to_le_bytes());
+    frame.extend(0u32.to_le_bytes());
+    frame.extend(4u32.to_le_bytes());
+    frame.extend(b"map\0");
+    let s = 0.01 * f64::from(1 + i);
+    let mut covariance = [0.0; 36];
+    for (axis, v) in [s, s, 1e-6, 1e-4, 1e-4, s].into_iter().enumerate() {
+        covariance[7 * axis] = v;
+    }
+    let pose = [0.1 * f64::from(i), 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    for v in pose.iter().chain(&covariance) {
+        frame.extend(v.to_le_bytes());
+    }
+    tungstenite::Message::binary(frame)
+}
+
+/// Reads until the client goes (its unsubscribe and close), so that nothing is cut short.
+fn until_gone(ws: &mut Ws) {
+    while ws.read().is_ok() {}
+}
+
+#[test]
+fn damaged_frames_are_skipped_and_said_and_the_run_goes_on() {
+    let port = scripted(1, |ws, sub, _| {
+        use tungstenite::Message;
+        ws.send(Message::text("{\"op\":")).expect("send");
+        ws.send(Message::text(r#"{"op":"advertise"}"#))
+            .expect("send");
+        let mut unknown = vec![1u8];
+        unknown.extend((sub + 40).to_le_bytes());
+        unknown.extend([0; 8]);
+        ws.send(Message::binary(unknown)).expect("send");
+        ws.send(Message::binary(vec![1u8, 2, 3])).expect("send");
+        for i in 0..10 {
+            ws.send(pose_frame(sub, i)).expect("send");
+        }
+        until_gone(ws);
+    });
+    let url = format!("ws://127.0.0.1:{port}");
+    let out = posecov(&["check", &url, "--messages", "10", "--duration", "20s"]);
+    let said = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{said}");
+    assert!(
+        said.contains(": ok (1 pose topic(s), 10 messages"),
+        "{said}"
+    );
+    let warning = format!("warning: {url}: skipped 4 damaged frame(s), the run went on: ");
+    assert!(said.contains(&warning), "{said}");
+    for words in [
+        "a text frame: malformed JSON",
+        "a text frame: `advertise` without its \"channels\" field",
+        "which posecov never made",
+        "a truncated message-data frame (3 bytes",
+    ] {
+        assert!(said.contains(words), "{words}: {said}");
+    }
+}
+
+#[test]
+fn an_oversize_frame_ends_the_read_naming_the_bound() {
+    let port = scripted(1, |ws, _, _| {
+        // A binary frame header stating 17 MiB (the payload never comes).
+        let mut header = vec![0x82u8, 127];
+        header.extend((17u64 << 20).to_be_bytes());
+        let _ = ws.get_mut().write_all(&header);
+        until_gone(ws);
+    });
+    let url = format!("ws://127.0.0.1:{port}");
+    refused_with(
+        &url,
+        "a frame of 17825792 bytes, beyond the 16 MiB posecov accepts",
+    );
+}
+
+#[test]
+fn a_lost_connection_is_made_again_and_said() {
+    // Two connections of 5 messages each, the first dropped without a close.
+    let port = scripted(2, |ws, sub, session| {
+        for i in 5 * session..5 * session + 5 {
+            ws.send(pose_frame(sub, i)).expect("send");
+        }
+        if session == 1 {
+            until_gone(ws);
+        }
+    });
+    let url = format!("ws://127.0.0.1:{port}");
+    let out = posecov(&["check", &url, "--messages", "10", "--duration", "30s"]);
+    let said = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{said}");
+    assert!(
+        said.contains(": ok (1 pose topic(s), 10 messages"),
+        "{said}"
+    );
+    assert!(
+        said.contains(&format!(
+            "warning: {url}: the connection was lost 1 time(s) and made again"
+        )),
+        "{said}"
+    );
+}
+
+#[test]
+fn a_stream_that_ends_early_is_exit_2_with_the_reason() {
+    let port = scripted(1, |ws, sub, _| {
+        for i in 0..5 {
+            ws.send(pose_frame(sub, i)).expect("send");
+        }
+        let _ = ws.close(None);
+        let _ = ws.flush();
+    });
+    let url = format!("ws://127.0.0.1:{port}");
+    let out = posecov(&["check", &url, "--messages", "10", "--duration", "30s"]);
+    let said = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{said}");
+    assert!(said.contains(&format!("error: {url}: ")) && said.contains("the stream ended early: closed by the server; connecting again failed 4 time(s) (last: connection refused"), "{said}");
+    assert!(
+        said.contains("5 message(s), before --messages 10"),
+        "{said}"
+    );
 }

@@ -288,5 +288,6 @@ pub(super) fn check_as(
     Ok(Checked {
         line,
         defects: Vec::new(),
+        notes: Vec::new(),
     })
 }

@@ -26,7 +26,7 @@ use crate::eval::log::{LogEvaluation, evaluate_log};
 use crate::input::log::{LogOptions, bundled, read_located_observed};
 use crate::input::{About, InputError, Located, Place};
 use crate::plan::log::LogObserver;
-use crate::plan::log::{Class, Issue, LogSummary};
+use crate::plan::log::{Class, Issue, LogSummary, StreamNotes};
 use crate::scene::{Scene, SceneError, Timing};
 
 /// A read, evaluated and drawn log.
@@ -327,6 +327,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
             "messages": plan.messages_total,
             "cancelled": plan.cancelled,
             "cut_short": plan.cut,
+            "stream": plan.stream,
         },
         "topics": topics,
         "frames": frames::frames_json(&plan.tf, &run.evaluation),
@@ -459,7 +460,16 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
             }
         )
     };
-    Checked { line, defects }
+    let notes = plan
+        .stream
+        .as_ref()
+        .map(StreamNotes::sentences)
+        .unwrap_or_default();
+    Checked {
+        line,
+        defects,
+        notes,
+    }
 }
 
 #[cfg(test)]

@@ -104,7 +104,9 @@ pub fn connect(url: &WsUrl) -> Result<Connection, String> {
     })?;
     let io = |e: std::io::Error| format!("cannot set up the connection ({e})");
     stream.set_read_timeout(Some(CONNECT_TIMEOUT)).map_err(io)?;
-    stream.set_write_timeout(Some(CONNECT_TIMEOUT)).map_err(io)?;
+    stream
+        .set_write_timeout(Some(CONNECT_TIMEOUT))
+        .map_err(io)?;
     stream.set_nodelay(true).map_err(io)?;
     let mut request = url
         .url
@@ -145,10 +147,7 @@ pub fn connect(url: &WsUrl) -> Result<Connection, String> {
             SUBPROTOCOLS.join(" and ")
         ));
     }
-    socket
-        .get_ref()
-        .set_read_timeout(Some(POLL))
-        .map_err(io)?;
+    socket.get_ref().set_read_timeout(Some(POLL)).map_err(io)?;
     Ok(Connection {
         socket,
         subprotocol,
@@ -201,7 +200,8 @@ fn waiting(e: &std::io::Error) -> bool {
     )
 }
 
-/// Reads one frame, waiting at most [`POLL`].
+/// Reads one frame, waiting at most [`POLL`]. A frame beyond [`MAX_FRAME`] is an error (the
+/// stream is refused); a broken connection or framing is [`Read::Closed`] (connected again).
 pub fn read(socket: &mut WebSocket<TcpStream>) -> Result<Read, String> {
     use tungstenite::error::{CapacityError, Error};
     match socket.read() {
@@ -223,7 +223,8 @@ pub fn read(socket: &mut WebSocket<TcpStream>) -> Result<Read, String> {
             MAX_FRAME >> 20
         )),
         Err(Error::Io(e)) => Ok(Read::Closed(format!("the connection was lost ({e})"))),
-        Err(e) => Err(format!("a damaged WebSocket frame ({e})")),
+        // The framing itself is broken: this connection cannot be read on.
+        Err(e) => Ok(Read::Closed(format!("a damaged WebSocket frame ({e})"))),
     }
 }
 

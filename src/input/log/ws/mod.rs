@@ -13,8 +13,12 @@
 //! The read subscribes to the channels posecov reads (the pose-with-covariance topics chosen,
 //! the reference, `/tf` and `/tf_static`), declares every other advertised channel (listed as
 //! skipped, as a file's), and ends after [`LiveOptions::duration`], after
-//! [`LiveOptions::messages`], on Ctrl-C (the run keeps what arrived), or when the server closes
-//! (an error when a limit was asked for and not reached). It unsubscribes and closes on exit.
+//! [`LiveOptions::messages`], on Ctrl-C (the run keeps what arrived), or when the server is
+//! gone: a lost connection is made again after a bounded back-off ([`RECONNECT_BACKOFF`]);
+//! when that fails, an error if a limit was asked for and not reached. A frame posecov cannot
+//! read (malformed JSON, a truncated frame, an unknown subscription) is skipped and noted
+//! ([`StreamNotes`]); a frame beyond [`client::MAX_FRAME`] ends the read with an error. It
+//! unsubscribes and closes on exit.
 //! No async runtime: one thread reads frames as they come (the server, not posecov, holds back
 //! what a slow reader has not taken, so nothing queues here without bound).
 //!
@@ -37,8 +41,12 @@ pub mod client;
 pub mod protocol;
 mod record;
 
+use crate::plan::log::StreamNotes;
 use client::Read;
 use protocol::{Channel, ServerMessage};
+
+/// The connection's socket.
+type Socket = tungstenite::WebSocket<std::net::TcpStream>;
 
 /// How long a live read goes on and what it keeps (`--duration`, `--messages`, `--record`):
 /// the flags of a live stream only.
@@ -137,20 +145,30 @@ fn wanted(collector: &Collector<'_, '_>, stream: &Stream) -> bool {
     pose || tf || collector.is_reference(&stream.topic)
 }
 
+/// The waits before each attempt to connect again after the connection was lost: bounded
+/// (under 4 s in all), and cut short by a limit or Ctrl-C.
+pub const RECONNECT_BACKOFF: [Duration; 4] = [
+    Duration::from_millis(250),
+    Duration::from_millis(500),
+    Duration::from_secs(1),
+    Duration::from_secs(2),
+];
+
 /// Reads the stream at `url` into `collector` until a limit of `live`, Ctrl-C or the end of
-/// the stream. `progress(done, total)`: messages or milliseconds.
+/// the stream; a lost connection is made again (after [`RECONNECT_BACKOFF`]). Returns what
+/// the stream did besides carrying messages. `progress(done, total)`: messages or ms.
 pub(super) fn read(
     url: &str,
     live: &LiveOptions,
     collector: &mut Collector<'_, '_>,
     progress: &mut dyn FnMut(u64, u64),
-) -> Result<(), InputError> {
+) -> Result<StreamNotes, InputError> {
     let fail = |reason: String| InputError::Read {
         path: url.to_owned(),
         reason,
     };
     let parsed = client::parse_url(url).map_err(fail)?;
-    let mut recorder = match &live.record {
+    let recorder = match &live.record {
         Some(path) => Some(record::Recorder::create(path).map_err(fail)?),
         None => None,
     };
@@ -160,54 +178,82 @@ pub(super) fn read(
         subscriptions: BTreeMap::new(),
         next_subscription: 1,
         received: 0,
-        recorder: recorder.take(),
+        recorder,
+        notes: StreamNotes::new(url),
+        start: Instant::now(),
     };
-    let outcome = session.run(&mut connection.socket, live, collector, progress);
-    // Unsubscribe and close whatever happened; a complete recording either way.
-    let ids: Vec<u32> = session.subscriptions.keys().copied().collect();
-    if !ids.is_empty() {
-        let _ = client::send(&mut connection.socket, protocol::unsubscribe(&ids));
-    }
-    client::close(&mut connection.socket);
+    let outcome = loop {
+        let end = session.run(&mut connection.socket, live, collector, progress);
+        session.leave(&mut connection.socket);
+        match end {
+            Ok(None) => break Ok(()),
+            Err(e) => break Err(e),
+            Ok(Some(why)) => match session.reconnect(&parsed, live, collector) {
+                Again::Connected(next) => {
+                    session
+                        .notes
+                        .lost(why, session.start.elapsed().as_secs_f64());
+                    connection = next;
+                }
+                Again::Stopped => break Ok(()),
+                Again::Failed(last) => break session.ended(live, &why, &last),
+            },
+        }
+    };
+    // A complete recording whatever happened.
     let finished = session.recorder.take().map(record::Recorder::finish);
     outcome.map_err(fail)?;
     if let Some(Err(e)) = finished {
         return Err(fail(e));
     }
-    Ok(())
+    Ok(session.notes)
 }
 
-/// One connection's state.
+/// What trying to connect again gave.
+enum Again {
+    Connected(client::Connection),
+    /// A limit or Ctrl-C came first: the run ends as asked.
+    Stopped,
+    /// Every attempt failed: the last reason.
+    Failed(String),
+}
+
+/// One stream's state, across its connections.
 struct Session {
     channels: BTreeMap<u64, Live>,
-    /// Subscription id → channel id.
+    /// Subscription id → channel id (this connection's).
     subscriptions: BTreeMap<u32, u64>,
+    /// Ids below it were made by posecov (a frame for one no longer held is skipped quietly).
     next_subscription: u32,
     received: u64,
     recorder: Option<record::Recorder>,
+    notes: StreamNotes,
+    start: Instant,
 }
 
 impl Session {
+    /// Whether a limit of `live` is reached.
+    fn done(&self, live: &LiveOptions) -> bool {
+        live.duration.is_some_and(|d| self.start.elapsed() >= d)
+            || live.messages.is_some_and(|n| self.received >= n)
+    }
+
+    /// Reads frames until a limit or Ctrl-C (`Ok(None)`) or until the connection is lost
+    /// (`Ok(Some(why))`); a frame posecov cannot read is noted and skipped.
     fn run(
         &mut self,
-        socket: &mut tungstenite::WebSocket<std::net::TcpStream>,
+        socket: &mut Socket,
         live: &LiveOptions,
         collector: &mut Collector<'_, '_>,
         progress: &mut dyn FnMut(u64, u64),
-    ) -> Result<(), String> {
-        let start = Instant::now();
+    ) -> Result<Option<String>, String> {
         let mut last_progress = Instant::now();
         loop {
-            if collector.stop() {
-                return Ok(());
-            }
-            let elapsed = start.elapsed();
-            if live.duration.is_some_and(|d| elapsed >= d)
-                || live.messages.is_some_and(|n| self.received >= n)
-            {
-                return Ok(());
+            if collector.stop() || self.done(live) {
+                return Ok(None);
             }
             if last_progress.elapsed() >= Duration::from_millis(200) {
+                let elapsed = self.start.elapsed();
                 match (live.messages, live.duration) {
                     (Some(n), _) => progress(self.received, n),
                     (None, Some(d)) => progress(elapsed.as_millis() as u64, d.as_millis() as u64),
@@ -217,40 +263,86 @@ impl Session {
             }
             let frame = match client::read(socket)? {
                 Read::Idle => continue,
-                Read::Closed(why) => return self.ended(live, start.elapsed(), &why),
+                Read::Closed(why) => return Ok(Some(why)),
                 Read::Frame(frame) => frame,
             };
             match frame {
-                tungstenite::Message::Text(text) => {
-                    let message = protocol::parse_text(text.as_str())
-                        .map_err(|e| format!("a text frame from the server: {e}"))?;
-                    self.server_message(socket, message, collector)?;
-                }
-                tungstenite::Message::Binary(bytes) => {
-                    self.binary(&bytes, collector)?;
-                }
+                tungstenite::Message::Text(text) => match protocol::parse_text(text.as_str()) {
+                    Ok(message) => self.server_message(socket, message, collector)?,
+                    Err(e) => self.notes.damaged(format!("a text frame: {e}")),
+                },
+                tungstenite::Message::Binary(bytes) => self.binary(&bytes, collector)?,
                 _ => {}
             }
         }
     }
 
-    /// The server closed the stream: fine without a limit, an error before one.
-    fn ended(&self, live: &LiveOptions, after: Duration, why: &str) -> Result<(), String> {
+    /// Unsubscribes and closes the connection (whatever state it is in).
+    fn leave(&mut self, socket: &mut Socket) {
+        let ids: Vec<u32> = self.subscriptions.keys().copied().collect();
+        if !ids.is_empty() {
+            let _ = client::send(socket, protocol::unsubscribe(&ids));
+        }
+        client::close(socket);
+    }
+
+    /// Connects again after a loss, waiting [`RECONNECT_BACKOFF`] before each attempt; the
+    /// new connection's channels are advertised afresh (the recording keeps its channels).
+    fn reconnect(
+        &mut self,
+        url: &client::WsUrl,
+        live: &LiveOptions,
+        collector: &mut Collector<'_, '_>,
+    ) -> Again {
+        let mut last = String::new();
+        for wait in RECONNECT_BACKOFF {
+            let until = Instant::now() + wait;
+            while Instant::now() < until {
+                if collector.stop() || self.done(live) {
+                    return Again::Stopped;
+                }
+                std::thread::sleep(client::POLL.min(until - Instant::now()));
+            }
+            match client::connect(url) {
+                Ok(connection) => {
+                    self.channels.clear();
+                    self.subscriptions.clear();
+                    if let Some(recorder) = &mut self.recorder {
+                        recorder.reconnected();
+                    }
+                    return Again::Connected(connection);
+                }
+                Err(e) => last = e,
+            }
+        }
+        Again::Failed(last)
+    }
+
+    /// The connection lost for good (`why`; connecting again failed with `last`): an error
+    /// when a limit was asked for and not reached, else the end of the run, noted.
+    fn ended(&mut self, live: &LiveOptions, why: &str, last: &str) -> Result<(), String> {
+        let again = format!(
+            "{why}; connecting again failed {} time(s) (last: {last})",
+            RECONNECT_BACKOFF.len()
+        );
         let asked = match (live.duration, live.messages) {
             (_, Some(n)) => format!("--messages {n}"),
             (Some(d), None) => format!("--duration {}s", d.as_secs_f64()),
-            (None, None) => return Ok(()),
+            (None, None) => {
+                self.notes.ended = Some(again);
+                return Ok(());
+            }
         };
         Err(format!(
-            "the stream ended early: {why} after {:.1} s and {} message(s), before {asked}",
-            after.as_secs_f64(),
+            "the stream ended early: {again}; after {:.1} s and {} message(s), before {asked}",
+            self.start.elapsed().as_secs_f64(),
             self.received
         ))
     }
 
     fn server_message(
         &mut self,
-        socket: &mut tungstenite::WebSocket<std::net::TcpStream>,
+        socket: &mut Socket,
         message: ServerMessage,
         collector: &mut Collector<'_, '_>,
     ) -> Result<(), String> {
@@ -305,17 +397,31 @@ impl Session {
     }
 
     /// A binary frame: a message on a subscription goes to the collector (and the recording);
-    /// a frame for a subscription no longer held (one in flight when a channel went) is skipped.
+    /// a frame for a subscription no longer held (one in flight when a channel went) is
+    /// skipped; a damaged one, or one for a subscription posecov never made, is noted.
     fn binary(&mut self, frame: &[u8], collector: &mut Collector<'_, '_>) -> Result<(), String> {
-        let Some(data) = protocol::parse_binary(frame)? else {
+        let data = match protocol::parse_binary(frame) {
+            Ok(Some(data)) => data,
+            Ok(None) => return Ok(()),
+            Err(e) => {
+                self.notes.damaged(e);
+                return Ok(());
+            }
+        };
+        let Some(live) = self
+            .subscriptions
+            .get(&data.subscription)
+            .and_then(|channel| self.channels.get(channel).map(|live| (*channel, live)))
+        else {
+            if data.subscription == 0 || data.subscription >= self.next_subscription {
+                self.notes.damaged(format!(
+                    "a message-data frame for subscription {}, which posecov never made",
+                    data.subscription
+                ));
+            }
             return Ok(());
         };
-        let Some(&channel) = self.subscriptions.get(&data.subscription) else {
-            return Ok(());
-        };
-        let Some(live) = self.channels.get(&channel) else {
-            return Ok(());
-        };
+        let (channel, live) = live;
         self.received += 1;
         if let Some(recorder) = &mut self.recorder {
             recorder.message(channel, data.log_time_ns, data.payload)?;

@@ -196,8 +196,14 @@ mod tests {
         for (text, start) in [
             (r#"{"op":1}"#, "a JSON message without"),
             (r#"{"op":"advertise"}"#, "`advertise` without"),
-            (r#"{"op":"advertise","channels":[{"id":-1}]}"#, "`advertise` with a malformed"),
-            (r#"{"op":"unadvertise","channelIds":["x"]}"#, "`unadvertise` with malformed"),
+            (
+                r#"{"op":"advertise","channels":[{"id":-1}]}"#,
+                "`advertise` with a malformed",
+            ),
+            (
+                r#"{"op":"unadvertise","channelIds":["x"]}"#,
+                "`unadvertise` with malformed",
+            ),
             ("[]", "a JSON message without"),
         ] {
             let e = parse_text(text).unwrap_err();

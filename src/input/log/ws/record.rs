@@ -1,6 +1,8 @@
 //! `--record run.mcap`: every message received on the subscribed channels written as it
 //! arrives, each channel with its schema, encoding and the server's log time, so that the
-//! file reads back (`posecov report run.mcap`) as the live run read it.
+//! file reads back (`posecov report run.mcap`) as the live run read it. A channel advertised
+//! again after a lost connection (a new id, the same topic, encoding and schema) is the same
+//! channel of the file.
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -9,11 +11,16 @@ use std::path::{Path, PathBuf};
 
 use super::protocol::Channel;
 
+/// A channel as the file knows it: topic, message encoding, schema name.
+type ChannelKey = (String, String, String);
+
 /// An MCAP file being written.
 pub(super) struct Recorder {
     path: PathBuf,
     writer: mcap::Writer<BufWriter<File>>,
-    /// The server's channel id → the file's channel id.
+    /// Every channel written → the file's channel id.
+    written: BTreeMap<ChannelKey, u16>,
+    /// This connection's channel ids → the file's channel id.
     channels: BTreeMap<u64, u16>,
     sequence: u32,
 }
@@ -21,14 +28,13 @@ pub(super) struct Recorder {
 impl Recorder {
     /// Creates the file.
     pub(super) fn create(path: &Path) -> Result<Self, String> {
-        let file = File::create(path)
-            .map_err(|e| format!("--record {}: cannot create it ({e})", path.display()))?;
-        let writer = mcap::Writer::new(BufWriter::new(file)).map_err(|e| {
-            format!("--record {}: cannot write it ({e})", path.display())
-        })?;
+        let fail = |e: String| format!("--record {}: cannot create it ({e})", path.display());
+        let file = File::create(path).map_err(|e| fail(e.to_string()))?;
+        let writer = mcap::Writer::new(BufWriter::new(file)).map_err(|e| fail(e.to_string()))?;
         Ok(Self {
             path: path.to_owned(),
             writer,
+            written: BTreeMap::new(),
             channels: BTreeMap::new(),
             sequence: 0,
         })
@@ -38,18 +44,30 @@ impl Recorder {
         format!("--record {}: cannot write it ({e})", self.path.display())
     }
 
+    /// The connection was made again: the server's channel ids start afresh.
+    pub(super) fn reconnected(&mut self) {
+        self.channels.clear();
+    }
+
     /// A channel the server advertises, written once.
     pub(super) fn channel(&mut self, channel: &Channel) -> Result<(), String> {
-        if self.channels.contains_key(&channel.id) {
+        let key = (
+            channel.topic.clone(),
+            channel.encoding.clone(),
+            channel.schema_name.clone(),
+        );
+        if let Some(&id) = self.written.get(&key) {
+            self.channels.insert(channel.id, id);
             return Ok(());
         }
-        let encoding = channel
-            .schema_encoding
-            .clone()
-            .unwrap_or_else(|| match channel.encoding.as_str() {
-                "ros1" => "ros1msg".to_owned(),
-                _ => "ros2msg".to_owned(),
-            });
+        let encoding =
+            channel
+                .schema_encoding
+                .clone()
+                .unwrap_or_else(|| match channel.encoding.as_str() {
+                    "ros1" => "ros1msg".to_owned(),
+                    _ => "ros2msg".to_owned(),
+                });
         let schema = self
             .writer
             .add_schema(&channel.schema_name, &encoding, channel.schema.as_bytes())
@@ -58,6 +76,7 @@ impl Recorder {
             .writer
             .add_channel(schema, &channel.topic, &channel.encoding, &BTreeMap::new())
             .map_err(|e| self.fail(&e))?;
+        self.written.insert(key, id);
         self.channels.insert(channel.id, id);
         Ok(())
     }
