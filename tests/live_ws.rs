@@ -461,15 +461,8 @@ fn http_without_upgrade_is_named() {
 
 #[test]
 fn a_subprotocol_posecov_does_not_speak_is_named() {
-    use tungstenite::handshake::server::{Request, Response};
     let port = one_shot(|stream| {
-        let answer = |_: &Request, mut response: Response| {
-            response
-                .headers_mut()
-                .insert("Sec-WebSocket-Protocol", "rosbridge.v2".parse().unwrap());
-            Ok(response)
-        };
-        if let Ok(mut ws) = tungstenite::accept_hdr(stream, answer) {
+        if let Some(mut ws) = accept_as(stream, "rosbridge.v2") {
             let _ = ws.read();
         }
     });
@@ -505,12 +498,23 @@ fn live_flags_on_a_log_file_are_refused() {
 
 type Ws = tungstenite::WebSocket<std::net::TcpStream>;
 
+/// Accepts a WebSocket handshake on `stream`, the server choosing `subprotocol`.
+#[allow(clippy::result_large_err)] // tungstenite's callback type: its error is an HTTP response
+fn accept_as(stream: std::net::TcpStream, subprotocol: &'static str) -> Option<Ws> {
+    use tungstenite::handshake::server::{ErrorResponse, Request, Response};
+    let answer = move |_: &Request, mut response: Response| -> Result<Response, ErrorResponse> {
+        let v = subprotocol.parse().expect("header");
+        response.headers_mut().insert("Sec-WebSocket-Protocol", v);
+        Ok(response)
+    };
+    tungstenite::accept_hdr(stream, answer).ok()
+}
+
 /// Serves `sessions` connections in turn on 127.0.0.1: each advertises `/pose` (ROS 2
 /// PoseWithCovarianceStamped, `cdr`), waits for the client's `subscribe` and runs
 /// `script(ws, subscription id, session)`. The listener closes as the last session starts (a
 /// client connecting again is then refused). Returns the port.
 fn scripted(sessions: u32, script: impl Fn(&mut Ws, u32, u32) + Send + 'static) -> u16 {
-    use tungstenite::handshake::server::{Request, Response};
     let listener = TcpListener::bind("127.0.0.1:0").expect("bind");
     let port = listener.local_addr().expect("addr").port();
     std::thread::spawn(move || {
@@ -522,12 +526,7 @@ fn scripted(sessions: u32, script: impl Fn(&mut Ws, u32, u32) + Send + 'static) 
             if session + 1 == sessions {
                 listener = None;
             }
-            let answer = |_: &Request, mut response: Response| {
-                let v = "foxglove.websocket.v1".parse().expect("header");
-                response.headers_mut().insert("Sec-WebSocket-Protocol", v);
-                Ok(response)
-            };
-            let Ok(mut ws) = tungstenite::accept_hdr(stream, answer) else {
+            let Some(mut ws) = accept_as(stream, "foxglove.websocket.v1") else {
                 return;
             };
             let advertise = r#"{"op":"advertise","channels":[{"id":1,"topic":"/pose","encoding":"cdr","schemaName":"geometry_msgs/msg/PoseWithCovarianceStamped","schema":"","schemaEncoding":"ros2msg"}]}"#;

@@ -91,7 +91,11 @@ pub(super) fn run(
     };
     let summary = description(
         &plan,
-        located.format.name(),
+        match &located.place {
+            // Its channels are MCAP channels, but it is no file.
+            Place::Live(_) => "Live stream (Foxglove WebSocket)",
+            _ => located.format.name(),
+        },
         &evaluation,
         settings.confidence,
     );

@@ -193,7 +193,7 @@ pub(super) fn read(
                     session
                         .notes
                         .lost(why, session.start.elapsed().as_secs_f64());
-                    connection = next;
+                    connection = *next;
                 }
                 Again::Stopped => break Ok(()),
                 Again::Failed(last) => break session.ended(live, &why, &last),
@@ -211,7 +211,7 @@ pub(super) fn read(
 
 /// What trying to connect again gave.
 enum Again {
-    Connected(client::Connection),
+    Connected(Box<client::Connection>),
     /// A limit or Ctrl-C came first: the run ends as asked.
     Stopped,
     /// Every attempt failed: the last reason.
@@ -310,7 +310,7 @@ impl Session {
                     if let Some(recorder) = &mut self.recorder {
                         recorder.reconnected();
                     }
-                    return Again::Connected(connection);
+                    return Again::Connected(Box::new(connection));
                 }
                 Err(e) => last = e,
             }
