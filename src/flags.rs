@@ -1,6 +1,6 @@
 //! The binary's flag values: the words clap accepts for `--graph-reading` and `--optimizer`
 //! (matched exhaustively onto the library's types) and the parsers of `--joint`,
-//! `--confidence` and `--size`. Part of the `posecov` binary, not of the library.
+//! `--confidence`, `--size` and `--duration`. Part of the `posecov` binary, not of the library.
 
 use clap::ValueEnum;
 use posecov::eval::graph::{GraphReading, Optimizer};
@@ -79,4 +79,31 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
             "{s:?} is not WIDTHxHEIGHT with sides in 16..=8192, e.g. 1024x640"
         )),
     }
+}
+
+/// `--duration`: `30s`, `2m`, `1h`, `500ms`, or plain seconds (`30`, `0.5`), more than zero.
+pub(crate) fn parse_duration(text: &str) -> Result<std::time::Duration, String> {
+    let t = text.trim();
+    let (number, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
+        Some(i) => t.split_at(i),
+        None => (t, "s"),
+    };
+    let scale = match unit {
+        "ms" => 1e-3,
+        "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        other => {
+            return Err(format!("unit `{other}`: use ms, s, m or h (e.g. 30s, 2m)"));
+        }
+    };
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a duration (e.g. 30s, 2m, 500ms)"))?;
+    let seconds = value * scale;
+    if !(seconds.is_finite() && seconds > 0.0 && seconds < 1e9) {
+        return Err(format!("`{text}`: give a duration above zero"));
+    }
+    Ok(std::time::Duration::from_secs_f64(seconds))
 }

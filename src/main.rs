@@ -22,7 +22,9 @@ use posecov::interop::RosReading;
 use posecov::sink::Sink;
 
 mod flags;
-use flags::{GraphReadingArg, OptimizerArg, parse_joint, parse_probability, parse_size};
+use flags::{
+    GraphReadingArg, OptimizerArg, parse_duration, parse_joint, parse_probability, parse_size,
+};
 
 /// See robot pose uncertainty: Lie-group poses with covariances, propagated and drawn in Rerun.
 ///
@@ -198,6 +200,17 @@ struct ScenarioArgs {
     /// positions, no scale).
     #[arg(long, value_name = "none|first|se3")]
     align: Option<posecov::eval::log::nees::Align>,
+    /// A running robot (ws://HOST:PORT): stop reading after this long, e.g. `30s`, `2m`
+    /// (default: until --messages, Ctrl-C or the server closes).
+    #[arg(long, value_name = "TIME", value_parser = parse_duration)]
+    duration: Option<std::time::Duration>,
+    /// A running robot (ws://HOST:PORT): stop after this many messages on the subscribed topics.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    messages: Option<u64>,
+    /// A running robot (ws://HOST:PORT): write every message received on the subscribed topics
+    /// to this MCAP file (`posecov report FILE.mcap` reads it back as the live run read it).
+    #[arg(long, value_name = "FILE.mcap")]
+    record: Option<PathBuf>,
 }
 
 /// How to evaluate: values that override the file's.
@@ -248,6 +261,7 @@ impl EvalArgs {
             graph_reading: self.graph_reading.map(GraphReadingArg::reading),
             optimizer: self.optimizer.map(OptimizerArg::optimizer),
             joints: self.joints.clone(),
+            live: Default::default(),
         }
     }
 }
@@ -324,6 +338,11 @@ impl ScenarioArgs {
             ros_reading: self.ros_reading,
             reference: self.reference.clone(),
             align: self.align,
+            live: posecov::input::log::ws::LiveOptions {
+                duration: self.duration,
+                messages: self.messages,
+                record: self.record.clone(),
+            },
             ..self.settings.overrides()
         }
     }
@@ -471,7 +490,20 @@ fn try_main() -> anyhow::Result<ExitCode> {
                 });
                 return Ok(ExitCode::from(code));
             }
-            match commands::report(&inputs.names[0], &scenario.overrides(), json) {
+            let name = &inputs.names[0];
+            let report = if posecov::input::log::ws::is_live(name) {
+                let cancel = install_ctrl_c()?;
+                let report =
+                    commands::report_until(name, &scenario.overrides(), json, Arc::clone(&cancel));
+                if report.is_ok() && cancel.load(Ordering::SeqCst) {
+                    write_out(&report?)?;
+                    return Ok(ExitCode::from(EXIT_INTERRUPTED));
+                }
+                report
+            } else {
+                commands::report(name, &scenario.overrides(), json)
+            };
+            match report {
                 Ok(text) => emit(&text),
                 Err(err) => {
                     // Scripts reading `--json` get the error as JSON too; people get stderr.
@@ -496,13 +528,34 @@ fn try_main() -> anyhow::Result<ExitCode> {
                 });
                 return Ok(ExitCode::from(code));
             }
-            let checked = commands::check(&inputs.names[0], &scenario.overrides(), &allow)?;
+            let name = &inputs.names[0];
+            // A running robot is read until a limit or Ctrl-C: then checked on what arrived,
+            // and the exit code says it was interrupted.
+            let (checked, interrupted) = if posecov::input::log::ws::is_live(name) {
+                let cancel = install_ctrl_c()?;
+                let checked = commands::check_until(
+                    name,
+                    &scenario.overrides(),
+                    &allow,
+                    Arc::clone(&cancel),
+                )?;
+                (checked, cancel.load(Ordering::SeqCst))
+            } else {
+                (commands::check(name, &scenario.overrides(), &allow)?, false)
+            };
+            for note in &checked.notes {
+                eprintln!("warning: {note}");
+            }
             for defect in &checked.defects {
                 eprintln!("{defect}");
             }
             let read = write_out(&(checked.line.clone() + "\n"))?;
             // A reader that closed stdout (`… | head`) ends the run quietly with 0.
-            Ok(ExitCode::from(if read { checked.exit_code() } else { 0 }))
+            Ok(ExitCode::from(match (read, interrupted) {
+                (_, true) => EXIT_INTERRUPTED,
+                (true, false) => checked.exit_code(),
+                (false, false) => 0,
+            }))
         }
         Some(Command::Figure(args)) => {
             let options = posecov::sink::figure::FigureOptions {

@@ -87,6 +87,9 @@ fn skipped(words: &[String]) -> Option<&'static str> {
     if first == Some("live") {
         return Some("live mode serves a page and opens a viewer");
     }
+    if words.iter().any(|w| w.starts_with("ws://")) {
+        return Some("reads a running robot (tests/live_ws.rs runs these against a real server)");
+    }
     if words.iter().any(|w| w == "--reference") {
         return Some("the reference is the user's (tests/nees.rs runs NEES)");
     }

@@ -11,6 +11,9 @@ pub struct Checked {
     pub line: String,
     /// One line per topic with a defect not `--allow`ed.
     pub defects: Vec<String>,
+    /// Lines for stderr that are not defects: what a live stream did besides carrying
+    /// messages (damaged frames skipped, connections lost), each naming its URL.
+    pub notes: Vec<String>,
 }
 
 impl Checked {

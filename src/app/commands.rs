@@ -1,6 +1,8 @@
 //! The commands that print: `list`, `report`, `check`.
 
 use std::fmt::Write as _;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 pub use super::checked::Checked;
 use super::run::{Opened, PlanRun, Run, RunOptions, open};
@@ -71,7 +73,30 @@ pub fn report(scenario: &str, overrides: &Overrides, json: bool) -> Result<Strin
     } else {
         ReportStyle::Text
     };
-    report_as(scenario, overrides, style, true)
+    report_as(scenario, overrides, style, true, None)
+}
+
+/// [`report`] of a run that `cancel` (Ctrl-C) may stop: a live stream's (`ws://…`), whose
+/// report is of what arrived before it.
+///
+/// ```
+/// use std::sync::{Arc, atomic::AtomicBool};
+/// let cancel = Arc::new(AtomicBool::new(false));
+/// let text = posecov::app::commands::report_until("covariance_health", &Default::default(), true, cancel).unwrap();
+/// assert!(text.contains("\"topics\""));
+/// ```
+pub fn report_until(
+    scenario: &str,
+    overrides: &Overrides,
+    json: bool,
+    cancel: Arc<AtomicBool>,
+) -> Result<String, AppError> {
+    let style = if json {
+        ReportStyle::Json
+    } else {
+        ReportStyle::Text
+    };
+    report_as(scenario, overrides, style, true, Some(cancel))
 }
 
 /// [`report`] in a [`ReportStyle`]; `bar`: a log's reading shows its progress bar.
@@ -80,6 +105,7 @@ pub(super) fn report_as(
     overrides: &Overrides,
     style: ReportStyle,
     bar: bool,
+    cancel: Option<Arc<AtomicBool>>,
 ) -> Result<String, AppError> {
     let printed = |value: serde_json::Value| match style {
         ReportStyle::JsonLine => value.to_string() + "\n",
@@ -87,6 +113,7 @@ pub(super) fn report_as(
     };
     let options = RunOptions {
         progress: bar,
+        cancel,
         ..RunOptions::numbers()
     };
     let run = match Run::start(open(scenario)?, overrides, options)? {
@@ -187,7 +214,25 @@ pub fn allowed(names: &[String]) -> Result<Vec<Issue>, AppError> {
 /// assert_eq!(log.exit_code(), 1);
 /// ```
 pub fn check(scenario: &str, overrides: &Overrides, allow: &[Issue]) -> Result<Checked, AppError> {
-    check_as(scenario, overrides, allow, true)
+    check_as(scenario, overrides, allow, true, None)
+}
+
+/// [`check`] of a run that `cancel` (Ctrl-C) may stop: a live stream's (`ws://…`), checked on
+/// what arrived before it.
+///
+/// ```
+/// use std::sync::{Arc, atomic::AtomicBool};
+/// let cancel = Arc::new(AtomicBool::new(false));
+/// let checked = posecov::app::commands::check_until("covariance_health", &Default::default(), &[], cancel).unwrap();
+/// assert_eq!(checked.exit_code(), 1);
+/// ```
+pub fn check_until(
+    scenario: &str,
+    overrides: &Overrides,
+    allow: &[Issue],
+    cancel: Arc<AtomicBool>,
+) -> Result<Checked, AppError> {
+    check_as(scenario, overrides, allow, true, Some(cancel))
 }
 
 /// [`check`]; `bar`: a log's reading shows its progress bar.
@@ -196,6 +241,7 @@ pub(super) fn check_as(
     overrides: &Overrides,
     allow: &[Issue],
     bar: bool,
+    cancel: Option<Arc<AtomicBool>>,
 ) -> Result<Checked, AppError> {
     let opened = open(scenario)?;
     let quick = match &opened {
@@ -220,7 +266,7 @@ pub(super) fn check_as(
     let options = RunOptions {
         draw: matches!(opened, Opened::Plan(_)),
         progress: bar,
-        cancel: None,
+        cancel,
     };
     let run = match Run::start(opened, &quick, options)? {
         Run::Log(run) => return Ok(log::check(&run, scenario, allow)),
@@ -242,5 +288,6 @@ pub(super) fn check_as(
     Ok(Checked {
         line,
         defects: Vec::new(),
+        notes: Vec::new(),
     })
 }

@@ -25,7 +25,7 @@ use crate::input::log::{LogOptions, bundled, read_located_observed};
 use crate::input::{About, Format, InputError, Located, Place};
 use crate::interop::RosReading;
 use crate::plan::log::LogObserver;
-use crate::plan::log::{Class, Issue, LogSummary};
+use crate::plan::log::{Class, Issue, LogSummary, StreamNotes};
 use crate::scene::{Origin, Scene, SceneError, Timing};
 
 /// A read, evaluated and drawn log.
@@ -86,7 +86,7 @@ pub(super) fn run(
     }
     let title = match &located.place {
         Place::Bundled(e) => bundled::find(e.name).map_or(e.name, |l| l.title).to_owned(),
-        Place::File(_) => file.clone(),
+        Place::File(_) | Place::Live(_) => file.clone(),
     };
     let draw = LogDrawSettings {
         about: About {
@@ -99,7 +99,11 @@ pub(super) fn run(
     };
     let summary = description(
         &plan,
-        located.format.name(),
+        match &located.place {
+            // Its channels are MCAP channels, but it is no file.
+            Place::Live(_) => "Live stream (Foxglove WebSocket)",
+            _ => located.format.name(),
+        },
         &evaluation,
         settings.confidence,
     );
@@ -337,6 +341,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
             "messages": plan.messages_total,
             "cancelled": plan.cancelled,
             "cut_short": plan.cut,
+            "stream": plan.stream,
         },
         "topics": topics,
         "frames": frames::frames_json(&plan.tf, &run.evaluation),
@@ -469,7 +474,16 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
             }
         )
     };
-    Checked { line, defects }
+    let notes = plan
+        .stream
+        .as_ref()
+        .map(StreamNotes::sentences)
+        .unwrap_or_default();
+    Checked {
+        line,
+        defects,
+        notes,
+    }
 }
 
 #[cfg(test)]

@@ -169,7 +169,7 @@ pub fn report(
     let mut closed = false;
     each(
         names,
-        |name| commands::report_as(name, overrides, style, false),
+        |name| commands::report_as(name, overrides, style, false, None),
         |name, result| {
             let text = match result {
                 Ok(text) => text,
@@ -204,7 +204,7 @@ pub fn check(
     let mut closed = false;
     each(
         names,
-        |name| commands::check_as(name, overrides, allow, false),
+        |name| commands::check_as(name, overrides, allow, false, None),
         |name, result: Result<Checked, AppError>| {
             let line = match result {
                 Ok(checked) => {

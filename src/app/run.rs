@@ -231,6 +231,17 @@ impl Run {
             }
             Opened::Log(located) => {
                 let settings = resolve(RobotLog, overrides, None)?;
+                if let input::Place::Live(url) = &located.place
+                    && let Some(reference) = &settings.reference
+                    && reference.align == crate::eval::log::nees::Align::Se3
+                {
+                    return Err(AppError::Input(input::InputError::Read {
+                        path: url.clone(),
+                        reason: "--align se3 fits the reference to the whole run, which a live \
+                                 stream does not have; use --align first or none"
+                            .to_owned(),
+                    }));
+                }
                 log::run(&located, &settings, &options).map(|run| Run::Log(Box::new(run)))
             }
         }

@@ -51,6 +51,8 @@ pub struct Overrides {
     pub optimizer: Option<Optimizer>,
     /// `--joint A,B` (repeatable; pose graphs): vertex ids whose joint marginal is wanted.
     pub joints: Vec<(u64, u64)>,
+    /// `--duration`, `--messages`, `--record` (a live stream, `ws://…`, only).
+    pub live: crate::input::log::ws::LiveOptions,
 }
 
 /// What an input is, as far as flags go: a scenario or a pose graph (both plans), or a robot
@@ -166,7 +168,7 @@ pub enum SettingsError {
 /// table every input's flags are checked against.
 fn kind_flags(
     overrides: &Overrides,
-) -> [(&'static str, AppliesTo, &'static str, Option<String>); 9] {
+) -> [(&'static str, AppliesTo, &'static str, Option<String>); 10] {
     [
         (
             "--reference",
@@ -197,6 +199,17 @@ fn kind_flags(
             AppliesTo::Logs,
             "it says how a log's PoseWithCovariance covariances are read (a scenario says it with `reading` in a pose's `cov`)",
             overrides.ros_reading.map(|r| r.name().to_owned()),
+        ),
+        (
+            // --duration, --messages, --record: a live stream's (a file refuses them where it
+            // is read, `input::log::read_located`).
+            overrides
+                .live
+                .first_flag()
+                .map_or("--duration", |(flag, _)| flag),
+            AppliesTo::Logs,
+            "it says how long to read a running robot's topics (ws://HOST:PORT) and where to record them",
+            overrides.live.first_flag().map(|(_, value)| value),
         ),
         (
             "--block-samples",
@@ -557,6 +570,7 @@ fn log_settings(overrides: &Overrides) -> Result<LogSettings, SettingsError> {
             topics: overrides.topics.clone(),
             every: overrides.every,
             reference: None,
+            live: overrides.live.clone(),
         },
         eval: LogEvalSettings {
             seed: overrides.seed.unwrap_or(0),

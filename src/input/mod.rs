@@ -187,6 +187,10 @@ pub enum Place {
     File(std::path::PathBuf),
     /// A bundled example.
     Bundled(Example),
+    /// A running robot's topics: a Foxglove WebSocket server's URL, `ws://HOST:PORT`
+    /// ([`log::ws`]). Its format is [`Format::Mcap`]: the server's channels are MCAP channels
+    /// (topic, message encoding, schema), their messages in the same bytes.
+    Live(String),
 }
 
 /// An input found and its format decided, once ([`locate`]): what every later step reads
@@ -209,6 +213,7 @@ impl Located {
         match &self.place {
             Place::File(path) => path.display().to_string(),
             Place::Bundled(e) => format!("{} (bundled)", e.file),
+            Place::Live(url) => url.clone(),
         }
     }
 
@@ -230,6 +235,12 @@ impl Located {
 /// assert!(e.contains("; MCAP files (ROS 2 bags): covariance_health"), "{e}");
 /// ```
 pub fn locate(name_or_path: &str) -> Result<Located, InputError> {
+    if log::ws::is_live(name_or_path) {
+        return Ok(Located {
+            place: Place::Live(name_or_path.to_owned()),
+            format: Format::Mcap,
+        });
+    }
     let path = Path::new(name_or_path);
     if path.is_dir() {
         return Ok(Located {
@@ -307,6 +318,7 @@ pub fn open_located(located: &Located) -> Result<(Source, Input), InputError> {
     match &located.place {
         Place::File(path) => open_file_as(path, located.format),
         Place::Bundled(e) => open_text(e.text, &located.origin(), located.format),
+        Place::Live(url) => Err(not_a_plan(url, located.format)),
     }
 }
 

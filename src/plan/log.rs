@@ -25,6 +25,8 @@ pub use reference::{
 };
 mod cut;
 pub use cut::LogCut;
+mod stream;
+pub use stream::{MAX_NOTED, StreamNotes};
 mod tf;
 pub use tf::{MAX_TF_EDGES, MAX_TF_SAMPLES, TfEdge, TfTree, UndecodableTf};
 mod health;
@@ -349,6 +351,9 @@ pub struct LogSummary {
     /// The read stopped at a cut or a damage before the file's end: everything before was
     /// read.
     pub cut: Option<LogCut>,
+    /// A live stream's notes (`ws://…`): damaged frames skipped, connections lost; `None`
+    /// for a file.
+    pub stream: Option<StreamNotes>,
     /// The log's `/tf` and `/tf_static` transforms, bounded ([`TfTree`]): what joins topics
     /// in different frames (`eval::log::frames`).
     pub tf: TfTree,

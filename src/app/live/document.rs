@@ -146,6 +146,9 @@ impl LiveDocument {
                 })?;
                 Self::new(&text, name_or_path)
             }
+            crate::input::Place::Live(url) => Err(AppError::Live(format!(
+                "{url}: live mode edits scenario files; show a running robot with `posecov {url}`"
+            ))),
         }
     }
 

@@ -215,6 +215,9 @@ pub fn description(
             "\n**Interrupted (Ctrl-C)**: only the messages before the interruption were read."
         );
     }
+    for sentence in plan.stream.iter().flat_map(|n| n.sentences()) {
+        let _ = writeln!(s, "\n**Live stream**: {sentence}.");
+    }
     if let Some(cut) = &plan.cut {
         let _ = writeln!(
             s,
