@@ -1,4 +1,5 @@
-"""posecov in a Jupyter notebook: the figure inline and the Rerun viewer with a recording.
+"""posecov in a Jupyter notebook: the figure inline and the Rerun viewer with a recording
+(the notebook recipe of docs/guide/python.md; docs/notebooks.md is the same without the package).
 
 The figure needs nothing but the package: ``posecov.Figure(source, **options)`` (SVG, shown
 inline by IPython). The interactive 3-D view plays a recording the CLI wrote
@@ -37,7 +38,10 @@ def viewer(rrd: Union[str, PathLike, bytes], width: Union[int, str] = "auto", he
     (``RERUN_NOTEBOOK_ASSET=inline``, set before ``rerun_notebook`` is first imported; about
     50 MB per viewer cell) instead of being fetched from the network.
 
-    Needs ``rerun-notebook==0.36.3`` (ImportError otherwise, saying so).
+    Needs ``rerun-notebook==0.36.3`` (ImportError otherwise, saying so). In a notebook cell,
+    after ``posecov camera_on_robot --save camera.rrd``:
+
+    >>> notebook.viewer("camera.rrd")  # doctest: +SKIP
     """
     if offline:
         os.environ.setdefault("RERUN_NOTEBOOK_ASSET", "inline")

@@ -128,6 +128,19 @@ def test_figure_inline_svg():
     assert fig._repr_svg_().startswith("<svg") and "</svg>" in fig.svg
 
 
+def test_notebook_figure_and_viewer_needs():
+    from posecov import notebook
+
+    assert notebook.figure("so3_sampling", samples=100).svg == posecov.figure_svg("so3_sampling", samples=100)
+    try:
+        import rerun_notebook  # noqa: F401
+    except ImportError:
+        with pytest.raises(ImportError, match=r"pip install rerun-notebook==0\.36\.3"):
+            notebook.viewer(b"")
+    else:
+        pytest.skip("rerun-notebook is installed: the missing-widget message cannot be seen")
+
+
 def test_examples_and_expand(root):
     names = [n for n, _ in posecov.examples()]
     assert "camera_on_robot" in names and "jackal_odometry" in names
