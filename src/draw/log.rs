@@ -80,7 +80,9 @@ pub struct LogDrawSettings {
 /// let settings = LogDrawSettings { about, confidence: posecov::uncertain::Confidence::DEFAULT, axis_length: None };
 /// let scene = draw_log(&e, &settings, &description(&plan, "ROS 1 bag", &e, posecov::uncertain::Confidence::DEFAULT));
 /// assert!(scene.validate().is_ok());
-/// let topic = "world/jackal_velocity_controller/odom";
+/// use posecov::scene::paths;
+/// let topic = paths::topic("/jackal_velocity_controller/odom");
+/// assert_eq!(topic, "world/jackal_velocity_controller/odom");
 /// assert!(scene.items.iter().any(|i| i.path == paths::child(&topic, "meaning/banana")));
 /// // Beside the whole trajectory (84 m), the selected message at the robot's scale.
 /// assert_eq!(scene.views.len(), 2);

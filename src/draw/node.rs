@@ -140,7 +140,7 @@ fn regions<G: LieGroup<N>, const N: usize>(
     let method = evaluated.result.method;
     let rotation_only = p.kind.is_rotation_only();
     let timing = at_step(node.step);
-    let base = paths::method(&node.name, &shown.estimate.segment());
+    let base = paths::method(&node.name, shown.estimate.segment());
     let color = method.color();
     let who = legend::who(shown.estimate, method.label());
     let mut cartesian = None;

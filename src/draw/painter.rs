@@ -127,7 +127,7 @@ impl Painter {
         };
         let line_radius = 0.002 * self.axis_length / 0.15;
         self.place(
-            paths::child(&base, "ellipsoid"),
+            paths::child(base, "ellipsoid"),
             timing,
             ItemKind::Ellipsoids(Ellipsoids {
                 shapes: vec![shape],
@@ -158,12 +158,12 @@ impl Painter {
         }
         .with_computed_normals();
         self.place(
-            paths::child(&base, "banana"),
+            paths::child(base, "banana"),
             timing,
             ItemKind::Surface(surface),
         );
         self.region_outlines(
-            &paths::child(&base, "banana_outline"),
+            &paths::child(base, "banana_outline"),
             timing,
             pose,
             color,

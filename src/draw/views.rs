@@ -107,7 +107,7 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
                         .others
                         .iter()
                         .filter(|m| **m != Estimate::Method(Method::VectorSpace))
-                        .map(|m| paths::method(pose, &m.segment())),
+                        .map(|m| paths::method(pose, m.segment())),
                 );
             }
             vec![view]
@@ -257,7 +257,7 @@ fn per_method(plan: &ViewInputs) -> Vec<View3d> {
                         .iter()
                         .chain(&m.others)
                         .filter(move |e| matches!(e, Estimate::Method(o) if *o != shown))
-                        .map(move |e| paths::method(pose, &e.segment()))
+                        .map(move |e| paths::method(pose, e.segment()))
                 })
                 .collect(),
             ..Default::default()

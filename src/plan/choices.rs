@@ -115,8 +115,8 @@ pub struct Link {
     pub to: String,
 }
 
-/// What a pose graph file holds, as facts: the draw stage writes the graph's description from
-/// them ([`crate::draw::input_description`]), the input stage writes no words.
+/// What a pose graph file holds, as facts: the drawing stage writes the graph's description
+/// from them (its `input_description`); the input stage writes no words.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct GraphFacts {
     /// SE(2) vertices (else SE(3)).

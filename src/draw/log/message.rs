@@ -80,7 +80,7 @@ pub(super) fn message(
         UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z))
     };
     p.place(
-        paths::child(&base, "pose"),
+        paths::child(base, "pose"),
         at,
         ItemKind::Frame(Frame {
             translation: origin,
@@ -100,7 +100,7 @@ pub(super) fn message(
             let s = Vector2::new(shift.x, shift.y);
             let moved = |x: &Se2| Se2::from_parts(x.translation() - s, *x.rotation());
             let g = UncertainPose::new_unchecked(moved(g.mean()), *g.cov(), Side::Right);
-            let meaning = paths::child(&base, "meaning");
+            let meaning = paths::child(base, "meaning");
             p.region_banana(&meaning, at, &g, MEANING, |x| {
                 x.to_se3().translation().to_owned()
             });
@@ -116,7 +116,7 @@ pub(super) fn message(
         PoseState::Spatial { pose: g, cloud } => {
             let moved = |x: &Se3| Se3::from_parts(x.translation() - shift, *x.rotation());
             let g = UncertainPose::new_unchecked(moved(g.mean()), *g.cov(), Side::Right);
-            let meaning = paths::child(&base, "meaning");
+            let meaning = paths::child(base, "meaning");
             p.region_banana(&meaning, at, &g, MEANING, |x| *x.translation());
             p.region_ellipsoid(&meaning, at, &g, MEANING);
             let cloud: Vec<Se3> = cloud.iter().map(moved).collect();
@@ -164,7 +164,7 @@ pub(super) fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
         Swatch::Line,
     );
     p.place(
-        paths::child(&base, "history/rviz"),
+        paths::child(base, "history/rviz"),
         Timing::Static,
         ItemKind::Ellipsoids(Ellipsoids {
             shapes: shapes_rviz,
@@ -190,7 +190,7 @@ pub(super) fn history(p: &mut Painter, base: &str, t: &TopicEvaluation) {
         })
         .collect();
     p.place(
-        paths::child(&base, "history/meaning"),
+        paths::child(base, "history/meaning"),
         Timing::Static,
         ItemKind::LineStrips(LineStrips {
             strips,
@@ -209,7 +209,7 @@ fn cloud_item(p: &mut Painter, base: &str, at: Timing, positions: Vec<Vec3>) {
         );
     }
     p.place(
-        paths::child(&base, "meaning/cloud"),
+        paths::child(base, "meaning/cloud"),
         at,
         ItemKind::Points(PointCloud {
             positions,
@@ -252,7 +252,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
     let s = 0.5 * p.axis_length;
     let [x, y, z] = origin;
     p.place(
-        paths::child(&base, "invalid"),
+        paths::child(base, "invalid"),
         at,
         ItemKind::LineStrips(LineStrips {
             strips: vec![
@@ -271,12 +271,12 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
         })
     };
     p.place(
-        paths::child(&base, "meaning/banana_outline"),
+        paths::child(base, "meaning/banana_outline"),
         at,
         empty_strips(),
     );
     p.place(
-        paths::child(&base, "meaning/ellipsoid"),
+        paths::child(base, "meaning/ellipsoid"),
         at,
         ItemKind::Ellipsoids(Ellipsoids {
             shapes: Vec::new(),
@@ -287,7 +287,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
         }),
     );
     p.place(
-        paths::child(&base, "meaning/banana"),
+        paths::child(base, "meaning/banana"),
         at,
         ItemKind::Surface(crate::scene::Surface {
             vertices: Vec::new(),
@@ -302,7 +302,7 @@ fn invalid(p: &mut Painter, base: &str, at: Timing, origin: Vec3) {
 
 fn clear_invalid(p: &mut Painter, base: &str, at: Timing) {
     p.place(
-        paths::child(&base, "invalid"),
+        paths::child(base, "invalid"),
         at,
         ItemKind::LineStrips(LineStrips {
             strips: Vec::new(),

@@ -103,7 +103,7 @@ pub(super) fn rviz_picture(
     let l = p.axis_length;
     let (shape, note) = rviz_position(rviz, &center, r_pos, l, planar);
     p.place(
-        paths::child(&base, "rviz/position"),
+        paths::child(base, "rviz/position"),
         at,
         ItemKind::Ellipsoids(Ellipsoids {
             shapes: vec![shape],
@@ -125,7 +125,7 @@ pub(super) fn rviz_picture(
         fan.extend(arc);
         fan.push(origin);
         p.place(
-            paths::child(&base, "rviz/orientation"),
+            paths::child(base, "rviz/orientation"),
             at,
             ItemKind::LineStrips(LineStrips {
                 strips: vec![fan],
