@@ -182,22 +182,7 @@ fn judge(file: &str, text: &str, run: Run<Outcome>, limits: &Limits) -> Vec<Find
     judged.dedup_by(|a, b| a.class == "error_ok" && b.class == "error_ok");
     found.extend(judged);
     if let Ok(json) = &estimate {
-        // As for every log (tests/fuzz/logs.rs): absent by design.
-        let optional = [
-            "step",
-            "min_eigenvalue",
-            "twist_sigma_last",
-            ".topics[#].constant_stretch",
-            "first_s",
-            "last_s",
-            "median_of_kept",
-            ".topics[#].consistency",
-            ".meta.cut_short",
-            ".topics[#].frame_join",
-            "first_left_out_s",
-            ".frames.problems[#].first_stamp_s",
-        ];
-        if let Some(path) = json_null(json, &optional) {
+        if let Some(path) = json_null(json, crate::logs::LOG_JSON_OPTIONAL) {
             found.push(finding("nonfinite_json", format!("null at {path}")));
         }
     }
