@@ -547,7 +547,10 @@ fn check_sigmas<G: LieGroup<N>, const N: usize>(g: &GraphEvaluation<G, N>, what:
         }
         compared += 1;
     }
-    assert!(compared + 1 >= g.ids.len(), "{what}: {compared} poses compared");
+    assert!(
+        compared + 1 >= g.ids.len(),
+        "{what}: {compared} poses compared"
+    );
     // Somewhere the loop closures made a difference.
     assert!(
         sigmas.iter().any(|s| match (s.before, s.after) {
@@ -560,14 +563,26 @@ fn check_sigmas<G: LieGroup<N>, const N: usize>(g: &GraphEvaluation<G, N>, what:
 
 #[test]
 fn sigma_after_the_loop_closures_is_at_most_dead_reckonings_at_every_pose() {
-    check_sigmas(&evaluated(&se2_graph(POSE2), GraphSettings::default()), "pose2example");
-    check_sigmas(&evaluated(&se3_graph(POSE3), GraphSettings::default()), "pose3example");
     check_sigmas(
-        &evaluated(&graph_common::manhattan_walk(400, 7), GraphSettings::default()),
+        &evaluated(&se2_graph(POSE2), GraphSettings::default()),
+        "pose2example",
+    );
+    check_sigmas(
+        &evaluated(&se3_graph(POSE3), GraphSettings::default()),
+        "pose3example",
+    );
+    check_sigmas(
+        &evaluated(
+            &graph_common::manhattan_walk(400, 7),
+            GraphSettings::default(),
+        ),
         "manhattan walk",
     );
     check_sigmas(
-        &evaluated(&graph_common::manhattan_walk_3d(200, 7), GraphSettings::default()),
+        &evaluated(
+            &graph_common::manhattan_walk_3d(200, 7),
+            GraphSettings::default(),
+        ),
         "3-D manhattan walk",
     );
     // Without loop closures, before is after.
@@ -613,18 +628,35 @@ fn sigma_before_and_after_are_in_report_json_and_the_figure_plots_them() {
     // The plot: first, four lines over the poses with a marginal and the loop closures' ends.
     let plot = &scene.plots[0];
     assert_eq!(plot.id.as_str(), "graph_sigma");
-    assert!(plot.title.contains("heading σ"), "{}", plot.title);
+    assert_eq!(
+        plot.label(),
+        "σ by pose, before/after loop closures (m, rad)"
+    );
     let series: Vec<_> = scene.series.iter().filter(|s| s.plot == plot.id).collect();
     assert_eq!(series.len(), 5);
-    assert!(series[..4].iter().all(|s| s.points.len() == with_sigma && !s.marks));
+    assert!(
+        series[..4]
+            .iter()
+            .all(|s| s.points.len() == with_sigma && !s.marks)
+    );
     let ends = series[4];
     assert!(ends.marks);
-    // v5 → v9 and v3 → v10 (pose2example's loop closures): four ends on the after line.
+    // v5 → v9 and v3 → v10 (pose2example's loop closures): four ends, a rug below the lines.
     let xs: Vec<i64> = ends.points.iter().map(|p| p.0).collect();
     assert_eq!(xs, vec![3, 5, 9, 10]);
+    let lowest = series[..4]
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold(f64::INFINITY, f64::min);
+    assert!(ends.points.iter().all(|p| p.1 <= lowest));
     let svg = posecov::sink::figure::svg(&scene, &posecov::sink::figure::FigureOptions::default());
     for s in &series {
         assert!(svg.contains(&s.name), "the figure names {}", s.name);
     }
-    assert!(svg.contains("σ per pose before and after the loop closures"));
+    assert!(svg.contains(&plot.label()));
+    assert!(
+        series[2].name.starts_with("heading σ"),
+        "{}",
+        series[2].name
+    );
 }

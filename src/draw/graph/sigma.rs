@@ -1,6 +1,6 @@
 //! The plot that says what the loop closures did: each pose's σ against its index, before
-//! (dead reckoning) and after (optimised), position and rotation, with marks where the loop
-//! closures join.
+//! (dead reckoning) and after (optimised), position and rotation, with a rug of marks where
+//! the loop closures join.
 
 use std::collections::{BTreeSet, HashMap};
 
@@ -26,7 +26,7 @@ const LOG_RATIO: f64 = 100.0;
 /// Adds the σ plot first among `scene`'s plots: per pose (x = its index in vertex order),
 /// the position σ √tr Σ_ρρ and the rotation σ √tr Σ_θθ (a 2-D pose's heading σ) of its
 /// dead-reckoning marginal and of its optimised one ([`GraphEvaluation::sigmas`]), and a
-/// mark on the after line at both poses each loop closure joins. Values are in m and rad; when
+/// mark below the lines (a rug) at both poses each loop closure joins. Values are in m and rad; when
 /// they span more than [`LOG_RATIO`], log₁₀ of them, said in the title and unit. Poses held
 /// fixed (no marginal) are left out.
 pub(in crate::draw) fn sigma_plot<G: LieGroup<N>, const N: usize>(
@@ -44,9 +44,9 @@ pub(in crate::draw) fn sigma_plot<G: LieGroup<N>, const N: usize>(
     if all.is_empty() {
         return;
     }
-    let (low, high) = all
-        .iter()
-        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let (low, high) = all.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &v| {
+        (lo.min(v), hi.max(v))
+    });
     let log = high > LOG_RATIO * low;
     let value = |v: f64| if log { v.log10() } else { v };
     let id = PlotId::new(PLOT);
@@ -102,7 +102,20 @@ pub(in crate::draw) fn sigma_plot<G: LieGroup<N>, const N: usize>(
             line(&turn, false),
         ),
     ];
-    // Where the loop closures join: a mark on the position-after line at both ends.
+    let (bottom, top) = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    // Where the loop closures join: a rug of marks below the lines (on a long graph they are
+    // hundreds; on the lines they would hide them), at both ends of each.
+    let (rug, range) = if log {
+        let pad = 0.08 * (top - bottom).max(0.1);
+        (bottom - pad, [bottom - 2.0 * pad, top + pad])
+    } else {
+        (0.0, [-0.05 * top, 1.05 * top])
+    };
     let index: HashMap<u64, usize> = g.ids.iter().enumerate().map(|(k, &id)| (id, k)).collect();
     let ends: BTreeSet<usize> = g
         .loop_closures
@@ -111,52 +124,32 @@ pub(in crate::draw) fn sigma_plot<G: LieGroup<N>, const N: usize>(
         .flatten()
         .copied()
         .collect();
-    let after = series[1].points.clone();
-    let marks: Vec<(i64, f64)> = ends
-        .iter()
-        .filter_map(|&k| after.iter().find(|p| p.0 == k as i64).copied())
-        .collect();
-    if !marks.is_empty() {
+    if !ends.is_empty() {
         series.push(
             ScalarSeries::new(
                 id.clone(),
                 "loop_closure_ends",
                 format!(
-                    "loop closure ends ({} closures, {} poses)",
+                    "where loop closures join ({} closures, {} poses)",
                     g.loop_closures.len(),
                     ends.len()
                 ),
                 scene::LINK,
                 5.0,
-                marks,
+                ends.iter().map(|&k| (k as i64, rug)).collect(),
             )
             .as_marks(),
         );
     }
-    let drawn: Vec<f64> = series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.1))
-        .collect();
-    let (bottom, top) = drawn
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        });
-    let range = if log {
-        let pad = 0.05 * (top - bottom).max(0.1);
-        [bottom - pad, top + pad]
-    } else {
-        [0.0, 1.05 * top]
-    };
     scene.plots.insert(
         0,
         Plot {
             id,
             title: format!(
-                "{}σ per pose before and after the loop closures, against pose index (position √tr Σ_ρρ, {rotation})",
+                "{}σ by pose, before/after loop closures",
                 if log { "log₁₀ " } else { "" }
             ),
-            unit: if log { "log₁₀ of m and rad" } else { "m and rad" }.to_owned(),
+            unit: if log { "log₁₀ m, rad" } else { "m, rad" }.to_owned(),
             range: range.iter().all(|v| v.is_finite()).then_some(range),
             legend: Corner::LeftTop,
         },

@@ -9,11 +9,11 @@ use crate::lie::{LieGroup, Tangent, TangentMatrix};
 use crate::plan::graph::PoseGraph;
 use crate::uncertain::Confidence;
 
+use super::sigma::{PoseSigma, SigmaBeforeAfter};
 use super::{
     Anchor, ClosureTimeline, GraphReading, Iteration, Joint, Optimizer, Solution, SolverSettings,
     SparseError, Stage, Stop, relative_covariance,
 };
-use super::sigma::{PoseSigma, SigmaBeforeAfter};
 
 /// The settings of a graph's evaluation (resolved by `app/`).
 #[derive(Debug, Clone, PartialEq, Default)]

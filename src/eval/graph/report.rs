@@ -3,9 +3,7 @@
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::uncertain::Confidence;
 
-use super::{
-    GraphEvaluation, GraphReading, Iteration, Joint, Optimizer, Part, PoseSigma, Stop,
-};
+use super::{GraphEvaluation, GraphReading, Iteration, Joint, Optimizer, Part, PoseSigma, Stop};
 
 /// One optimised pose.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
