@@ -3,7 +3,8 @@
 //! two poses against a dense inverse and against GTSAM's `jointMarginalCovariance`; the
 //! relative pose's covariance against a numeric Jacobian; `--joint`, `--optimizer` and
 //! `--graph-reading` refused by name where they do not apply; mutated GTSAM files refused or
-//! drawn, never a panic.
+//! drawn, never a panic; each pose's σ before (dead reckoning) and after the loop closures, never
+//! larger after, in `report --json` and plotted in the figure.
 
 use nalgebra::{DMatrix, SVector};
 use posecov::app::{Loaded, Overrides, pipeline};
@@ -511,5 +512,151 @@ fn mutated_graphs_are_refused_or_drawn_never_a_panic_or_a_bad_scene() {
     assert!(
         drawn > 100 && refused > 100,
         "{drawn} drawn, {refused} refused"
+    );
+}
+
+/// Every pose's σ after is at most its σ before, position and rotation, and both are the
+/// roots of the marginals' block traces.
+fn check_sigmas<G: LieGroup<N>, const N: usize>(g: &GraphEvaluation<G, N>, what: &str) {
+    let sigmas = g.sigmas();
+    assert_eq!(sigmas.len(), g.ids.len());
+    let rot = G::KIND.rotation_range();
+    let mut compared = 0;
+    for (k, s) in sigmas.iter().enumerate() {
+        let (Some(before), Some(after)) = (s.before, s.after) else {
+            assert!(g.solution.covariances[k].is_none(), "{what}: v{}", g.ids[k]);
+            continue;
+        };
+        let cov = g.solution.covariances[k].expect("a marginal");
+        let position: f64 = (0..rot.start).map(|i| cov[(i, i)]).sum();
+        let rotation: f64 = rot.clone().map(|i| cov[(i, i)]).sum();
+        assert!((after.position - position.sqrt()).abs() <= 1e-12 * position.sqrt());
+        assert!((after.rotation - rotation.sqrt()).abs() <= 1e-12 * rotation.sqrt());
+        let dr = g.dead_reckoning[k].expect("a dead-reckoning marginal");
+        let before_position: f64 = (0..rot.start).map(|i| dr[(i, i)]).sum();
+        assert!((before.position - before_position.sqrt()).abs() <= 1e-12 * before.position);
+        for (b, a, name) in [
+            (before.position, after.position, "position"),
+            (before.rotation, after.rotation, "rotation"),
+        ] {
+            assert!(
+                a <= b * (1.0 + 1e-9),
+                "{what}: v{} {name} σ after {a} > before {b}",
+                g.ids[k]
+            );
+        }
+        compared += 1;
+    }
+    assert!(
+        compared + 1 >= g.ids.len(),
+        "{what}: {compared} poses compared"
+    );
+    // Somewhere the loop closures made a difference.
+    assert!(
+        sigmas.iter().any(|s| match (s.before, s.after) {
+            (Some(b), Some(a)) => a.position < 0.9 * b.position,
+            _ => false,
+        }),
+        "{what}: no pose's σ shrank"
+    );
+}
+
+#[test]
+fn sigma_after_the_loop_closures_is_at_most_dead_reckonings_at_every_pose() {
+    check_sigmas(
+        &evaluated(&se2_graph(POSE2), GraphSettings::default()),
+        "pose2example",
+    );
+    check_sigmas(
+        &evaluated(&se3_graph(POSE3), GraphSettings::default()),
+        "pose3example",
+    );
+    check_sigmas(
+        &evaluated(
+            &graph_common::manhattan_walk(400, 7),
+            GraphSettings::default(),
+        ),
+        "manhattan walk",
+    );
+    check_sigmas(
+        &evaluated(
+            &graph_common::manhattan_walk_3d(200, 7),
+            GraphSettings::default(),
+        ),
+        "3-D manhattan walk",
+    );
+    // Without loop closures, before is after.
+    let chain = evaluated(
+        &se2_graph(
+            "VERTEX_SE2 0 0 0 0\nVERTEX_SE2 1 1 0 0\nVERTEX_SE2 2 2 0 0\n\
+             EDGE_SE2 0 1 1 0 0 100 0 0 100 0 400\nEDGE_SE2 1 2 1 0 0 100 0 0 100 0 400\n",
+        ),
+        GraphSettings::default(),
+    );
+    assert!(chain.sigmas().iter().all(|s| s.before == s.after));
+}
+
+#[test]
+fn sigma_before_and_after_are_in_report_json_and_the_figure_plots_them() {
+    let (source, input) = open("tests/data/gtsam/pose2example.txt").expect("readable");
+    let loaded = Loaded { source, input };
+    let overrides = Overrides {
+        samples: Some(64),
+        ..Overrides::default()
+    };
+    let (evaluation, scene) = pipeline(&loaded, &overrides, None).expect("drawn");
+    let json = posecov::app::report_json("p", &loaded, &evaluation, Confidence::DEFAULT);
+    let poses = json["optimized"]["poses"].as_array().expect("poses");
+    let mut with_sigma = 0;
+    for p in poses {
+        let Some(cov) = p["covariance"].as_array() else {
+            assert!(p["sigma"].is_null() && p["sigma_before"].is_null(), "{p}");
+            continue;
+        };
+        let at = |r: usize| cov[r][r].as_f64().expect("a number");
+        let after = &p["sigma"];
+        let position = after["position"].as_f64().expect("m");
+        assert!((position - (at(0) + at(1)).sqrt()).abs() < 1e-12, "{p}");
+        let heading = after["rotation"].as_f64().expect("rad");
+        assert!((heading - at(2).sqrt()).abs() < 1e-12, "{p}");
+        let before = p["sigma_before"]["position"].as_f64().expect("m");
+        assert!(position <= before * (1.0 + 1e-9), "{p}");
+        with_sigma += 1;
+    }
+    assert_eq!(with_sigma, poses.len() - 1, "all but the anchor");
+
+    // The plot: first, four lines over the poses with a marginal and the loop closures' ends.
+    let plot = &scene.plots[0];
+    assert_eq!(plot.id.as_str(), "graph_sigma");
+    assert_eq!(
+        plot.label(),
+        "σ by pose, before/after loop closures (m, rad)"
+    );
+    let series: Vec<_> = scene.series.iter().filter(|s| s.plot == plot.id).collect();
+    assert_eq!(series.len(), 5);
+    assert!(
+        series[..4]
+            .iter()
+            .all(|s| s.points.len() == with_sigma && !s.marks)
+    );
+    let ends = series[4];
+    assert!(ends.marks);
+    // v5 → v9 and v3 → v10 (pose2example's loop closures): four ends, a rug below the lines.
+    let xs: Vec<i64> = ends.points.iter().map(|p| p.0).collect();
+    assert_eq!(xs, vec![3, 5, 9, 10]);
+    let lowest = series[..4]
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold(f64::INFINITY, f64::min);
+    assert!(ends.points.iter().all(|p| p.1 <= lowest));
+    let svg = posecov::sink::figure::svg(&scene, &posecov::sink::figure::FigureOptions::default());
+    for s in &series {
+        assert!(svg.contains(&s.name), "the figure names {}", s.name);
+    }
+    assert!(svg.contains(&plot.label()));
+    assert!(
+        series[2].name.starts_with("heading σ"),
+        "{}",
+        series[2].name
     );
 }

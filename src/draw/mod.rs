@@ -44,7 +44,8 @@
 //!   `graph/about.rs`; a pose graph's findings and its paragraph — loop closures
 //!   before and after, joint marginals — in `graph/mod.rs`, its after picture — marginals following
 //!   the loop-closure timeline on the `step` timeline after the chain's steps, loop closures,
-//!   relative uncertainties, labels that do not collide — in `graph/after.rs`), the 3-D views —
+//!   relative uncertainties, labels that do not collide — in `graph/after.rs`; the σ before and
+//!   after against pose index in `graph/sigma.rs`), the 3-D views —
 //!   layout, hidden entities, each view's camera fitted to what it draws (`views.rs`);
 //! - `log.rs` (`draw_log`: a robot log's scene on the `stamp` timeline and its views: one whole-log
 //!   view per `frame_id`, never overlaid, and per topic a view at the robot's scale whose camera is
@@ -368,6 +369,9 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     let (plots, series) = plots::plots(e);
     p.scene.plots = plots;
     p.scene.series = series;
+    if let Some(g) = &e.graph {
+        graph::sigma_plot(&mut p.scene, g);
+    }
     let plan = views::ViewInputs {
         poses: &p.methods,
         rotation_only: G::KIND.is_rotation_only(),

@@ -97,8 +97,11 @@ pub struct ScalarSeries {
     pub name: String,
     /// Line colour (use the method's [`Method::color`](crate::uncertain::Method::color)).
     pub color: Color,
-    /// Line width in UI points.
+    /// Line width in UI points (with `marks`, the marks' diameter).
     pub width: f64,
+    /// Drawn as a mark at each sample, unjoined (e.g. where loop closures join), not a line
+    /// ([`ScalarSeries::as_marks`]).
+    pub marks: bool,
     /// `(step, value)` samples (`(stamp ns, value)` when the scene's timeline is
     /// [`Timeline::Stamp`](super::Timeline::Stamp)).
     pub points: Vec<(i64, f64)>,
@@ -127,8 +130,21 @@ impl ScalarSeries {
             name: name.into(),
             color,
             width,
+            marks: false,
             points,
         }
+    }
+
+    /// The same samples drawn as unjoined marks of diameter `width` instead of a line.
+    ///
+    /// ```
+    /// use posecov::scene::{Color, PlotId, ScalarSeries};
+    /// let s = ScalarSeries::new(PlotId::new("sigma"), "ends", "ends", Color::rgb(0, 0, 0), 5.0, vec![(3, 1.0)]).as_marks();
+    /// assert!(s.marks);
+    /// ```
+    pub fn as_marks(mut self) -> Self {
+        self.marks = true;
+        self
     }
 
     /// Its entity path, `plots/<plot>/<segment>` ([`paths::series`]).

@@ -325,18 +325,26 @@ fn arrows3d(arrows: &Arrows) -> rr::Arrows3D {
         .with_radii([f(arrows.radius)])
 }
 
-/// Series style (static, once) and all samples in one column chunk.
+/// Series style (static, once: a line, or marks) and all samples in one column chunk.
 fn log_series(
     rec: &rr::RecordingStream,
     series: &ScalarSeries,
     timeline: scene::Timeline,
 ) -> Result<(), SinkError> {
-    let style = rr::SeriesLines::new()
-        .with_names([series.name.as_str()])
-        .with_colors([color(series.color)])
-        .with_widths([f(series.width)]);
     let path = series.path();
-    send(rec, path.as_str(), rr::TimePoint::default(), &[&style])?;
+    if series.marks {
+        let style = rr::SeriesPoints::new()
+            .with_names([series.name.as_str()])
+            .with_colors([color(series.color)])
+            .with_marker_sizes([f(series.width)]);
+        send(rec, path.as_str(), rr::TimePoint::default(), &[&style])?;
+    } else {
+        let style = rr::SeriesLines::new()
+            .with_names([series.name.as_str()])
+            .with_colors([color(series.color)])
+            .with_widths([f(series.width)]);
+        send(rec, path.as_str(), rr::TimePoint::default(), &[&style])?;
+    }
     if series.points.is_empty() {
         return Ok(());
     }

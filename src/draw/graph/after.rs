@@ -28,7 +28,7 @@ const MAX_DRAWN_JOINTS: usize = 12;
 /// Most labels in the after picture.
 const MAX_LABELS: usize = 24;
 /// Colour of the optimised poses and their marginals.
-const OPTIMIZED: Color = Color::rgb(0, 158, 115);
+pub(super) const OPTIMIZED: Color = Color::rgb(0, 158, 115);
 /// Colour of loop closures beyond their radius.
 const OUTLIER: Color = Color::rgb(213, 94, 0);
 /// Colour of a relative pose's uncertainty (X_b as X_a sees it).

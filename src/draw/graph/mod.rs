@@ -1,6 +1,7 @@
 //! A pose graph's optimisation in words — the findings (outliers, parts, duplicated edges, a
 //! solve that did not converge) and the text panel's paragraph — and in pictures
-//! ([`after`]: the optimised poses, marginals, loop closures and relative uncertainties).
+//! ([`after`]: the optimised poses, marginals, loop closures and relative uncertainties;
+//! [`sigma`]: each pose's σ before and after the loop closures, against its index).
 
 use std::fmt::Write;
 
@@ -10,9 +11,11 @@ use crate::lie::LieGroup;
 
 mod about;
 mod after;
+mod sigma;
 
 pub(super) use about::description as file_description;
 pub(super) use after::draw_optimized;
+pub(super) use sigma::sigma_plot;
 
 /// The sentence of a graph finding (`None` for any other finding).
 pub(super) fn finding_text(f: &Finding) -> Option<String> {

@@ -9,6 +9,7 @@ use crate::lie::{LieGroup, Tangent, TangentMatrix};
 use crate::plan::graph::PoseGraph;
 use crate::uncertain::Confidence;
 
+use super::sigma::{PoseSigma, SigmaBeforeAfter};
 use super::{
     Anchor, ClosureTimeline, GraphReading, Iteration, Joint, Optimizer, Solution, SolverSettings,
     SparseError, Stage, Stop, relative_covariance,
@@ -101,6 +102,10 @@ pub struct GraphEvaluation<G: LieGroup<N>, const N: usize> {
     pub joints: Vec<JointMarginal<G, N>>,
     /// The graph re-solved as its loop closures are added one by one.
     pub timeline: ClosureTimeline<G, N>,
+    /// Every pose's dead-reckoning marginal: of the graph without its loop closures
+    /// (odometry and priors), optimised, right form [ρ; θ]; None as in
+    /// [`Solution::covariances`]. The "before" of [`GraphEvaluation::sigmas`].
+    pub dead_reckoning: Vec<Option<TangentMatrix<N>>>,
     /// The confidence the residuals are measured at.
     pub confidence: Confidence,
     /// √χ²_N(confidence): a residual beyond it is an outlier.
@@ -236,6 +241,14 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
     } else {
         super::timeline::closure_timeline(graph, &loop_edges, &solution, &solver, progress)?
     };
+    let dead_reckoning = super::timeline::dead_reckoning(
+        graph,
+        &loop_edges,
+        &solution,
+        &timeline,
+        &solver,
+        progress,
+    )?;
     let edge_chi2 = graph
         .edges
         .iter()
@@ -251,6 +264,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         loop_closures,
         joints,
         timeline,
+        dead_reckoning,
         confidence,
         radius: confidence.radius(N),
         duplicates,
@@ -268,6 +282,19 @@ impl<G: LieGroup<N>, const N: usize> GraphEvaluation<G, N> {
             .collect();
         out.sort_by(|a, b| b.mahalanobis.total_cmp(&a.mahalanobis));
         out
+    }
+
+    /// Every pose's σ before (dead reckoning, [`GraphEvaluation::dead_reckoning`]) and after
+    /// (the optimised marginal), in vertex order: what the loop closures did.
+    pub fn sigmas(&self) -> Vec<SigmaBeforeAfter> {
+        self.dead_reckoning
+            .iter()
+            .zip(&self.solution.covariances)
+            .map(|(before, after)| SigmaBeforeAfter {
+                before: before.as_ref().map(PoseSigma::of::<G, N>),
+                after: after.as_ref().map(PoseSigma::of::<G, N>),
+            })
+            .collect()
     }
 
     /// Whether the solve stopped as it should (converged, or LM at a minimum).

@@ -58,6 +58,7 @@ mod evaluate;
 pub mod marginals;
 mod parts;
 mod report;
+mod sigma;
 mod solve;
 pub mod sparse;
 mod timeline;
@@ -71,6 +72,7 @@ pub use report::{
     JointRecord, LoopClosureRecord, OptimizedReport, PoseRecord, Seconds, StopCriteria,
     TimelineRecord,
 };
+pub use sigma::{PoseSigma, SigmaBeforeAfter};
 pub use solve::edge_jacobians;
 pub use sparse::{MAX_FACTOR_NONZEROS, SparseError};
 pub use timeline::{

@@ -3,7 +3,7 @@
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::uncertain::Confidence;
 
-use super::{GraphEvaluation, GraphReading, Iteration, Joint, Optimizer, Part, Stop};
+use super::{GraphEvaluation, GraphReading, Iteration, Joint, Optimizer, Part, PoseSigma, Stop};
 
 /// One optimised pose.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -15,6 +15,12 @@ pub struct PoseRecord {
     /// The marginal covariance, posecov's right form [ρ; θ], row by row (`null`: held fixed,
     /// isolated, or no marginals).
     pub covariance: Option<Vec<Vec<f64>>>,
+    /// σ of the marginal `covariance`: `position` √tr Σ_ρρ (m), `rotation` √tr Σ_θθ (rad;
+    /// a 2-D pose's heading σ) ([`PoseSigma`]; `null` with `covariance`).
+    pub sigma: Option<PoseSigma>,
+    /// The same σ before the loop closures: of the pose's dead-reckoning marginal, the graph
+    /// without its loop closures optimised ([`GraphEvaluation::dead_reckoning`]).
+    pub sigma_before: Option<PoseSigma>,
 }
 
 /// One loop closure.
@@ -195,10 +201,13 @@ impl<G: LieGroup<N>, const N: usize> GraphEvaluation<G, N> {
                 .iter()
                 .zip(&s.poses)
                 .zip(&s.covariances)
-                .map(|((&id, x), cov)| PoseRecord {
+                .zip(self.sigmas())
+                .map(|(((&id, x), cov), sigma)| PoseRecord {
                     id,
                     pose: g2o_values(x),
                     covariance: cov.as_ref().map(rows),
+                    sigma: sigma.after,
+                    sigma_before: sigma.before,
                 })
                 .collect(),
             loop_closures: self

@@ -85,10 +85,7 @@ pub(super) fn closure_timeline<G: LieGroup<N>, const N: usize>(
         timeline.too_large = Some(graph.vertices.len());
         return Ok(timeline);
     }
-    let mut rank = vec![None; graph.edges.len()];
-    for (r, &e) in loop_edges.iter().enumerate() {
-        rank[e] = Some(r);
-    }
+    let rank = ranks(graph, loop_edges);
     let solver = SolverSettings {
         pairs: Vec::new(),
         ..settings.clone()
@@ -107,21 +104,7 @@ pub(super) fn closure_timeline<G: LieGroup<N>, const N: usize>(
             });
             break;
         }
-        let mut sub = PoseGraph {
-            vertices: graph.vertices.clone(),
-            edges: graph
-                .edges
-                .iter()
-                .zip(&rank)
-                .filter(|(_, r)| r.is_none_or(|r| r < k))
-                .map(|(e, _)| e.clone())
-                .collect(),
-            priors: graph.priors.clone(),
-            fixed: graph.fixed.clone(),
-        };
-        for (v, x) in sub.vertices.iter_mut().zip(&start) {
-            v.estimate = *x;
-        }
+        let sub = first_closures(graph, &rank, k, &start);
         let stage = Stage::Timeline { step: step + 1, of };
         let s = optimize(&sub, &solver, &mut |i| progress(stage, i))?;
         if s.stop == Stop::Interrupted {
@@ -138,4 +121,69 @@ pub(super) fn closure_timeline<G: LieGroup<N>, const N: usize>(
         });
     }
     Ok(timeline)
+}
+
+/// Per edge: its rank among the loop closures `loop_edges` (None: odometry).
+fn ranks<G: LieGroup<N>, const N: usize>(
+    graph: &PoseGraph<G, N>,
+    loop_edges: &[usize],
+) -> Vec<Option<usize>> {
+    let mut rank = vec![None; graph.edges.len()];
+    for (r, &e) in loop_edges.iter().enumerate() {
+        rank[e] = Some(r);
+    }
+    rank
+}
+
+/// `graph` with its odometry, priors and first `k` loop closures (by `rank`), its estimates
+/// `start`.
+fn first_closures<G: LieGroup<N>, const N: usize>(
+    graph: &PoseGraph<G, N>,
+    rank: &[Option<usize>],
+    k: usize,
+    start: &[G],
+) -> PoseGraph<G, N> {
+    let mut sub = PoseGraph {
+        vertices: graph.vertices.clone(),
+        edges: graph
+            .edges
+            .iter()
+            .zip(rank)
+            .filter(|(_, r)| r.is_none_or(|r| r < k))
+            .map(|(e, _)| e.clone())
+            .collect(),
+        priors: graph.priors.clone(),
+        fixed: graph.fixed.clone(),
+    };
+    for (v, x) in sub.vertices.iter_mut().zip(start) {
+        v.estimate = *x;
+    }
+    sub
+}
+
+/// Every pose's dead-reckoning marginal: of `graph` without its loop closures `loop_edges`
+/// (odometry and priors only), optimised — the timeline's step 0 when it has one, `full`'s
+/// marginals when there are no loop closures, else solved here once (a graph too large for
+/// the timeline).
+pub(super) fn dead_reckoning<G: LieGroup<N>, const N: usize>(
+    graph: &PoseGraph<G, N>,
+    loop_edges: &[usize],
+    full: &Solution<G, N>,
+    timeline: &ClosureTimeline<G, N>,
+    settings: &SolverSettings,
+    progress: &mut dyn FnMut(Stage, &Iteration),
+) -> Result<Vec<Option<TangentMatrix<N>>>, SparseError> {
+    if loop_edges.is_empty() {
+        return Ok(full.covariances.clone());
+    }
+    if let Some(step) = timeline.steps.first().filter(|s| s.closures == 0) {
+        return Ok(step.covariances.clone());
+    }
+    let solver = SolverSettings {
+        pairs: Vec::new(),
+        ..settings.clone()
+    };
+    let sub = first_closures(graph, &ranks(graph, loop_edges), 0, &graph.estimates());
+    let stage = Stage::Timeline { step: 1, of: 1 };
+    Ok(optimize(&sub, &solver, &mut |i| progress(stage, i))?.covariances)
 }

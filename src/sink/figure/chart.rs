@@ -336,13 +336,19 @@ impl PlotPanel<'_> {
                 (x, row) = (area.x, row + 1.3 * small);
             }
             let y = row - 0.3 * small;
-            svg.line(
-                [x, y],
-                [x + 1.5 * small, y],
-                darker(s.color, 0.1),
-                2.0 * pen.unit,
-                "",
-            );
+            if s.marks {
+                svg.open(&format!("fill=\"{}\"", rgb(darker(s.color, 0.1))));
+                svg.circle([x + 0.75 * small, y], 0.3 * small);
+                svg.close();
+            } else {
+                svg.line(
+                    [x, y],
+                    [x + 1.5 * small, y],
+                    darker(s.color, 0.1),
+                    2.0 * pen.unit,
+                    "",
+                );
+            }
             svg.text(
                 [x + 1.8 * small, row],
                 small,
@@ -421,12 +427,16 @@ impl PlotPanel<'_> {
                 .map(|&(x, v)| px((self.x_of)(x), v))
                 .filter(|p| p[0].is_finite() && p[1].is_finite())
                 .collect();
-            if line.len() == 1 {
+            if line.len() == 1 || s.marks {
                 svg.open(&format!("fill=\"{}\"", rgb(darker(s.color, 0.1))));
-                svg.circle(line[0], 2.0 * pen.unit);
+                for p in &line {
+                    svg.circle(*p, if s.marks { 1.2 } else { 1.0 } * 2.0 * pen.unit);
+                }
                 svg.close();
             }
-            svg.polyline(&line, false, darker(s.color, 0.1), 1.6 * pen.unit, "");
+            if !s.marks {
+                svg.polyline(&line, false, darker(s.color, 0.1), 1.6 * pen.unit, "");
+            }
         }
         svg.close();
         axes.frame(svg, pen);
