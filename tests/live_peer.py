@@ -11,7 +11,7 @@ rosbags). Serves on 127.0.0.1 only, on a port the OS picks, and prints one JSON 
 2. waits until the server reports that a client subscribed to every expected topic (the SDK
    server's `on_subscribe`, the legacy server's listener): no sleep is synchronisation; after
    --wait seconds without them it publishes anyway (to whoever is subscribed);
-3. publishes every message once, paced (1 ms apart, far below the SDK server's 1024-message
+3. publishes every message once, paced (1 ms apart, or spread over --span seconds; far below the SDK server's 1024-message
    backlog), writing the same bytes with the same log time to --mcap (the Foxglove SDK's MCAP
    writer), then closes the MCAP and prints {"sent": N};
 4. exits when the client has unsubscribed from every expected topic (or after --wait seconds).
@@ -163,6 +163,8 @@ def main():
     ap.add_argument("--expect", action="append", default=[],
                     help="topic the client must subscribe before publishing (repeatable; default all)")
     ap.add_argument("--wait", type=float, default=20.0, help="seconds to wait for subscriptions")
+    ap.add_argument("--span", type=float, default=0.0,
+                    help="spread the publishing over this many seconds (default: 1 ms apart)")
     args = ap.parse_args()
     topics = script()
     expected = set(args.expect or [t[0] for t in topics])
@@ -191,6 +193,12 @@ def main():
 
 def say(obj):
     print(json.dumps(obj), flush=True)
+
+
+def pause(args, topics):
+    """Seconds between two messages: 1 ms, or `--span` over all of them."""
+    count = sum(len(t[4]) for t in topics)
+    return max(0.001, args.span / count) if args.span > 0 else 0.001
 
 
 def paced(topics):
@@ -225,7 +233,7 @@ def run_sdk(args, topics, channels, context, writer, expected, total):
     for ns, topic, data in paced(topics):
         channels[topic].log(data, log_time=ns)
         sent += topic in expected
-        time.sleep(0.001)
+        time.sleep(pause(args, topics))
     writer.close()
     say({"sent": sent})
     with lock:
@@ -280,7 +288,7 @@ async def run_legacy(args, topics, channels, writer, expected, total):
             await server.send_message(ids[topic], ns, data)
             channels[topic].log(data, log_time=ns)
             sent += topic in expected
-            await asyncio.sleep(0.001)
+            await asyncio.sleep(pause(args, topics))
         writer.close()
         say({"sent": sent})
         await until(lambda: not (expected & subscribed))

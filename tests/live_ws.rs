@@ -65,12 +65,25 @@ struct Peer {
 
 impl Peer {
     fn start(python: &Path, server: &str, dir: &Path, expect: &[&str]) -> Peer {
+        Self::start_spread(python, server, dir, expect, 0.0)
+    }
+
+    /// A peer that spreads its publishing over `span` seconds (0: 1 ms apart).
+    fn start_spread(python: &Path, server: &str, dir: &Path, expect: &[&str], span: f64) -> Peer {
         let mcap = dir.join(format!("peer-{server}.mcap"));
         let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/live_peer.py");
         let mut command = Command::new(python);
         command
             .arg(script)
-            .args(["--server", server, "--wait", "30", "--mcap"])
+            .args([
+                "--server",
+                server,
+                "--wait",
+                "30",
+                "--span",
+                &span.to_string(),
+            ])
+            .arg("--mcap")
             .arg(&mcap);
         for topic in expect {
             command.args(["--expect", topic]);
@@ -317,6 +330,73 @@ fn a_live_recording_saved_as_rrd_verifies_and_se3_is_refused() {
     verify_rrd(&rrd);
     peer.finish();
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The view grows while messages arrive: a recording saved from a run of a few seconds holds
+/// several generations of the log view (each re-streamed in place, its σ series under
+/// `plots/<plot>/g<N>/`), and the last is the one-shot drawing of the same messages (the
+/// recorded MCAP's, drawn whole).
+#[test]
+fn a_live_view_grows_and_its_last_generation_is_the_one_shot_drawing() {
+    let Some(python) = peer_python() else { return };
+    let dir = scratch("grow");
+    let peer = Peer::start_spread(&python, "sdk", &dir, &POSE_TOPICS, 6.0);
+    let (rrd, record, whole) = (
+        dir.join("grow.rrd"),
+        dir.join("grow.mcap"),
+        dir.join("whole.rrd"),
+    );
+    let (rrd_s, record_s) = (rrd.display().to_string(), record.display().to_string());
+    let n = peer.messages.to_string();
+    let (url, limit) = (peer.url(), ["--duration", "90s", "--messages", &n]);
+    let out = posecov(&[
+        &url, &limit[0], &limit[1], &limit[2], &limit[3], "--record", &record_s, "--save", &rrd_s,
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    peer.finish();
+    verify_rrd(&rrd);
+    let out = posecov(&[&record_s, "--save", &whole.display().to_string()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let grown = rrd::recording_chunks(&std::fs::read(&rrd).expect("the recording"));
+    let generations: std::collections::BTreeSet<u64> = grown
+        .iter()
+        .filter_map(|c| {
+            let p = c.entity_path().to_string();
+            let rest = p.strip_prefix("/plots/")?.split_once('/')?.1;
+            rest.strip_prefix('g')?.split_once('/')?.0.parse().ok()
+        })
+        .collect();
+    assert!(
+        generations.len() > 1,
+        "one generation only: {generations:?}"
+    );
+    let last = generations.last().expect("a generation");
+    let one_shot = rrd::recording_chunks(&std::fs::read(&whole).expect("the one-shot recording"));
+    let newest = series(&grown, &format!("g{last}/"));
+    assert!(!newest.is_empty());
+    assert_eq!(newest, series(&one_shot, ""));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Every σ series with points: its plot and path below the plot (past `prefix`), its rows and
+/// their values.
+fn series(chunks: &[rerun::log::Chunk], prefix: &str) -> Vec<(String, usize, String)> {
+    let scalars = rerun::Scalars::descriptor_scalars().component;
+    let mut v: Vec<(String, usize, String)> = chunks
+        .iter()
+        .filter(|c| !c.is_static())
+        .filter_map(|c| {
+            let p = c.entity_path().to_string();
+            let (plot, tail) = p.strip_prefix("/plots/")?.split_once('/')?;
+            let tail = tail.strip_prefix(prefix)?;
+            let values: Vec<String> = (0..c.num_rows())
+                .map(|row| format!("{:?}", c.component_batch_raw(scalars, row)))
+                .collect();
+            (c.num_rows() > 1).then(|| (format!("{plot}/{tail}"), c.num_rows(), values.join(";")))
+        })
+        .collect();
+    v.sort();
+    v
 }
 
 #[test]

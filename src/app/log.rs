@@ -21,7 +21,7 @@ use super::run::RunOptions;
 use super::settings::LogSettings;
 use crate::draw::log::{LogDrawSettings, description, draw_log, issue_sentence, issue_word};
 use crate::eval::log::{LogEvaluation, evaluate_log};
-use crate::input::log::{LogOptions, bundled, read_located_observed};
+use crate::input::log::{LogOptions, bundled, read_located_growing};
 use crate::input::{About, Format, InputError, Located, Place};
 use crate::interop::RosReading;
 use crate::plan::log::LogObserver;
@@ -54,6 +54,7 @@ pub(super) fn run(
     located: &Located,
     settings: &LogSettings,
     options: &RunOptions,
+    mut growing: Option<&mut dyn FnMut(&Scene)>,
 ) -> Result<LogRun, AppError> {
     let (cancel, bar, drawn) = (options.cancel.as_deref(), options.progress, options.draw);
     let file = located.origin();
@@ -79,11 +80,6 @@ pub(super) fn run(
     let observer = reference
         .as_mut()
         .map(|r| &mut r.observer as &mut dyn LogObserver);
-    let mut plan = read(located, &options, cancel, bar, observer)?;
-    let mut evaluation = evaluate_log(&mut plan, &settings.eval);
-    if let Some(reference) = reference {
-        evaluation = evaluation.with_consistency(nees::finish(reference, &plan, &file)?);
-    }
     let title = match &located.place {
         Place::Bundled(e) => bundled::find(e.name).map_or(e.name, |l| l.title).to_owned(),
         Place::File(_) | Place::Live(_) => file.clone(),
@@ -92,21 +88,31 @@ pub(super) fn run(
         about: About {
             title,
             description: String::new(),
-            source: file,
+            source: file.clone(),
         },
         confidence: settings.confidence,
         axis_length: None,
     };
-    let summary = description(
-        &plan,
-        match &located.place {
-            // Its channels are MCAP channels, but it is no file.
-            Place::Live(_) => "Live stream (Foxglove WebSocket)",
-            _ => located.format.name(),
-        },
-        &evaluation,
-        settings.confidence,
-    );
+    let growing_wanted = drawn && growing.is_some();
+    // What the stream has given so far, evaluated and drawn as the end's summary is (its NEES
+    // waits for the end: the observer is the read's); an undrawable one is left out.
+    let mut grow = |mut plan: LogSummary| {
+        if let Some(show) = growing.as_mut() {
+            let evaluation = evaluate_log(&mut plan, &settings.eval);
+            let summary = describe(located, &plan, &evaluation, settings.confidence);
+            let scene = draw_log(&evaluation, &draw, &summary);
+            if scene.validate().is_ok() {
+                show(&scene);
+            }
+        }
+    };
+    let grow = growing_wanted.then_some(&mut grow as &mut dyn FnMut(LogSummary));
+    let mut plan = read(located, &options, cancel, bar, observer, grow)?;
+    let mut evaluation = evaluate_log(&mut plan, &settings.eval);
+    if let Some(reference) = reference {
+        evaluation = evaluation.with_consistency(nees::finish(reference, &plan, &file)?);
+    }
+    let summary = describe(located, &plan, &evaluation, settings.confidence);
     let scene = if drawn {
         let scene = draw_log(&evaluation, &draw, &summary);
         scene
@@ -123,6 +129,21 @@ pub(super) fn run(
         evaluation,
         scene,
     })
+}
+
+/// The text panel's description of a log read (so far).
+fn describe(
+    located: &Located,
+    plan: &LogSummary,
+    evaluation: &LogEvaluation,
+    confidence: crate::uncertain::Confidence,
+) -> String {
+    let kind = match &located.place {
+        // Its channels are MCAP channels, but it is no file.
+        Place::Live(_) => "Live stream (Foxglove WebSocket)",
+        _ => located.format.name(),
+    };
+    description(plan, kind, evaluation, confidence)
 }
 
 /// A log's scene that cannot be drawn (a number beyond what the viewer holds, `f32`, that
@@ -164,6 +185,7 @@ fn read(
     cancel: Option<&std::sync::atomic::AtomicBool>,
     shown: bool,
     observer: Option<&mut dyn LogObserver>,
+    grow: Option<&mut dyn FnMut(LogSummary)>,
 ) -> Result<LogSummary, AppError> {
     let file = located.origin();
     let bar = if shown {
@@ -176,7 +198,7 @@ fn read(
         ProgressStyle::with_template("{msg} {wide_bar} {percent} % ({elapsed}, eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let plan = read_located_observed(
+    let plan = read_located_growing(
         located,
         options,
         &mut |done, total| {
@@ -185,6 +207,7 @@ fn read(
         },
         cancel,
         observer,
+        grow,
     );
     bar.finish_and_clear();
     let plan = plan?;

@@ -209,6 +209,22 @@ impl Run {
         overrides: &Overrides,
         options: RunOptions,
     ) -> Result<Run, AppError> {
+        Self::start_growing(opened, overrides, options, None)
+    }
+
+    /// [`Run::start`], and for a live stream that is drawn each scene of what has arrived so
+    /// far handed to `growing` while it is read (at most once per
+    /// [`growth_interval`](crate::input::log::growth_interval)); the run's own scene is the
+    /// end's.
+    ///
+    /// # Errors
+    /// As [`Run::start`].
+    pub(crate) fn start_growing(
+        opened: Opened,
+        overrides: &Overrides,
+        options: RunOptions,
+        growing: Option<&mut dyn FnMut(&Scene)>,
+    ) -> Result<Run, AppError> {
         match opened {
             Opened::Plan(loaded) => {
                 let what = format!("evaluating {}", loaded.input.about.title);
@@ -242,7 +258,7 @@ impl Run {
                             .to_owned(),
                     }));
                 }
-                log::run(&located, &settings, &options).map(|run| Run::Log(Box::new(run)))
+                log::run(&located, &settings, &options, growing).map(|run| Run::Log(Box::new(run)))
             }
         }
     }

@@ -14,9 +14,10 @@ use super::sinks::{
     EXIT_INTERRUPTED, ViewOptions, choose_sink, finish, flush, render_with, scenario_name, serve,
     watch_file,
 };
-use super::{AppError, Overrides};
+use super::{AppError, Overrides, RobotLog, resolve};
+use crate::input::Place;
 use crate::scene::Scene;
-use crate::sink::{self, LogOutcome, RecordingIds, Sink, open_stream};
+use crate::sink::{self, LogOutcome, RecordingIds, Restream, Sink, SinkGuard, open_stream};
 
 impl Run {
     /// Logs the scene, then the clouds of any later Monte Carlo blocks one block at a time
@@ -121,6 +122,12 @@ pub(crate) fn show(
     opened: Opened,
     cancel: &Arc<AtomicBool>,
 ) -> Result<u8, AppError> {
+    if options.png.is_none()
+        && let Opened::Log(located) = &opened
+        && matches!(located.place, Place::Live(_))
+    {
+        return show_growing(options, opened, cancel);
+    }
     let run = Run::start(
         opened,
         &options.overrides,
@@ -138,6 +145,68 @@ pub(crate) fn show(
         println!("Web viewer: {url}");
     }
     let outcome = run.log(&rec, cancel)?;
+    if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
+        serve(&options.serve, &guard, cancel)?;
+    }
+    finish(guard, rec, &sink, outcome).map(|code| run.exit_code(code))
+}
+
+/// A live stream shown as it grows: the sink opens with the first scene of what has arrived,
+/// each later one (at most once per [`growth_interval`](crate::input::log::growth_interval))
+/// and at last the run's own scene replace it in place ([`Restream`]: the viewer keeps its
+/// camera, a recording holds one generation per scene). Returns the exit code.
+///
+/// # Errors
+/// The input's error; the sink's (the first one stops the drawing, the read goes on to its
+/// end and the error is returned then).
+fn show_growing(
+    options: &ViewOptions,
+    opened: Opened,
+    cancel: &Arc<AtomicBool>,
+) -> Result<u8, AppError> {
+    let seed = resolve(RobotLog, &options.overrides, None)?.eval.seed;
+    let ids = RecordingIds::for_scenario(&scenario_name(&options.scenario), seed);
+    let sink = choose_sink(options)?;
+    let mut shown: Option<(rerun::RecordingStream, SinkGuard, Restream)> = None;
+    let mut failed: Option<AppError> = None;
+    let never = AtomicBool::new(false);
+    let mut show = |scene: &Scene, cancel: &AtomicBool| -> Result<LogOutcome, AppError> {
+        let (rec, _, restream) = match &mut shown {
+            Some(open) => open,
+            None => {
+                let (rec, guard) = open_stream(&sink, &ids, scene)?;
+                if let Some(url) = guard.viewer_url() {
+                    println!("Web viewer: {url}");
+                }
+                shown.insert((rec, guard, Restream::new()))
+            }
+        };
+        let outcome = restream.log(rec, scene.clone(), cancel)?;
+        flush(rec)?;
+        Ok(outcome)
+    };
+    let mut grown = |scene: &Scene| {
+        if failed.is_none()
+            && let Err(e) = show(scene, &never)
+        {
+            failed = Some(e);
+        }
+    };
+    let run = Run::start_growing(
+        opened,
+        &options.overrides,
+        RunOptions::shown().cancelled_by(Arc::clone(cancel)),
+        Some(&mut grown),
+    );
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let run = run?;
+    let outcome = show(run.scene(), cancel)?;
+    report_interrupted(outcome);
+    let Some((rec, guard, _)) = shown else {
+        unreachable!("the run's scene was shown, so the sink is open");
+    };
     if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
         serve(&options.serve, &guard, cancel)?;
     }

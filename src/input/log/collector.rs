@@ -1,15 +1,17 @@
 //! The one collector every log reader feeds ([`Collector`]): each stream (a ROS 1
 //! connection, an MCAP channel, a live stream's channel) declared with what posecov makes of
 //! it ([`Stream`]), then every message in order — pose topics decoded and counted, the
-//! reference and `/tf` kept — and at the end the bounded [`LogSummary`].
+//! reference and `/tf` kept — and at the end the bounded [`LogSummary`]. A live stream's
+//! reader also asks it, as messages arrive, for the summary so far ([`Collector::grow`]).
 
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use crate::plan::log::{
     EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessage, PoseMessageKind, ReferenceInLog,
-    ReferenceRead, SkippedTopic,
+    ReferenceRead, SkippedTopic, StreamNotes,
 };
 
 use super::reference::{self, ReferenceType};
@@ -50,6 +52,28 @@ pub(super) struct Collector<'a, 'o> {
     /// Where a read without an index stopped before the file's end.
     pub(super) cut: Option<LogCut>,
     tf: tf::TfCollector,
+    /// Where the summary so far goes while a live stream is read, when the read began and
+    /// when the next summary is due.
+    growth: Option<Growth<'o>>,
+}
+
+/// A growing read's hook ([`Collector::growing`]), when the read began, when the hook is due.
+type Growth<'o> = (&'o mut dyn FnMut(LogSummary), Instant, Option<Instant>);
+
+/// How long after the last summary was shown ([`Collector::grow`]) the next one is due,
+/// `elapsed` into the read: every second, and once the read is past 100 s every hundredth of
+/// its age (an hour: every 36 s), so a long run hands on about 100 · (1 + ln(age / 100 s))
+/// summaries, each bounded as the summary is: what drawing them costs does not grow with the
+/// messages, and their number grows with the logarithm of the run's length.
+///
+/// ```
+/// use std::time::Duration;
+/// use posecov::input::log::growth_interval;
+/// assert_eq!(growth_interval(Duration::from_secs(5)), Duration::from_secs(1));
+/// assert_eq!(growth_interval(Duration::from_secs(3600)), Duration::from_secs(36));
+/// ```
+pub fn growth_interval(elapsed: Duration) -> Duration {
+    (elapsed / 100).max(Duration::from_secs(1))
 }
 
 impl<'a, 'o> Collector<'a, 'o> {
@@ -70,6 +94,49 @@ impl<'a, 'o> Collector<'a, 'o> {
             reference: options.reference.as_ref().map(|_| ReferenceRead::default()),
             cut: None,
             tf: tf::TfCollector::default(),
+            growth: None,
+        }
+    }
+
+    /// The same collector, handing the summary so far to `show` when [`Self::grow`] finds one
+    /// due.
+    pub(super) fn growing(mut self, show: Option<&'o mut dyn FnMut(LogSummary)>) -> Self {
+        self.growth = show.map(|show| (show, Instant::now(), None));
+        self
+    }
+
+    /// Hands the summary read so far (with the stream's `notes`) to the `show` of
+    /// [`Self::growing`] when one is due and a pose message has arrived: a copy of the bounded
+    /// state, the collector goes on unchanged. The next is due [`growth_interval`] after this
+    /// one was shown, or four times what showing it took if longer (redraws take at most a
+    /// fifth of the time, whatever the machine).
+    pub(super) fn grow(&mut self, notes: &StreamNotes) {
+        let Some((_, _, next)) = &self.growth else {
+            return;
+        };
+        if next.is_some_and(|at| Instant::now() < at) {
+            return;
+        }
+        let mut plan = assemble(
+            self.topics.clone(),
+            self.skipped.clone(),
+            self.not_selected.clone(),
+            self.total,
+            self.cancelled,
+            self.reference.clone(),
+            self.cut.clone(),
+            self.tf.clone().finish(),
+        );
+        if plan.topics.iter().all(|t| t.count == 0) {
+            return;
+        }
+        plan.stream = Some(notes.clone());
+        if let Some((show, started, next)) = &mut self.growth {
+            let before = Instant::now();
+            show(plan);
+            // The reading gets at least four fifths of the time, however long a redraw takes.
+            let cost = before.elapsed();
+            *next = Some(Instant::now() + growth_interval(started.elapsed()).max(4 * cost));
         }
     }
 
@@ -305,14 +372,7 @@ impl<'a, 'o> Collector<'a, 'o> {
         });
     }
 
-    pub(super) fn finish(mut self, path: &Path) -> Result<LogSummary, InputError> {
-        // A topic declared (or first seen) with another type before its pose messages: those
-        // messages are the pose topic's type change, not a topic of their own.
-        for (name, state) in &mut self.topics {
-            if let Some((label, count, first)) = self.skipped.remove(name) {
-                state.other_type_before(label, count, first);
-            }
-        }
+    pub(super) fn finish(self, path: &Path) -> Result<LogSummary, InputError> {
         for wanted in &self.options.topics {
             if !self.topics.contains_key(wanted) && !self.cancelled {
                 let why = match self.skipped.get(wanted) {
@@ -341,29 +401,58 @@ impl<'a, 'o> Collector<'a, 'o> {
                 });
             }
         }
-        Ok(LogSummary {
-            topics: self
-                .topics
-                .into_iter()
-                .map(|(name, s)| s.into_plan(name))
-                .collect(),
-            skipped: self
-                .skipped
-                .into_iter()
-                .map(|(name, (message_type, count, _))| SkippedTopic {
-                    name,
-                    message_type,
-                    count,
-                })
-                .collect(),
-            not_selected: self.not_selected.into_keys().collect(),
-            messages_total: self.total,
-            cancelled: self.cancelled,
-            reference: self.reference,
-            cut: self.cut,
-            stream: None,
-            tf: self.tf.finish(),
-        })
+        Ok(assemble(
+            self.topics,
+            self.skipped,
+            self.not_selected,
+            self.total,
+            self.cancelled,
+            self.reference,
+            self.cut,
+            self.tf.finish(),
+        ))
+    }
+}
+
+/// The [`LogSummary`] of a collector's parts (at the end, or a copy while a stream grows).
+#[allow(clippy::too_many_arguments)]
+fn assemble(
+    mut topics: BTreeMap<String, TopicState>,
+    mut skipped: BTreeMap<String, (String, u64, i64)>,
+    not_selected: BTreeMap<String, ()>,
+    total: u64,
+    cancelled: bool,
+    reference: Option<ReferenceRead>,
+    cut: Option<LogCut>,
+    tf: crate::plan::log::TfTree,
+) -> LogSummary {
+    // A topic declared (or first seen) with another type before its pose messages: those
+    // messages are the pose topic's type change, not a topic of their own.
+    for (name, state) in &mut topics {
+        if let Some((label, count, first)) = skipped.remove(name) {
+            state.other_type_before(label, count, first);
+        }
+    }
+    LogSummary {
+        topics: topics
+            .into_iter()
+            .map(|(name, s)| s.into_plan(name))
+            .collect(),
+        skipped: skipped
+            .into_iter()
+            .map(|(name, (message_type, count, _))| SkippedTopic {
+                name,
+                message_type,
+                count,
+            })
+            .collect(),
+        not_selected: not_selected.into_keys().collect(),
+        messages_total: total,
+        cancelled,
+        reference,
+        cut,
+        stream: None,
+        tf,
     }
 }
 

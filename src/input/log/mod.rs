@@ -41,6 +41,7 @@ mod tf;
 mod topic;
 pub mod ws;
 
+pub use collector::growth_interval;
 use collector::{Codec, Collector, Stream};
 use topic::no_pose_topic;
 
@@ -145,11 +146,39 @@ pub fn read_located_observed(
     cancel: Option<&AtomicBool>,
     observer: Option<&mut dyn LogObserver>,
 ) -> Result<LogSummary, InputError> {
+    read_located_growing(located, options, progress, cancel, observer, None)
+}
+
+/// [`read_located_observed`], and for a live stream the summary read so far handed to
+/// `grow` as messages arrive, at most once per [`growth_interval`] (a file is read whole:
+/// `grow` is not called). Each is a bounded copy (the drawn set, series and statistics as
+/// the end's summary keeps them), `stream` with the stream's notes so far; what the observer
+/// saw is not in it.
+///
+/// ```
+/// use posecov::input::{locate, log::{LogOptions, read_located_growing}};
+/// let log = locate("covariance_health").unwrap();
+/// let mut grown = 0;
+/// let plan = read_located_growing(&log, &LogOptions::default(), &mut |_, _| {}, None, None,
+///     Some(&mut |_| grown += 1)).unwrap();
+/// assert_eq!((plan.topics.len(), grown), (3, 0));
+/// ```
+pub fn read_located_growing(
+    located: &Located,
+    options: &LogOptions,
+    progress: &mut dyn FnMut(u64, u64),
+    cancel: Option<&AtomicBool>,
+    observer: Option<&mut dyn LogObserver>,
+    grow: Option<&mut dyn FnMut(LogSummary)>,
+) -> Result<LogSummary, InputError> {
     let origin = located.origin();
     let example = match &located.place {
         // A running robot: its topics until a limit, Ctrl-C or the stream's end.
         Place::Live(url) => {
-            let mut collector = Collector::new(options, cancel, observer);
+            // Each hook's borrow shortened to the read's (`&mut dyn` is invariant).
+            let observer = observer.map(|o| o as &mut dyn LogObserver);
+            let grow = grow.map(|g| g as &mut dyn FnMut(LogSummary));
+            let mut collector = Collector::new(options, cancel, observer).growing(grow);
             let notes = ws::read(url, &options.live, &mut collector, progress)?;
             let mut plan = summary(collector, ws::origin(url))?;
             plan.stream = Some(notes);

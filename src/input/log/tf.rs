@@ -14,7 +14,7 @@ use crate::plan::log::{
 pub(super) const TF_TOPICS: [&str; 2] = ["/tf", "/tf_static"];
 
 /// The transforms read so far.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(super) struct TfCollector {
     /// Per edge: the edge, its kept `/tf` samples and its `/tf` transforms read.
     edges: Vec<(TfEdge, Decimator<ReferenceSample>, u64)>,

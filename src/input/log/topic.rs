@@ -21,7 +21,8 @@ pub(super) struct Added {
     pub(super) unestimated: [bool; 6],
 }
 
-/// The per-topic streaming state.
+/// The per-topic streaming state (cloned for the summary so far of a growing live read).
+#[derive(Clone)]
 pub(super) struct TopicState {
     pub(super) kind: PoseMessageKind,
     frame_id: Option<String>,

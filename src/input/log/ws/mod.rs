@@ -261,6 +261,7 @@ impl Session {
                 }
                 last_progress = Instant::now();
             }
+            collector.grow(&self.notes);
             let frame = match client::read(socket)? {
                 Read::Idle => continue,
                 Read::Closed(why) => return Ok(Some(why)),
