@@ -14,7 +14,8 @@ use crate::plan::log::{
     ReferenceRead, SkippedTopic, StreamNotes,
 };
 
-use super::reference::{self, ReferenceType};
+use super::decode::{ros1_kind, ros2_kind};
+use super::reference::{self, ReferenceType, ros1_reference_type, ros2_reference_type};
 use super::topic::TopicState;
 use super::{InputError, LogOptions, decode, tf};
 use crate::input::suggest;
@@ -35,6 +36,49 @@ pub(super) struct Stream {
 pub(crate) enum Codec {
     Ros1,
     Cdr,
+}
+
+impl Stream {
+    /// A channel of schema name `schema` in `encoding` (an MCAP channel, a live stream's
+    /// channel): `cdr` reads the ROS 2 name, `ros1` the ROS 1 name with its definition taken
+    /// by name (`mcap convert` of a ROS 1 bag writes no MD5 sum); a pose or reference type in
+    /// any other encoding is named with `other`'s words, and read as nothing.
+    pub(super) fn of_channel(
+        topic: String,
+        schema: String,
+        encoding: &str,
+        other: impl Fn() -> String,
+    ) -> (Stream, Codec) {
+        let (kind, reference, codec) = match encoding {
+            "cdr" => (
+                ros2_kind(&schema).map(Ok),
+                ros2_reference_type(&schema).map(Ok),
+                Codec::Cdr,
+            ),
+            "ros1" => (
+                ros1_kind(&schema, "*"),
+                ros1_reference_type(&schema, "*"),
+                Codec::Ros1,
+            ),
+            _ => (
+                ros2_kind(&schema).map(|_| Err(other())),
+                ros2_reference_type(&schema).map(|_| Err(other())),
+                Codec::Cdr,
+            ),
+        };
+        let type_name = if schema.is_empty() {
+            format!("(no schema, {encoding} encoding)")
+        } else {
+            schema
+        };
+        let stream = Stream {
+            topic,
+            type_name,
+            kind,
+            reference,
+        };
+        (stream, codec)
+    }
 }
 
 /// Receives every message of a log in file order.

@@ -17,9 +17,7 @@ use std::path::Path;
 
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
-use super::decode::{ros1_kind, ros2_kind};
 use super::mcap_records::{ChunkHeader, McapRecord, parse};
-use super::reference::{ros1_reference_type, ros2_reference_type};
 use super::{Codec, Collector, RECORD_LIMIT, Stream};
 use crate::input::InputError;
 
@@ -144,36 +142,8 @@ impl Streams {
                         "{schema} in {message_encoding} encoding (schema {encoding}); posecov reads cdr or ros1"
                     )
                 };
-                // `mcap convert` of a ROS 1 bag writes ROS 1 names and bytes (no MD5 sum:
-                // the definition is the schema's text).
-                let (kind, reference, codec) = match message_encoding.as_str() {
-                    "cdr" => (
-                        ros2_kind(&schema).map(Ok),
-                        ros2_reference_type(&schema).map(Ok),
-                        Codec::Cdr,
-                    ),
-                    "ros1" => (
-                        ros1_kind(&schema, "*"),
-                        ros1_reference_type(&schema, "*"),
-                        Codec::Ros1,
-                    ),
-                    _ => (
-                        ros2_kind(&schema).map(|_| Err(other())),
-                        ros2_reference_type(&schema).map(|_| Err(other())),
-                        Codec::Cdr,
-                    ),
-                };
-                let type_name = if schema.is_empty() {
-                    format!("(no schema, {message_encoding} encoding)")
-                } else {
-                    schema
-                };
-                let stream = Stream {
-                    topic,
-                    type_name,
-                    kind,
-                    reference,
-                };
+                let (stream, codec) =
+                    Stream::of_channel(topic, schema.clone(), &message_encoding, other);
                 collector.declare_stream(&stream);
                 let at = usize::from(id);
                 if self.channels.len() <= at {

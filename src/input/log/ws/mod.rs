@@ -32,8 +32,6 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use super::decode::{ros1_kind, ros2_kind};
-use super::reference::{ros1_reference_type, ros2_reference_type};
 use super::{Codec, Collector, Stream};
 use crate::input::InputError;
 
@@ -104,37 +102,7 @@ fn stream_of(channel: &Channel) -> (Stream, Codec) {
     let schema = channel.schema_name.clone();
     let encoding = channel.encoding.as_str();
     let other = || format!("{schema} in {encoding} encoding; posecov reads cdr or ros1");
-    let (kind, reference, codec) = match encoding {
-        "cdr" => (
-            ros2_kind(&schema).map(Ok),
-            ros2_reference_type(&schema).map(Ok),
-            Codec::Cdr,
-        ),
-        "ros1" => (
-            ros1_kind(&schema, "*"),
-            ros1_reference_type(&schema, "*"),
-            Codec::Ros1,
-        ),
-        _ => (
-            ros2_kind(&schema).map(|_| Err(other())),
-            ros2_reference_type(&schema).map(|_| Err(other())),
-            Codec::Cdr,
-        ),
-    };
-    let type_name = if schema.is_empty() {
-        format!("(no schema, {encoding} encoding)")
-    } else {
-        schema
-    };
-    (
-        Stream {
-            topic: channel.topic.clone(),
-            type_name,
-            kind,
-            reference,
-        },
-        codec,
-    )
+    Stream::of_channel(channel.topic.clone(), schema.clone(), encoding, other)
 }
 
 /// Whether posecov subscribes to a stream: a chosen pose topic, the reference, or `/tf`.
