@@ -350,7 +350,7 @@ fn a_live_view_grows_and_its_last_generation_is_the_one_shot_drawing() {
     let n = peer.messages.to_string();
     let (url, limit) = (peer.url(), ["--duration", "90s", "--messages", &n]);
     let out = posecov(&[
-        &url, &limit[0], &limit[1], &limit[2], &limit[3], "--record", &record_s, "--save", &rrd_s,
+        &url, limit[0], limit[1], limit[2], limit[3], "--record", &record_s, "--save", &rrd_s,
     ]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     peer.finish();

@@ -216,6 +216,10 @@ fn judge(text: &str, run: Run<Result<Output, String>>, limits: &Limits) -> Vec<F
                 ".optimized.loop_closures[#].relative_covariance",
                 ".optimized.joints[#].covariance",
                 ".optimized.joints[#].relative_covariance",
+                // No σ: a vertex held fixed or not connected (after), or one the graph
+                // without its loop closures does not reach (before).
+                ".optimized.poses[#].sigma",
+                ".optimized.poses[#].sigma_before",
             ];
             if let Some(path) = json_null(&out.json, &optional) {
                 found.push(finding("nonfinite_json", format!("null at {path}")));

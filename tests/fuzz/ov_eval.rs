@@ -181,10 +181,10 @@ fn judge(file: &str, text: &str, run: Run<Outcome>, limits: &Limits) -> Vec<Find
         .collect();
     judged.dedup_by(|a, b| a.class == "error_ok" && b.class == "error_ok");
     found.extend(judged);
-    if let Ok(json) = &estimate {
-        if let Some(path) = json_null(json, crate::logs::LOG_JSON_OPTIONAL) {
-            found.push(finding("nonfinite_json", format!("null at {path}")));
-        }
+    if let Ok(json) = &estimate
+        && let Some(path) = json_null(json, crate::logs::LOG_JSON_OPTIONAL)
+    {
+        found.push(finding("nonfinite_json", format!("null at {path}")));
     }
     // Whatever a read accepted has only lines it reads.
     if estimate.is_ok() || reference.is_ok() {

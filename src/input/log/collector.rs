@@ -104,7 +104,7 @@ pub(super) struct Collector<'a, 'o> {
 /// A growing read's hook ([`Collector::growing`]), when the read began, when the hook is due.
 type Growth<'o> = (&'o mut dyn FnMut(LogSummary), Instant, Option<Instant>);
 
-/// How long after the last summary was shown ([`Collector::grow`]) the next one is due,
+/// How long after the last summary was shown (the collector's `grow`) the next one is due,
 /// `elapsed` into the read: every second, and once the read is past 100 s every hundredth of
 /// its age (an hour: every 36 s), so a long run hands on about 100 · (1 + ln(age / 100 s))
 /// summaries, each bounded as the summary is: what drawing them costs does not grow with the
