@@ -115,12 +115,10 @@ pub struct Link {
     pub to: String,
 }
 
-/// What a pose graph file holds, as facts: the drawing stage writes the graph's description
-/// from them (its `input_description`); the input stage writes no words.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct GraphFacts {
-    /// SE(2) vertices (else SE(3)).
-    pub planar: bool,
+/// The counts a pose graph file holds: for messages, the text panel and `report --json`'s
+/// `input` (serialised as they stand).
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize)]
+pub struct GraphCounts {
     /// Vertices.
     pub vertices: usize,
     /// Edges.
@@ -129,10 +127,21 @@ pub struct GraphFacts {
     pub chain_edges: usize,
     /// Loop closures (every other edge).
     pub loop_closures: usize,
-    /// Loop closures drawn.
+    /// Loop closures evaluated and drawn with their uncertainty (at most the graph reader's
+    /// bound on drawn loop closures).
     pub loop_closures_drawn: usize,
-    /// Vertex estimates drawn.
+    /// Vertex estimates drawn as axes (at most 300, plus the drawn loop closures' ends).
     pub vertices_drawn: usize,
+}
+
+/// What a pose graph file holds, as facts: the drawing stage writes the graph's description
+/// from them (its `input_description`); the input stage writes no words.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GraphFacts {
+    /// SE(2) vertices (else SE(3)).
+    pub planar: bool,
+    /// Its counts.
+    pub counts: GraphCounts,
     /// The first vertex id: where the chain starts.
     pub first: u64,
     /// The vertex id the chain ends at.

@@ -8,7 +8,7 @@ use crate::plan::choices::{GraphFacts, SkippedRecords};
 /// `report --json`'s `meta.description`).
 pub(in crate::draw) fn description(f: &GraphFacts) -> String {
     let (first, chain_end) = (f.first, f.chain_end);
-    let chain = if f.chain_edges == 0 {
+    let chain = if f.counts.chain_edges == 0 {
         format!(
             "- **No odometry chain**: no edge joins v{first} to v{}, so nothing is propagated.\n",
             first.saturating_add(1)
@@ -20,7 +20,7 @@ pub(in crate::draw) fn description(f: &GraphFacts) -> String {
              covariance (first order in colour, Monte Carlo as the cloud). Scrub the `step` \
              timeline: step k is vertex v{first}+k, and the banana grows as the errors of every \
              edge add up.\n",
-            f.chain_edges
+            f.counts.chain_edges
         )
     };
     let mut d = format!(
@@ -29,24 +29,24 @@ pub(in crate::draw) fn description(f: &GraphFacts) -> String {
          chain's mean, the file's estimate is not dead reckoning (e.g. it was optimised).\n\
          - **Loop closures** (the other {} edges): a grey line between the two vertices, and \
          `v<j>_via_v<i>` = X_i · Z, where edge i → j puts vertex j, with the edge's own uncertainty.\n",
-        f.vertices,
-        f.edges,
+        f.counts.vertices,
+        f.counts.edges,
         if f.planar { "SE(2)" } else { "SE(3)" },
-        f.loop_closures,
+        f.counts.loop_closures,
     );
-    if f.vertices_drawn < f.vertices {
+    if f.counts.vertices_drawn < f.counts.vertices {
         d.push_str(&format!(
             "\n{} of the {} vertex estimates are drawn (evenly chosen, and the drawn loop closures' ends).\n",
-            f.vertices_drawn, f.vertices
+            f.counts.vertices_drawn, f.counts.vertices
         ));
     }
-    if f.loop_closures_drawn < f.loop_closures {
+    if f.counts.loop_closures_drawn < f.counts.loop_closures {
         d.push_str(&format!(
             "\n{} of the {} loop closures are drawn (evenly chosen).\n",
-            f.loop_closures_drawn, f.loop_closures
+            f.counts.loop_closures_drawn, f.counts.loop_closures
         ));
     }
-    if f.chain_edges > 0 && f.vertices as u64 > chain_end - first + 1 {
+    if f.counts.chain_edges > 0 && f.counts.vertices as u64 > chain_end - first + 1 {
         d.push_str(&format!(
             "\nThe chain stops at v{chain_end}: no edge joins it to v{} (the later vertices are \
              drawn, not propagated).\n",

@@ -10,10 +10,10 @@ use super::convention::{
 };
 use super::parse::{Dimension, Kind, Record, Records, information_axes};
 use super::problem::{Edge, Prior, chain_initial_guess, pose_graph};
-use super::{InputError, Locator, Summary};
+use super::{InputError, Locator};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
-use crate::plan::choices::{GraphFacts, Link, SkippedRecords};
+use crate::plan::choices::{GraphCounts, GraphFacts, Link, SkippedRecords};
 use crate::plan::{
     AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, StepPolicy, limits,
 };
@@ -69,7 +69,7 @@ impl GraphGroup<6> for Se3 {
 }
 
 /// The plan, the line of each operation's edge, and the counts.
-pub(super) type Lowered = (Input, Vec<usize>, Summary);
+pub(super) type Lowered = (Input, Vec<usize>, GraphCounts);
 
 pub(super) fn lower(locator: &Locator, records: &Records) -> Result<Lowered, InputError> {
     let first = records.records.iter().find(|r| r.tag.kind != Kind::Fix);
@@ -368,7 +368,7 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         operation_lines.push(edges[i].line);
     }
     choices.axis_length = axis_length(&chain);
-    let summary = Summary {
+    let summary = GraphCounts {
         vertices: vertices.len(),
         edges: edges.len(),
         chain_edges: chain.len(),
@@ -378,12 +378,7 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
     };
     choices.graph = Some(GraphFacts {
         planar: G::KIND.is_planar(),
-        vertices: summary.vertices,
-        edges: summary.edges,
-        chain_edges: summary.chain_edges,
-        loop_closures: summary.loop_closures,
-        loop_closures_drawn: summary.loop_closures_drawn,
-        vertices_drawn: summary.vertices_drawn,
+        counts: summary.clone(),
         first,
         chain_end: first + chain.len() as u64,
         chained,

@@ -27,6 +27,7 @@
 use std::path::Path;
 
 use super::{Input, InputError, Locator};
+use crate::plan::choices::GraphCounts;
 
 pub mod bundled;
 pub mod convention;
@@ -39,38 +40,18 @@ pub use lower::MAX_LOOP_CLOSURES;
 /// Largest graph file read (bytes); larger ones are refused before reading.
 pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
 
-/// The counts a graph file holds, for messages, the text panel and `report --json`.
-#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
-pub struct Summary {
-    /// Vertices.
-    pub vertices: usize,
-    /// Edges.
-    pub edges: usize,
-    /// Edges in the odometry chain.
-    pub chain_edges: usize,
-    /// Loop closures (every other edge).
-    pub loop_closures: usize,
-    /// Loop closures evaluated and drawn with their uncertainty (at most
-    /// [`MAX_LOOP_CLOSURES`]).
-    pub loop_closures_drawn: usize,
-    /// Vertex estimates drawn as axes (at most 300, plus the drawn loop closures' ends).
-    /// Each loop closure's residual, before and after the optimisation, is evaluated at the
-    /// chosen confidence by [`crate::eval::graph`].
-    pub vertices_drawn: usize,
-}
-
 /// A read graph file: where its records are (to locate later errors) and what it holds.
 #[derive(Debug, Clone)]
 pub struct Graph {
     locator: Locator,
     /// The line of the edge each plan operation comes from.
     operation_lines: Vec<usize>,
-    summary: Summary,
+    summary: GraphCounts,
 }
 
 impl Graph {
     /// What the file holds.
-    pub fn summary(&self) -> &Summary {
+    pub fn summary(&self) -> &GraphCounts {
         &self.summary
     }
 
