@@ -50,8 +50,8 @@ enum Command {
     /// List the bundled scenarios with one-line descriptions.
     List,
     /// Evaluate a scenario and print every mean, covariance, method and error. Several inputs
-    /// (or a directory: every .bag and .mcap in it) run in parallel; with --json each prints
-    /// one compact JSON object per line (JSON Lines) as it finishes.
+    /// (or a directory: every .bag, .mcap, .db3 and ROS 2 bag directory in it) run in parallel;
+    /// with --json each prints one compact JSON object per line (JSON Lines) as it finishes.
     #[command(after_help = EXIT_CODES_HELP)]
     Report {
         #[command(flatten)]
@@ -170,9 +170,10 @@ impl ViewerArgs {
 /// Which scenario, evaluated how.
 #[derive(Clone, Debug, Args)]
 struct ScenarioArgs {
-    /// A bundled example (see `posecov list`) or a file: a TOML scenario, a g2o / GTSAM pose
-    /// graph (.g2o, .txt, TORO .graph), a ROS 1 bag (.bag) or an MCAP file (.mcap), recognised by content
-    /// and extension.
+    /// A bundled example (see `posecov list`), a file or a live stream: a TOML scenario, a g2o /
+    /// GTSAM pose graph (.g2o, .txt, TORO .graph), a robot log (ROS 1 .bag, .mcap, a ROS 2 bag
+    /// directory or .db3, an ov_eval text trajectory), recognised by content and extension, or
+    /// a Foxglove WebSocket server (ws://HOST:PORT).
     // `Option` only so that `posecov <COMMAND>` parses; clap requires it otherwise.
     #[arg(required = true)]
     scenario: Option<String>,

@@ -17,7 +17,7 @@ use posecov::app::{
     Overrides, log,
     run::{Run, open},
 };
-use posecov::eval::log::frames::{FrameProblemKind, join_plan};
+use posecov::eval::log::frames::{FrameProblemKind, TopicFrame, join_plan};
 use posecov::eval::log::{LogEvalSettings, PoseState, evaluate_log};
 use posecov::input::log::decode::{
     Odometry, Pose, PoseWithCovariance, PoseWithCovarianceStamped, nested,
@@ -325,10 +325,10 @@ fn amcl_map_to_odom_joins_the_odometry_to_the_map() {
     }
     assert_eq!(on_sample, 91);
     // Trajectory points are moved too.
-    let (stamp, point) = odom.trajectory[odom.trajectory.len() / 2];
-    let t = stamp as f64 * 1e-9;
+    let point = odom.trajectory[odom.trajectory.len() / 2];
+    let t = point.stamp_ns as f64 * 1e-9;
     let truth = map_from_odom(t).compose(&odom_from_base(t));
-    assert!((truth.translation() - nalgebra::Vector3::from(point)).norm() < 1e-3);
+    assert!((truth.translation() - nalgebra::Vector3::from(point.position)).norm() < 1e-3);
 
     // The app: one whole-log view for both topics, the panel and the JSON say the join.
     let run = log_run(&path);
@@ -534,8 +534,15 @@ fn tree(edges: &[(&str, &str)]) -> TfTree {
 
 #[test]
 fn tree_problems_by_kind() {
-    let topics = |frames: &[&'static str]| -> Vec<(&'static str, &'static str, Option<i64>)> {
-        frames.iter().map(|f| (*f, *f, Some(0))).collect()
+    let topics = |frames: &[&'static str]| -> Vec<TopicFrame<'static>> {
+        frames
+            .iter()
+            .map(|f| TopicFrame {
+                topic: f,
+                frame_id: f,
+                first_stamp_ns: Some(0),
+            })
+            .collect()
     };
     // map → odom → base_link → map: a cycle.
     let plan = join_plan(

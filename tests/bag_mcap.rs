@@ -340,7 +340,13 @@ fn every_health_case_is_counted_once() {
     assert_eq!(m8.stamp_ns, 108 * s + 500_000_000);
     // Message 9 (stamp 50 s) is earlier than message 8's.
     assert_eq!(amcl.stamps_out_of_order, 1);
-    assert_eq!(amcl.stamp_range, Some((50 * s, 110 * s)));
+    assert_eq!(
+        amcl.stamp_range,
+        Some(posecov::plan::log::StampRange {
+            first_ns: 50 * s,
+            last_ns: 110 * s
+        })
+    );
     assert!(
         amcl.series
             .windows(2)

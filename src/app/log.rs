@@ -309,8 +309,8 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 "child_frame_id": t.child_frame_id,
                 "messages": t.count,
                 "stamps": {
-                    "first_s": t.stamp_range.map(|r| stamp_seconds(r.0)),
-                    "last_s": t.stamp_range.map(|r| stamp_seconds(r.1)),
+                    "first_s": t.stamp_range.map(|r| stamp_seconds(r.first_ns)),
+                    "last_s": t.stamp_range.map(|r| stamp_seconds(r.last_ns)),
                     "from_log_time": t.stamps_from_log_time,
                     "out_of_order": t.stamps_out_of_order,
                 },

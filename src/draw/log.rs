@@ -238,7 +238,7 @@ fn extent(e: &LogEvaluation) -> f64 {
     let points: Vec<Vector3<f64>> = e
         .topics
         .iter()
-        .flat_map(|t| t.trajectory.iter().map(|(_, p)| Vector3::from(*p)))
+        .flat_map(|t| t.trajectory.iter().map(|p| Vector3::from(p.position)))
         .filter(|p| p.iter().all(|v| v.is_finite()))
         .collect();
     super::extent_of(&points)
@@ -261,7 +261,7 @@ fn draw_topic(p: &mut Painter, k: usize, t: &TopicEvaluation, rviz_note: bool) {
     let strip: Vec<Vec3> = t
         .trajectory
         .iter()
-        .map(|(_, q)| flat(t.group.is_planar(), &Vector3::from(*q)))
+        .map(|q| flat(t.group.is_planar(), &Vector3::from(q.position)))
         .filter(|q| q.iter().all(|v| v.is_finite()))
         .collect();
     if !strip.is_empty() {

@@ -99,12 +99,14 @@ fn record_method<G: LieGroup<N>, const N: usize>(
     } else {
         views::Estimate::Method(method)
     };
-    let drawn = match p.methods.iter().position(|(n, _)| *n == node.name) {
-        Some(i) => &mut p.methods[i].1,
+    let drawn = match p.methods.iter().position(|m| m.pose == node.name) {
+        Some(i) => &mut p.methods[i],
         None => {
-            p.methods
-                .push((node.name.clone(), views::PoseMethods::default()));
-            &mut p.methods.last_mut().expect("just pushed").1
+            p.methods.push(views::PoseMethods {
+                pose: node.name.clone(),
+                ..Default::default()
+            });
+            &mut p.methods.last_mut().expect("just pushed")
         }
     };
     if is_primary {

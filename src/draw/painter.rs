@@ -30,7 +30,7 @@ pub(super) struct Painter {
     /// draws every method's banana as a surface).
     pub layout: Layout,
     /// Per drawn uncertain pose, the methods drawn for it (for the views).
-    pub methods: Vec<(String, views::PoseMethods)>,
+    pub methods: Vec<views::PoseMethods>,
     /// What the items placed now are drawn from (a robot log's topic and message), stamped on
     /// each of them ([`SceneItem::origin`]); `None` for a plan's scene.
     pub origin: Option<Origin>,

@@ -60,6 +60,8 @@ impl Estimate {
 /// Which estimates were drawn for one pose: the main one and the others.
 #[derive(Default, Debug)]
 pub(super) struct PoseMethods {
+    /// The pose's name (its node).
+    pub pose: String,
     pub main: Option<Estimate>,
     pub others: Vec<Estimate>,
 }
@@ -67,7 +69,7 @@ pub(super) struct PoseMethods {
 /// What the views are made from besides the scene's items.
 pub(super) struct ViewInputs<'a> {
     /// Per drawn (uncertain) pose, its methods.
-    pub poses: &'a [(String, PoseMethods)],
+    pub poses: &'a [PoseMethods],
     /// Rotations only (SO(2), SO(3)).
     pub rotation_only: bool,
     /// Seen from above (planar scenes, or `view = "top"`).
@@ -101,13 +103,13 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
         Layout::Together => vec![whole("3D")],
         Layout::Main => {
             let mut view = whole("3D");
-            for (pose, methods) in plan.poses.iter() {
+            for drawn in plan.poses {
                 view.hidden.extend(
-                    methods
+                    drawn
                         .others
                         .iter()
                         .filter(|m| **m != Estimate::Method(Method::VectorSpace))
-                        .map(|m| paths::method(pose, m.segment())),
+                        .map(|m| paths::method(&drawn.pose, m.segment())),
                 );
             }
             vec![view]
@@ -116,9 +118,9 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
         Layout::PerPose => plan
             .poses
             .iter()
-            .map(|(pose, _)| View3d {
-                name: pose.clone(),
-                include: vec![paths::pose(pose)],
+            .map(|drawn| View3d {
+                name: drawn.pose.clone(),
+                include: vec![paths::pose(&drawn.pose)],
                 ..Default::default()
             })
             .collect(),
@@ -237,7 +239,7 @@ pub(super) fn note(views: &[View3d]) -> Option<String> {
 /// Gaussian is shown in every view).
 fn per_method(plan: &ViewInputs) -> Vec<View3d> {
     let mut all: Vec<Method> = Vec::new();
-    for (_, m) in plan.poses {
+    for m in plan.poses {
         for e in m.main.iter().chain(&m.others) {
             if let Estimate::Method(method) = e
                 && !all.contains(method)
@@ -252,12 +254,12 @@ fn per_method(plan: &ViewInputs) -> Vec<View3d> {
             exclude: plan
                 .poses
                 .iter()
-                .flat_map(|(pose, m)| {
+                .flat_map(|m| {
                     m.main
                         .iter()
                         .chain(&m.others)
                         .filter(move |e| matches!(e, Estimate::Method(o) if *o != shown))
-                        .map(move |e| paths::method(pose, e.segment()))
+                        .map(move |e| paths::method(&m.pose, e.segment()))
                 })
                 .collect(),
             ..Default::default()
@@ -440,7 +442,7 @@ mod tests {
     /// A view's width over height (the one [`views_aspect`] gives without a legend).
     const ASPECT: f64 = 600.0 / 554.0;
 
-    fn plan(poses: &[(String, PoseMethods)], top: bool) -> ViewInputs<'_> {
+    fn plan(poses: &[PoseMethods], top: bool) -> ViewInputs<'_> {
         ViewInputs {
             poses,
             rotation_only: false,

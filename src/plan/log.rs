@@ -129,6 +129,66 @@ pub struct PoseMessage {
     pub twist_covariance: Option<[f64; COV_LEN]>,
 }
 
+/// The earliest and latest header stamp among a topic's messages (ns since the epoch), in
+/// message order's min and max: `first_ns ≤ last_ns`.
+///
+/// ```
+/// use posecov::plan::log::StampRange;
+/// let r = StampRange::new(5).widened(2).widened(9);
+/// assert_eq!(r, StampRange { first_ns: 2, last_ns: 9 });
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StampRange {
+    /// Earliest stamp, ns.
+    pub first_ns: i64,
+    /// Latest stamp, ns.
+    pub last_ns: i64,
+}
+
+impl StampRange {
+    /// The range of one stamp.
+    ///
+    /// ```
+    /// # use posecov::plan::log::StampRange;
+    /// assert_eq!(StampRange::new(3).last_ns, 3);
+    /// ```
+    pub fn new(stamp_ns: i64) -> Self {
+        Self {
+            first_ns: stamp_ns,
+            last_ns: stamp_ns,
+        }
+    }
+
+    /// The range widened to hold `stamp_ns`.
+    ///
+    /// ```
+    /// # use posecov::plan::log::StampRange;
+    /// assert_eq!(StampRange::new(3).widened(1).first_ns, 1);
+    /// ```
+    pub fn widened(self, stamp_ns: i64) -> Self {
+        Self {
+            first_ns: self.first_ns.min(stamp_ns),
+            last_ns: self.last_ns.max(stamp_ns),
+        }
+    }
+}
+
+/// One point of a topic's trajectory: where a message put its child frame (`position`, m, in
+/// the message's `frame_id`, or the common frame once joined) at its stamp.
+///
+/// ```
+/// use posecov::plan::log::TrackPoint;
+/// let p = TrackPoint { stamp_ns: 1_000, position: [1.0, 2.0, 0.0] };
+/// assert_eq!(p.position[1], 2.0);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackPoint {
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// Position, m.
+    pub position: [f64; 3],
+}
+
 /// One point of a topic's time series: σ of each ROS axis (NaN-free: `None` where the axis is
 /// a placeholder, unknown or the message unusable) and the position trace.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -246,7 +306,7 @@ pub struct TopicSummary {
     /// Messages whose stamp is earlier than the one before (kept; series are sorted).
     pub stamps_out_of_order: u64,
     /// Earliest and latest stamp (ns), if any message.
-    pub stamp_range: Option<(i64, i64)>,
+    pub stamp_range: Option<StampRange>,
     /// Covariance health.
     pub health: Health,
     /// The topic's group, which gives its degrees of freedom ([`GroupKind::dof`],
@@ -258,7 +318,7 @@ pub struct TopicSummary {
     /// One kept message in `stride`.
     pub stride: u64,
     /// Positions along the trajectory (bounded, in stamp order), with their stamps.
-    pub trajectory: Vec<(i64, [f64; 3])>,
+    pub trajectory: Vec<TrackPoint>,
     /// Time series (bounded, in stamp order).
     pub series: Vec<SeriesPoint>,
     /// σ statistics per ROS axis (x, y, z, roll, pitch, yaw) over every message where the

@@ -3,6 +3,7 @@
 //! the observer that takes every message's NEES while the log is read, the errors in the
 //! user's words, and `topics[].consistency` of `report --json`.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::stamp_seconds;
@@ -101,7 +102,7 @@ pub(super) fn finish(
     prepared: Prepared,
     plan: &LogSummary,
     file: &str,
-) -> Result<Vec<(String, TopicConsistency)>, AppError> {
+) -> Result<BTreeMap<String, TopicConsistency>, AppError> {
     let value = &prepared.value;
     let error = |message: String| {
         AppError::Input(InputError::Format {
@@ -164,17 +165,21 @@ pub(super) fn finish(
         _ => {}
     }
     let span = prepared.observer.reference_span();
-    let strides: Vec<(String, u64)> = plan
+    let strides: BTreeMap<String, u64> = plan
         .topics
         .iter()
         .map(|t| (t.name.clone(), t.stride))
         .collect();
     let results = prepared.observer.finish(&strides);
-    if plan.cancelled || results.iter().any(|(_, c)| c.messages > 0) {
+    if plan.cancelled || results.values().any(|c| c.messages > 0) {
         return Ok(results);
     }
-    let span = span.map_or("no pose".to_owned(), |(a, b)| {
-        format!("{:.3} s … {:.3} s", stamp_seconds(a), stamp_seconds(b))
+    let span = span.map_or("no pose".to_owned(), |r| {
+        format!(
+            "{:.3} s … {:.3} s",
+            stamp_seconds(r.first_ns),
+            stamp_seconds(r.last_ns)
+        )
     });
     if results.is_empty() {
         return Err(error(format!(
@@ -189,8 +194,12 @@ pub(super) fn finish(
                 .iter()
                 .find(|t| t.name == *name)
                 .and_then(|t| t.stamp_range)
-                .map_or(String::new(), |(a, b)| {
-                    format!("{:.3} s … {:.3} s, ", stamp_seconds(a), stamp_seconds(b))
+                .map_or(String::new(), |r| {
+                    format!(
+                        "{:.3} s … {:.3} s, ",
+                        stamp_seconds(r.first_ns),
+                        stamp_seconds(r.last_ns)
+                    )
                 });
             let s = &c.skipped;
             format!(

@@ -309,8 +309,8 @@ fn topic(
         let _ = write!(s, ", dead-reckoned");
     }
     let _ = write!(s, "): {} messages", t.count);
-    if let Some((a, b)) = t.stamp_range {
-        let _ = write!(s, ", stamps {} … {}", secs(a), secs(b));
+    if let Some(r) = t.stamp_range {
+        let _ = write!(s, ", stamps {} … {}", secs(r.first_ns), secs(r.last_ns));
     }
     let _ = writeln!(s, ".");
     health(s, t);

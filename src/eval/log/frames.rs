@@ -21,12 +21,13 @@
 //!   [`PLANE_TOLERANCE`]).
 //!
 //! ```
-//! use posecov::eval::log::frames::{FrameProblemKind, join_plan};
+//! use posecov::eval::log::frames::{FrameProblemKind, TopicFrame, join_plan};
 //! use posecov::plan::log::{ReferenceSample, TfEdge, TfTree};
 //! let s = ReferenceSample { stamp_ns: 0, position: [1.0, 0.0, 0.0], orientation_xyzw: [0.0, 0.0, 0.0, 1.0] };
 //! let edge = |p: &str, c: &str| TfEdge { samples: vec![s, ReferenceSample { stamp_ns: 10, ..s }], messages: 2, ..TfEdge::new(p, c, "/tf", 0) };
 //! let tf = TfTree { edges: vec![edge("map", "odom"), edge("odom", "base_link")], ..Default::default() };
-//! let plan = join_plan(&tf, &[("/odom", "odom", Some(0)), ("/amcl_pose", "map", Some(0)), ("/gps", "utm", Some(3))]);
+//! let topic = |topic, frame_id, first_stamp_ns| TopicFrame { topic, frame_id, first_stamp_ns };
+//! let plan = join_plan(&tf, &[topic("/odom", "odom", Some(0)), topic("/amcl_pose", "map", Some(0)), topic("/gps", "utm", Some(3))]);
 //! assert_eq!(plan.chains[0].as_deref(), Some(&["odom".to_owned(), "map".to_owned()][..]));
 //! assert!(plan.chains[1].is_none() && plan.chains[2].is_none());
 //! assert_eq!(plan.problems[0].kind, FrameProblemKind::NoTransform);
@@ -46,7 +47,7 @@ use super::TopicMessages;
 use super::stamped::{Lookup, StampedPoses, pose_of_sample};
 use crate::interop::{RosReading, ros_cov_moved};
 use crate::lie::{GroupKind, LieGroup, Se3};
-use crate::plan::log::{Class, Issue, TfTree};
+use crate::plan::log::{Class, Issue, TfTree, TrackPoint};
 
 /// A transform keeps a planar topic's plane when its roll and pitch are below this (rad).
 pub const PLANE_TOLERANCE: f64 = 1e-6;
@@ -136,6 +137,24 @@ pub struct FrameProblem {
     pub stamp_ns: Option<i64>,
 }
 
+/// A topic as [`join_plan`] reads it: its name, the `frame_id` its messages are in, and its
+/// first stamp (ns; where a frame problem is located).
+///
+/// ```
+/// use posecov::eval::log::frames::TopicFrame;
+/// let t = TopicFrame { topic: "/odom", frame_id: "odom", first_stamp_ns: Some(0) };
+/// assert_eq!(t.frame_id, "odom");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TopicFrame<'a> {
+    /// The topic's name.
+    pub topic: &'a str,
+    /// The `frame_id` of its messages.
+    pub frame_id: &'a str,
+    /// Its first stamp, ns, if any message.
+    pub first_stamp_ns: Option<i64>,
+}
+
 /// Which topics join which frame: per topic its chain of frames up to the common one
 /// (`None`: drawn in its own frame), and the problems found.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -173,7 +192,7 @@ fn chain_up(parents: &BTreeMap<&str, &str>, frame: &str) -> Result<Vec<String>, 
 /// `frame_id` and first stamp.
 ///
 /// See the [module docs](self) for an example.
-pub fn join_plan(tf: &TfTree, topics: &[(&str, &str, Option<i64>)]) -> FrameJoins {
+pub fn join_plan(tf: &TfTree, topics: &[TopicFrame<'_>]) -> FrameJoins {
     let mut plan = FrameJoins {
         chains: vec![None; topics.len()],
         problems: Vec::new(),
@@ -185,7 +204,7 @@ pub fn join_plan(tf: &TfTree, topics: &[(&str, &str, Option<i64>)]) -> FrameJoin
     // One frame among the topics: nothing to join, nothing to say of frames /tf lacks.
     let distinct: BTreeSet<String> = topics
         .iter()
-        .map(|t| bare_frame(t.1))
+        .map(|t| bare_frame(t.frame_id))
         .filter(|f| !f.is_empty())
         .collect();
     if distinct.len() < 2 {
@@ -266,7 +285,7 @@ struct Trees {
 /// several parents is added to that problem.
 fn chains_to_roots(
     tf: &TfTree,
-    topics: &[(&str, &str, Option<i64>)],
+    topics: &[TopicFrame<'_>],
     parents: &BTreeMap<&str, &str>,
     broken: &BTreeSet<String>,
     problems: &mut Vec<FrameProblem>,
@@ -278,13 +297,19 @@ fn chains_to_roots(
         .collect();
     let mut chains: Vec<Option<Vec<String>>> = vec![None; topics.len()];
     let mut roots: BTreeMap<String, Vec<usize>> = BTreeMap::new();
-    for (i, (name, frame_id, first)) in topics.iter().enumerate() {
-        let f = bare_frame(frame_id);
+    for (i, t) in topics.iter().enumerate() {
+        let (name, f) = (t.topic, bare_frame(t.frame_id));
         if f.is_empty() {
             continue;
         }
         if !known.contains(f.as_str()) {
-            note_topic(problems, FrameProblemKind::NoTransform, &f, name, *first);
+            note_topic(
+                problems,
+                FrameProblemKind::NoTransform,
+                &f,
+                name,
+                t.first_stamp_ns,
+            );
             continue;
         }
         match chain_up(parents, &f) {
@@ -292,7 +317,7 @@ fn chains_to_roots(
                 if c.iter().any(|g| broken.contains(g)) {
                     for p in problems.iter_mut() {
                         if p.kind == FrameProblemKind::SeveralParents && c.contains(&p.frames[0]) {
-                            p.topics.push((*name).to_owned());
+                            p.topics.push(name.to_owned());
                         }
                     }
                 }
@@ -357,7 +382,7 @@ fn common_frame(chains: &[Option<Vec<String>>], members: &[usize]) -> Option<Str
 
 /// The problem of topics in /tf trees apart: per tree one topic's frame and the tree's root,
 /// and every topic under them.
-fn missing_link(trees: &Trees, topics: &[(&str, &str, Option<i64>)]) -> FrameProblem {
+fn missing_link(trees: &Trees, topics: &[TopicFrame<'_>]) -> FrameProblem {
     let (frames, roots): (Vec<String>, Vec<String>) = trees
         .roots
         .iter()
@@ -374,7 +399,7 @@ fn missing_link(trees: &Trees, topics: &[(&str, &str, Option<i64>)]) -> FramePro
             .roots
             .values()
             .flatten()
-            .map(|&i| topics[i].0.to_owned())
+            .map(|&i| topics[i].topic.to_owned())
             .collect(),
         source: "/tf".to_owned(),
         stamp_ns: None,
@@ -481,12 +506,12 @@ fn keeps_plane(t: &Se3) -> bool {
 /// let tf = TfTree { edges: vec![edge], ..Default::default() };
 /// let mut log = read_located(&locate("jackal_odometry").unwrap(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
 /// let topic = &mut log.topics[0]; // in `odom`, 47.584 s to 108.764 s
-/// let (group, x0) = (topic.group, topic.trajectory[0].1[0]);
+/// let (group, x0) = (topic.group, topic.trajectory[0].position[0]);
 /// let mut messages = TopicMessages::take(topic);
 /// let chain = ["odom".to_owned(), "map".to_owned()];
 /// let join = move_topic(&tf, &chain, group, &mut messages, RosReading::Tf2).unwrap();
 /// assert_eq!(messages.frame_id, "map");
-/// assert_eq!(messages.trajectory[0].1[0], x0 + 1.0);
+/// assert_eq!(messages.trajectory[0].position[0], x0 + 1.0);
 /// assert!(join.moved >= 1 && join.left_out > 0); // after 47.7 s: never extrapolated
 /// ```
 pub fn move_topic(
@@ -513,7 +538,7 @@ pub fn move_topic(
     let trajectory_at: Vec<Option<Se3>> = messages
         .trajectory
         .iter()
-        .map(|(stamp, _)| at(*stamp))
+        .map(|p| at(p.stamp_ns))
         .collect::<Result<_, _>>()?;
     let to = chain.last().cloned().unwrap_or_default();
     let mut join = FrameJoin {
@@ -549,11 +574,12 @@ pub fn move_topic(
         messages.drawn.push(d);
     }
     let trajectory = std::mem::take(&mut messages.trajectory);
-    for ((stamp, p), t) in trajectory.into_iter().zip(trajectory_at) {
+    for (p, t) in trajectory.into_iter().zip(trajectory_at) {
         match t {
-            Some(t) => messages
-                .trajectory
-                .push((stamp, t.act(&Vector3::from(p)).into())),
+            Some(t) => messages.trajectory.push(TrackPoint {
+                stamp_ns: p.stamp_ns,
+                position: t.act(&Vector3::from(p.position)).into(),
+            }),
             None => join.trajectory_left_out += 1,
         }
     }

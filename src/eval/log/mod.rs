@@ -22,6 +22,8 @@ mod meaning;
 pub mod nees;
 pub mod stamped;
 
+use std::collections::BTreeMap;
+
 use nalgebra::{Matrix3, Matrix6};
 
 use crate::interop::RosReading;
@@ -29,10 +31,12 @@ use crate::lie::{GroupKind, Se2, Se3, So3};
 use serde::Serialize;
 
 use self::frames::{
-    FrameFindings, FrameJoin, FrameProblem, FrameProblemKind, join_plan, move_topic,
+    FrameFindings, FrameJoin, FrameProblem, FrameProblemKind, TopicFrame, join_plan, move_topic,
 };
 use self::meaning::{meaning, readings_apart};
-use crate::plan::log::{AxisStats, DrawnMessage, Issue, LogSummary, SeriesPoint, TopicSummary};
+use crate::plan::log::{
+    AxisStats, DrawnMessage, Issue, LogSummary, SeriesPoint, TopicSummary, TrackPoint,
+};
 use crate::sample::{Sampler, chunk_rng};
 use crate::uncertain::UncertainPose;
 
@@ -202,7 +206,7 @@ pub struct TopicEvaluation {
     /// the largest ‖Σ_tf2 − Σ_body‖_F / ‖Σ_tf2‖_F (0 for planar topics, where they coincide).
     pub reading_difference: f64,
     /// Trajectory (stamp ns, position).
-    pub trajectory: Vec<(i64, [f64; 3])>,
+    pub trajectory: Vec<TrackPoint>,
     /// Time series.
     pub series: Vec<SeriesPoint>,
     /// σ per ROS axis (x, y, z, roll, pitch, yaw; m and rad), `None` where never estimated.
@@ -230,7 +234,7 @@ impl LogEvaluation {
     /// Attaches each topic's NEES ([`crate::eval::log::nees::NeesObserver::finish`]) by name.
     pub fn with_consistency(
         mut self,
-        results: Vec<(String, crate::eval::log::nees::TopicConsistency)>,
+        results: BTreeMap<String, crate::eval::log::nees::TopicConsistency>,
     ) -> Self {
         for (name, c) in results {
             if let Some(t) = self.topics.iter_mut().find(|t| t.name == name) {
@@ -250,7 +254,7 @@ pub struct TopicMessages {
     /// The drawn messages.
     pub drawn: Vec<DrawnMessage>,
     /// The trajectory (stamp ns, position).
-    pub trajectory: Vec<(i64, [f64; 3])>,
+    pub trajectory: Vec<TrackPoint>,
     /// The σ time series.
     pub series: Vec<SeriesPoint>,
 }
@@ -283,15 +287,13 @@ impl TopicMessages {
 ///
 /// See the [module docs](self) for an example.
 pub fn evaluate_log(plan: &mut LogSummary, settings: &LogEvalSettings) -> LogEvaluation {
-    let named: Vec<(&str, &str, Option<i64>)> = plan
+    let named: Vec<TopicFrame<'_>> = plan
         .topics
         .iter()
-        .map(|t| {
-            (
-                t.name.as_str(),
-                t.frame_id.as_str(),
-                t.stamp_range.map(|r| r.0),
-            )
+        .map(|t| TopicFrame {
+            topic: &t.name,
+            frame_id: &t.frame_id,
+            first_stamp_ns: t.stamp_range.map(|r| r.first_ns),
         })
         .collect();
     let joins = join_plan(&plan.tf, &named);

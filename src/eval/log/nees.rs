@@ -36,8 +36,8 @@
 //! nees.estimate(&EstimateMessage { topic: "/ekf", frame_id: "map", index: 0, stamp_ns: 150,
 //!     position: [1.6, 0.0, 0.0], orientation_xyzw: [0.0, 0.0, 0.0, 1.0], covariance: &cov,
 //!     usable: true, unestimated: [false; 6] });
-//! let topics = nees.finish(&[("/ekf".to_owned(), 1)]);
-//! let c = &topics[0].1;
+//! let topics = nees.finish(&[("/ekf".to_owned(), 1)].into());
+//! let c = &topics["/ekf"];
 //! assert_eq!((c.dof, c.messages), (6, 1));
 //! assert!((c.anees.unwrap().value - 1.0).abs() < 1e-9);
 //! ```
@@ -57,6 +57,7 @@ use crate::lie::{LieGroup, Se2, Se3, So3};
 use crate::plan::limits::MAX_COORDINATE;
 use crate::plan::log::{
     DEFAULT_MAX_DRAWN, Decimator, EstimateMessage, LogObserver, MAX_DRAWN_LIMIT, ReferenceSample,
+    StampRange,
 };
 use crate::uncertain::{Information, Side, UncertainPose, anees_band, chi2_radius};
 pub use math::{nees_se2, nees_se3, umeyama};
@@ -178,7 +179,7 @@ impl NeesObserver {
     }
 
     /// The stamps the reference spans (ns), if any sample.
-    pub fn reference_span(&self) -> Option<(i64, i64)> {
+    pub fn reference_span(&self) -> Option<StampRange> {
         self.reference.span()
     }
 
@@ -195,12 +196,13 @@ impl NeesObserver {
 
     /// Ends the stream: waiting estimates are after the reference; with `se3` alignment the
     /// transform is fitted and every matched message's NEES taken. `drawn` gives each topic's
-    /// drawn stride (the NEES series is kept at the drawn messages). Topics in name order.
-    pub fn finish(mut self, drawn: &[(String, u64)]) -> Vec<(String, TopicConsistency)> {
+    /// drawn stride by topic (the NEES series is kept at the drawn messages). Returns each
+    /// topic's NEES by name.
+    pub fn finish(mut self, drawn: &BTreeMap<String, u64>) -> BTreeMap<String, TopicConsistency> {
         self.complete = true;
         let settings = self.settings.clone();
         let reference_frame = self.reference_frame.clone().unwrap_or_default();
-        let mut out = Vec::new();
+        let mut out = BTreeMap::new();
         for (name, mut state) in std::mem::take(&mut self.topics) {
             state.skipped.after_reference += state.pending.len() as u64;
             state.pending.clear();
@@ -222,11 +224,9 @@ impl NeesObserver {
                     }
                 }
             }
-            let stride = drawn
-                .iter()
-                .find(|(n, _)| *n == name)
-                .map_or(1, |(_, s)| (*s).max(1));
-            out.push((name, summary(&settings, &reference_frame, state, stride)));
+            let stride = drawn.get(&name).map_or(1, |s| (*s).max(1));
+            let consistency = summary(&settings, &reference_frame, state, stride);
+            out.insert(name, consistency);
         }
         out
     }

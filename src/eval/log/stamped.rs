@@ -17,7 +17,7 @@
 //! ```
 
 use crate::lie::{LieGroup, Se3, So3};
-use crate::plan::log::ReferenceSample;
+use crate::plan::log::{ReferenceSample, StampRange};
 
 /// The pose of a sample (parent_from_child), if its position is finite and its quaternion a
 /// rotation ([`So3::try_from_quaternion_xyzw`]).
@@ -65,7 +65,7 @@ impl StampedPoses {
     /// p.insert(20, Se3::identity());
     /// p.insert(10, Se3::identity());
     /// p.insert(20, Se3::identity());
-    /// assert_eq!((p.len(), p.span()), (2, Some((10, 20))));
+    /// assert_eq!((p.len(), p.span().map(|r| (r.first_ns, r.last_ns))), (2, Some((10, 20))));
     /// ```
     pub fn insert(&mut self, stamp_ns: i64, pose: Se3) {
         match self.samples.last() {
@@ -99,8 +99,11 @@ impl StampedPoses {
     /// The first and last stamps, if any sample.
     ///
     /// See [`insert`](Self::insert) and the [module docs](self) for examples.
-    pub fn span(&self) -> Option<(i64, i64)> {
-        Some((self.samples.first()?.0, self.samples.last()?.0))
+    pub fn span(&self) -> Option<StampRange> {
+        Some(StampRange {
+            first_ns: self.samples.first()?.0,
+            last_ns: self.samples.last()?.0,
+        })
     }
 
     /// The latest sample's pose (a static transform's value).
@@ -165,7 +168,10 @@ mod tests {
         p.insert(20, b);
         p.insert(10, a);
         p.insert(20, b);
-        assert_eq!((p.len(), p.span()), (2, Some((10, 20))));
+        assert_eq!(
+            (p.len(), p.span().map(|r| (r.first_ns, r.last_ns))),
+            (2, Some((10, 20)))
+        );
         let Lookup::At(mid) = p.at(15) else { panic!() };
         assert!(mid.rminus(&a.interpolate(&b, 0.5)).norm() < 1e-15);
         assert!((mid.rotation().to_rpy()[2] - 0.5).abs() < 1e-12);

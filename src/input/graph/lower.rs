@@ -13,7 +13,7 @@ use super::problem::{Edge, Prior, chain_initial_guess, pose_graph};
 use super::{InputError, Locator};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
-use crate::plan::choices::{GraphCounts, GraphFacts, Link, SkippedRecords};
+use crate::plan::choices::{GraphCounts, GraphFacts, Link};
 use crate::plan::{
     AnyPlan, Control, FrameSide, OdometryModel, Op, Operand, Plan, StepNoise, StepPolicy, limits,
 };
@@ -382,14 +382,7 @@ fn assemble<G: GraphGroup<N>, const N: usize>(
         first,
         chain_end: first + chain.len() as u64,
         chained,
-        skipped: records
-            .skipped
-            .iter()
-            .map(|(tag, count)| SkippedRecords {
-                tag: tag.clone(),
-                count: *count,
-            })
-            .collect(),
+        skipped: records.skipped.clone(),
     });
     let about = About {
         title: format!(

@@ -12,6 +12,7 @@
 //! (landmarks, parameters) are counted and skipped; any other first token is an error.
 
 use super::super::{InputError, Locator};
+use crate::plan::choices::SkippedRecords;
 
 /// Planar or spatial.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -200,7 +201,7 @@ pub struct Records {
     /// Vertices and edges in file order.
     pub records: Vec<Record>,
     /// Skipped tags with their counts, in order of first appearance.
-    pub skipped: Vec<(String, usize)>,
+    pub skipped: Vec<SkippedRecords>,
 }
 
 /// Most records of one file (vertices + edges): larger graphs are refused before they are
@@ -241,9 +242,12 @@ pub fn read_records(locator: &Locator) -> Result<Records, InputError> {
         }
         let Some(tag) = TAGS.iter().find(|t| t.name == tag_text).copied() else {
             if SKIPPED_TAGS.contains(&tag_text) {
-                match out.skipped.iter_mut().find(|(t, _)| t == tag_text) {
-                    Some((_, n)) => *n += 1,
-                    None => out.skipped.push((tag_text.to_owned(), 1)),
+                match out.skipped.iter_mut().find(|s| s.tag == tag_text) {
+                    Some(s) => s.count += 1,
+                    None => out.skipped.push(SkippedRecords {
+                        tag: tag_text.to_owned(),
+                        count: 1,
+                    }),
                 }
                 continue;
             }
@@ -294,7 +298,7 @@ pub fn read_records(locator: &Locator) -> Result<Records, InputError> {
             let s: Vec<String> = out
                 .skipped
                 .iter()
-                .map(|(t, n)| format!("{n} {t}"))
+                .map(|s| format!("{} {}", s.count, s.tag))
                 .collect();
             format!(" (only {})", s.join(", "))
         };

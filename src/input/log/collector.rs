@@ -101,8 +101,13 @@ pub(super) struct Collector<'a, 'o> {
     growth: Option<Growth<'o>>,
 }
 
-/// A growing read's hook ([`Collector::growing`]), when the read began, when the hook is due.
-type Growth<'o> = (&'o mut dyn FnMut(LogSummary), Instant, Option<Instant>);
+/// A growing read ([`Collector::growing`]): where its summaries go, when it began, when the
+/// next summary is due (`None`: at the first pose message).
+struct Growth<'o> {
+    show: &'o mut dyn FnMut(LogSummary),
+    started: Instant,
+    next_due: Option<Instant>,
+}
 
 /// How long after the last summary was shown (the collector's `grow`) the next one is due,
 /// `elapsed` into the read: every second, and once the read is past 100 s every hundredth of
@@ -145,7 +150,11 @@ impl<'a, 'o> Collector<'a, 'o> {
     /// The same collector, handing the summary so far to `show` when [`Self::grow`] finds one
     /// due.
     pub(super) fn growing(mut self, show: Option<&'o mut dyn FnMut(LogSummary)>) -> Self {
-        self.growth = show.map(|show| (show, Instant::now(), None));
+        self.growth = show.map(|show| Growth {
+            show,
+            started: Instant::now(),
+            next_due: None,
+        });
         self
     }
 
@@ -155,10 +164,10 @@ impl<'a, 'o> Collector<'a, 'o> {
     /// one was shown, or four times what showing it took if longer (redraws take at most a
     /// fifth of the time, whatever the machine).
     pub(super) fn grow(&mut self, notes: &StreamNotes) {
-        let Some((_, _, next)) = &self.growth else {
+        let Some(growth) = &self.growth else {
             return;
         };
-        if next.is_some_and(|at| Instant::now() < at) {
+        if growth.next_due.is_some_and(|at| Instant::now() < at) {
             return;
         }
         let mut plan = assemble(
@@ -175,12 +184,13 @@ impl<'a, 'o> Collector<'a, 'o> {
             return;
         }
         plan.stream = Some(notes.clone());
-        if let Some((show, started, next)) = &mut self.growth {
+        if let Some(growth) = &mut self.growth {
             let before = Instant::now();
-            show(plan);
+            (growth.show)(plan);
             // The reading gets at least four fifths of the time, however long a redraw takes.
             let cost = before.elapsed();
-            *next = Some(Instant::now() + growth_interval(started.elapsed()).max(4 * cost));
+            growth.next_due =
+                Some(Instant::now() + growth_interval(growth.started.elapsed()).max(4 * cost));
         }
     }
 

@@ -6,7 +6,7 @@
 use crate::lie::GroupKind;
 use crate::plan::log::{
     Decimator, DrawnMessage, Issue, IssueCount, LogSummary, PoseMessage, PoseMessageKind,
-    SeriesPoint, TopicSummary, is_odom_frame,
+    SeriesPoint, StampRange, TopicSummary, TrackPoint, is_odom_frame,
 };
 
 use super::decode::DecodeError;
@@ -31,11 +31,11 @@ pub(super) struct TopicState {
     from_log: u64,
     out_of_order: u64,
     last_stamp: Option<i64>,
-    range: Option<(i64, i64)>,
+    range: Option<StampRange>,
     /// Health classes and σ statistics.
     pub(super) checks: TopicHealth,
     drawn: Decimator<DrawnMessage>,
-    trajectory: Decimator<(i64, [f64; 3])>,
+    trajectory: Decimator<TrackPoint>,
     /// The series, with each axis's variance in place of its σ: the square roots are taken
     /// for the points kept only ([`Self::into_plan`]).
     series: Decimator<SeriesPoint>,
@@ -100,10 +100,10 @@ impl TopicState {
             self.checks.health.note(Issue::FrozenStamp, stamp_ns, index);
         }
         self.last_stamp = Some(stamp_ns);
-        self.range = Some(match self.range {
-            Some((a, b)) => (a.min(stamp_ns), b.max(stamp_ns)),
-            None => (stamp_ns, stamp_ns),
-        });
+        self.range = Some(
+            self.range
+                .map_or(StampRange::new(stamp_ns), |r| r.widened(stamp_ns)),
+        );
         if self.frame_id.is_none() && !d.frame_id.is_empty() {
             self.frame_id = Some(d.frame_id.clone());
         }
@@ -115,7 +115,13 @@ impl TopicState {
         let (h, variance) = self.checks.add(index, stamp_ns, &d, dead_reckoned);
         let usable = h.usable();
         if usable && d.position.iter().all(|v| v.is_finite()) {
-            self.trajectory.push(index, (stamp_ns, d.position));
+            self.trajectory.push(
+                index,
+                TrackPoint {
+                    stamp_ns,
+                    position: d.position,
+                },
+            );
         }
         self.series.push(
             index,
@@ -174,7 +180,7 @@ impl TopicState {
     pub(super) fn into_plan(self, name: String) -> TopicSummary {
         let stride = self.drawn.stride();
         let mut trajectory = self.trajectory.into_items();
-        trajectory.sort_by_key(|p| p.0);
+        trajectory.sort_by_key(|p| p.stamp_ns);
         let mut series = self.series.into_items();
         for p in &mut series {
             p.sigma = p.sigma.map(|v| v.map(f64::sqrt));
