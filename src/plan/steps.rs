@@ -16,7 +16,7 @@
 /// assert!(p.detailed(95, 100) && !p.detailed(96, 100) && p.detailed(100, 100));
 /// let long = (0..=100_000).filter(|k| p.records(*k, 100_000)).count();
 /// assert!(long <= 1001);
-/// // A pose graph's chain: statistics at the drawn steps only (21 of 1728).
+/// // A pose graph's chain: statistics at the drawn steps only (11 of 1727).
 /// let g = StepPolicy::GRAPH;
 /// let sampled = (0..=1727).filter(|k| g.samples(*k, 1727)).count();
 /// let drawn = (0..=1727).filter(|k| g.detailed(*k, 1727)).count();
