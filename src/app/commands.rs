@@ -267,6 +267,7 @@ pub(super) fn check_as(
         draw: matches!(opened, Opened::Plan(_)),
         progress: bar,
         cancel,
+        ..RunOptions::numbers()
     };
     let run = match Run::start(opened, &quick, options)? {
         Run::Log(run) => return Ok(log::check(&run, scenario, allow)),

@@ -4,8 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use super::run::{Run, open};
+use super::run::{Run, RunOptions, open};
 use super::{AppError, Overrides};
+use crate::eval::graph::StepMarginals;
 use crate::scene::Scene;
 use crate::sink::figure::{self, FigureOptions};
 
@@ -17,11 +18,16 @@ use crate::sink::figure::{self, FigureOptions};
 /// assert!(!scene.legend.is_empty());
 /// ```
 pub fn scene_of(name_or_path: &str, overrides: &Overrides) -> Result<Scene, AppError> {
-    let run = Run::start(
-        open(name_or_path)?,
-        overrides,
-        crate::app::run::RunOptions::shown(),
-    )?;
+    scene_with(name_or_path, overrides, RunOptions::shown())
+}
+
+/// [`scene_of`] run with `options`.
+fn scene_with(
+    name_or_path: &str,
+    overrides: &Overrides,
+    options: RunOptions,
+) -> Result<Scene, AppError> {
+    let run = Run::start(open(name_or_path)?, overrides, options)?;
     Ok(match run {
         Run::Plan(r) => r.scene,
         Run::Log(r) => r.scene,
@@ -46,7 +52,17 @@ pub fn figure(
     out: &Path,
 ) -> Result<(), AppError> {
     figure::FigureFormat::of(out)?;
-    let scene = scene_of(name_or_path, overrides)?;
+    // A pose graph's figure of every step at once shows the graph before and its final
+    // state: the marginals of the loop-closure steps between are computed only for a figure
+    // of one of them (`--step K`).
+    let run = RunOptions {
+        step_marginals: match options.steps {
+            figure::Steps::At(_) => StepMarginals::Every,
+            figure::Steps::All => StepMarginals::DeadReckoning,
+        },
+        ..RunOptions::shown()
+    };
+    let scene = scene_with(name_or_path, overrides, run)?;
     Ok(figure::write(&scene, options, out)?)
 }
 

@@ -301,24 +301,28 @@ pub fn pipeline(
     overrides: &Overrides,
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<(AnyEvaluation, Scene), AppError> {
-    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, cancel, None, true)?;
+    let options = run::RunOptions {
+        cancel,
+        ..run::RunOptions::shown()
+    };
+    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, &options, None)?;
     Ok((evaluation, scene))
 }
 
 /// Resolves, evaluates, draws and validates: the one plan path ([`pipeline`],
-/// [`run::Run::start`]); undrawn when `drawn` is false (the scene keeps the title and
-/// description).
+/// [`run::Run::start`]) with `options`' cancel, graph step marginals and drawing; undrawn
+/// when [`run::RunOptions::draw`] is false (the scene keeps the title and description).
 fn evaluate_and_draw(
     loaded: &Loaded,
     overrides: &Overrides,
-    cancel: Option<Arc<AtomicBool>>,
+    options: &run::RunOptions,
     progress: Option<crate::eval::graph::ProgressHook>,
-    drawn: bool,
 ) -> Result<(Settings, AnyEvaluation, Scene), AppError> {
-    let mut settings = resolve(&loaded.input, overrides, cancel)?;
+    let mut settings = resolve(&loaded.input, overrides, options.cancel.clone())?;
     settings.eval.graph_progress = progress;
+    settings.eval.graph.step_marginals = options.step_marginals;
     let evaluation = evaluate(loaded, &settings.eval)?;
-    if !drawn {
+    if !options.draw {
         let about = &loaded.input.about;
         return Ok((
             settings,

@@ -22,7 +22,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::log::{self, LogRun};
 use super::{AppError, Loaded, Overrides, RobotLog, Settings, resolve};
 use crate::draw;
-use crate::eval::graph::{Iteration, ProgressHook, Stage};
+use crate::eval::graph::{Iteration, ProgressHook, Stage, StepMarginals};
 use crate::eval::{self, AnyEvaluation};
 use crate::input::{self, InputKind, Located};
 use crate::scene::Scene;
@@ -43,6 +43,8 @@ pub enum Opened {
 /// use posecov::app::run::RunOptions;
 /// assert!(RunOptions::shown().draw && !RunOptions::numbers().draw);
 /// assert!(!RunOptions::numbers().progress);
+/// use posecov::eval::graph::StepMarginals;
+/// assert_eq!(RunOptions::numbers().step_marginals, StepMarginals::DeadReckoning);
 /// ```
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
@@ -55,6 +57,10 @@ pub struct RunOptions {
     pub progress: bool,
     /// Set by Ctrl-C: a log's read stops and keeps what was read; a plan's evaluation stops.
     pub cancel: Option<Arc<AtomicBool>>,
+    /// Which of a pose graph's loop-closure steps get every pose's marginal: every step for
+    /// the viewer (its `step` timeline shows them), dead reckoning's only for a report or a
+    /// figure of the final state (computed where it is shown).
+    pub step_marginals: StepMarginals,
 }
 
 impl RunOptions {
@@ -64,12 +70,17 @@ impl RunOptions {
             draw: true,
             progress: true,
             cancel: None,
+            step_marginals: StepMarginals::Every,
         }
     }
 
-    /// A run for its numbers only: not drawn, no progress shown.
+    /// A run for its numbers only: not drawn, no progress shown, no marginals of a pose
+    /// graph's intermediate loop-closure steps (a report shows none).
     pub fn numbers() -> Self {
-        Self::default()
+        Self {
+            step_marginals: StepMarginals::DeadReckoning,
+            ..Self::default()
+        }
     }
 
     /// The same run, stopped by `cancel`.
@@ -135,20 +146,24 @@ impl PlanRun {
         overrides: &Overrides,
         cancel: Option<Arc<AtomicBool>>,
     ) -> Result<Self, AppError> {
-        Self::run(loaded, overrides, cancel, None, true)
+        let options = RunOptions {
+            cancel,
+            ..RunOptions::shown()
+        };
+        Self::run(loaded, overrides, &options, None)
     }
 
     /// Resolves and evaluates a loaded plan, a pose graph's solves reporting their steps to
-    /// `progress`, and draws it when `draw` (else the scene holds the title and description).
+    /// `progress`, and draws it when [`RunOptions::draw`] (else the scene holds the title and
+    /// description).
     fn run(
         loaded: Loaded,
         overrides: &Overrides,
-        cancel: Option<Arc<AtomicBool>>,
+        options: &RunOptions,
         progress: Option<ProgressHook>,
-        draw: bool,
     ) -> Result<Self, AppError> {
         let (settings, evaluation, scene) =
-            super::evaluate_and_draw(&loaded, overrides, cancel, progress, draw)?;
+            super::evaluate_and_draw(&loaded, overrides, options, progress)?;
         Ok(Self {
             loaded,
             settings,
@@ -230,13 +245,7 @@ impl Run {
                 let what = format!("evaluating {}", loaded.input.about.title);
                 let work = |spinner: Option<&ProgressBar>| {
                     let hook = spinner.map(|s| graph_progress(s.clone(), what.clone()));
-                    PlanRun::run(
-                        *loaded,
-                        overrides,
-                        options.cancel.clone(),
-                        hook,
-                        options.draw,
-                    )
+                    PlanRun::run(*loaded, overrides, &options, hook)
                 };
                 let run = if options.progress {
                     with_spinner(&what, |spinner| work(Some(spinner)))

@@ -449,6 +449,8 @@ fn plan_settings(
                 optimizer: overrides.optimizer.unwrap_or_default(),
                 reading: overrides.graph_reading.unwrap_or_default(),
                 joints: overrides.joints.clone(),
+                // Chosen by what the run is for (`RunOptions::step_marginals`).
+                step_marginals: Default::default(),
             },
             graph_progress: None,
         },

@@ -299,13 +299,21 @@ fn run<G: EvalGroup<N>, const N: usize>(
         0
     };
     let b = block_samples(plan, settings)?.min(n);
-    let mut out = if b >= n {
-        Engine::run(plan, settings, 0..n, StatsMode::Own)?
-    } else {
-        run_blocked(plan, settings, n, b)?
+    let monte_carlo = || {
+        if b >= n {
+            Engine::run(plan, settings, 0..n, StatsMode::Own)
+        } else {
+            run_blocked(plan, settings, n, b)
+        }
     };
-    if let Some(g) = &plan.graph {
-        let evaluation = graph::evaluate_graph(
+    let Some(g) = &plan.graph else {
+        return monte_carlo();
+    };
+    // A pose graph's optimisation (mostly sequential sparse algebra) and the Monte Carlo of
+    // its odometry chain and loop closures share nothing: both run at once, each on the
+    // cores the other leaves idle.
+    let (out, evaluation) = rayon::join(monte_carlo, || {
+        graph::evaluate_graph(
             g,
             &settings.graph,
             settings.confidence,
@@ -316,10 +324,11 @@ fn run<G: EvalGroup<N>, const N: usize>(
                 }
             },
         )
-        .map_err(|e| EvalError::Graph(e.to_string()))?;
-        out.findings.extend(graph_findings(&evaluation));
-        out.graph = Some(evaluation);
-    }
+    });
+    let mut out = out?;
+    let evaluation = evaluation.map_err(|e| EvalError::Graph(e.to_string()))?;
+    out.findings.extend(graph_findings(&evaluation));
+    out.graph = Some(evaluation);
     Ok(out)
 }
 

@@ -99,18 +99,22 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
         let samplers = Sampler::<G, N>::right_noise(noise.as_slice()).map_err(|e| self.math(e))?;
         let first = current.as_deref().filter(|_| policy.samples(0, last));
         self.push_step(&name, 0, last, step_estimates(0), first)?;
-        // From one recorded step to the next, each chunk of particles takes every step in
-        // one task (the same draws as one parallel pass per step: step k's family, chunk c's
-        // stream), and only the recorded step is pushed (the others keep no numbers).
+        // From one sampled step to the next, each chunk of particles takes every step in one
+        // task (the same draws as one parallel pass per step: step k's family, chunk c's
+        // stream); the recorded steps between keep their analytic numbers only.
         let mut done = 0usize;
         while done < controls.len() {
             if self.settings.cancelled() {
                 self.out.findings.push(Finding::Interrupted);
                 break;
             }
-            let next = (done + 1..=controls.len())
-                .find(|&k| policy.records(k as u64, last))
-                .unwrap_or(controls.len());
+            let recorded = |k: usize| policy.records(k as u64, last);
+            let sampled = |k: usize| policy.samples(k as u64, last);
+            let next = match current {
+                Some(_) => (done + 1..=controls.len()).find(|&k| sampled(k)),
+                None => (done + 1..=controls.len()).find(|&k| recorded(k)),
+            }
+            .unwrap_or(controls.len());
             if let Some(particles) = current.as_mut() {
                 let families: Vec<u64> = (done..next).map(|_| self.next_family()).collect();
                 let (seed, first_chunk) = (self.settings.seed, self.first_chunk());
@@ -131,14 +135,15 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                     }
                 });
             }
+            for k in (done + 1..next).filter(|&k| recorded(k)) {
+                self.push_step(&name, k as u64, last, step_estimates(k), None)?;
+            }
             self.push_step(
                 &name,
                 next as u64,
                 last,
                 step_estimates(next),
-                current
-                    .as_deref()
-                    .filter(|_| policy.samples(next as u64, last)),
+                current.as_deref().filter(|_| sampled(next)),
             )?;
             done = next;
         }

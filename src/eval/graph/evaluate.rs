@@ -10,6 +10,7 @@ use crate::plan::graph::PoseGraph;
 use crate::uncertain::Confidence;
 
 use super::sigma::{PoseSigma, SigmaBeforeAfter};
+use super::timeline::ClosureStep;
 use super::{
     Anchor, ClosureTimeline, GraphReading, Iteration, Joint, Optimizer, Solution, SolverSettings,
     SparseError, Stage, Stop, relative_covariance,
@@ -24,6 +25,21 @@ pub struct GraphSettings {
     pub reading: GraphReading,
     /// Pairs of vertex ids (a, b) whose joint marginal is wanted (`--joint a,b`).
     pub joints: Vec<(u64, u64)>,
+    /// Which steps of the loop-closure timeline get every pose's marginal.
+    pub step_marginals: StepMarginals,
+}
+
+/// Which steps of the loop-closure timeline ([`ClosureTimeline`]) get every pose's marginal
+/// besides the final solution's: computed where they are shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StepMarginals {
+    /// Every step's (the viewer's `step` timeline shows each state's marginals).
+    #[default]
+    Every,
+    /// Step 0's only (dead reckoning, the σ before of [`GraphEvaluation::sigmas`]): the other
+    /// steps keep their poses and χ² but no marginals ([`ClosureStep::covariances`] all None),
+    /// for a report or a figure of the final state, which show no other step's.
+    DeadReckoning,
 }
 
 /// Why a graph could not be evaluated.
@@ -145,7 +161,7 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
     settings: &GraphSettings,
     confidence: Confidence,
     cancel: Option<Arc<AtomicBool>>,
-    progress: &mut dyn FnMut(Stage, &Iteration),
+    progress: &mut (dyn FnMut(Stage, &Iteration) + Send),
 ) -> Result<GraphEvaluation<G, N>, GraphError> {
     let index = |id: u64| {
         graph
@@ -165,7 +181,48 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         cancel,
         ..SolverSettings::default()
     };
-    let solution = super::optimize(graph, &solver, &mut |i| progress(Stage::Optimizing, i))?;
+    let loop_edges = loop_closure_edges(graph);
+    // The full solve and the timeline's re-solves (each warm-started from the step before;
+    // the last step is the full solution) depend on nothing of each other: both run at once.
+    let progress = std::sync::Mutex::new(progress);
+    let report = |stage: Stage, i: &Iteration| {
+        if let Ok(mut p) = progress.lock() {
+            (*p)(stage, i);
+        }
+    };
+    let (solution, steps) = rayon::join(
+        || super::optimize(graph, &solver, &mut |i| report(Stage::Optimizing, i)),
+        || {
+            let timeline = super::timeline::closure_timeline(
+                graph,
+                &loop_edges,
+                &solver,
+                settings.step_marginals,
+                &report,
+            )?;
+            let dead_reckoning =
+                super::timeline::dead_reckoning(graph, &loop_edges, &timeline, &solver, &report)?;
+            Ok::<_, SparseError>((timeline, dead_reckoning))
+        },
+    );
+    let solution = solution?;
+    let (mut timeline, dead_reckoning) = steps?;
+    let dead_reckoning = dead_reckoning.unwrap_or_else(|| solution.covariances.clone());
+    if solution.stop == Stop::Interrupted {
+        timeline = ClosureTimeline {
+            steps: Vec::new(),
+            too_large: None,
+            interrupted: true,
+        };
+    } else if !timeline.interrupted && timeline.too_large.is_none() && !loop_edges.is_empty() {
+        timeline.steps.push(ClosureStep {
+            closures: loop_edges.len(),
+            poses: solution.poses.clone(),
+            covariances: solution.covariances.clone(),
+            chi2: solution.chi2_after,
+            stop: solution.stop,
+        });
+    }
     let isolated = |v: usize| {
         matches!(
             solution.parts[solution.part_of[v]].anchor,
@@ -193,8 +250,6 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
     let initial = graph.estimates();
     let mut first_of: std::collections::HashMap<(usize, usize), usize> = Default::default();
     let mut duplicates = Vec::new();
-    let mut chain_taken = std::collections::HashSet::new();
-    let mut loop_closures = Vec::new();
     for (k, e) in graph.edges.iter().enumerate() {
         let pair = (e.from.min(e.to), e.from.max(e.to));
         match first_of.get(&pair) {
@@ -203,52 +258,33 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
                 first_of.insert(pair, k);
             }
         }
-        let (i, j) = (graph.vertices[e.from].id, graph.vertices[e.to].id);
-        if i.abs_diff(j) == 1 && chain_taken.insert((i.min(j), i.max(j))) {
-            continue;
-        }
-        let lambda = e.information_in(settings.reading);
-        let distance = |r: &Tangent<N>| (r.transpose() * lambda * r)[(0, 0)].max(0.0).sqrt();
-        let residual_before = e.residual(&initial);
-        let residual = e.residual(&solution.poses);
-        // X_j = X_i · Z · Exp(r): the predicted pose is X_j · Exp(−r).
-        let predicted = solution.poses[e.to].compose(&G::exp(&-residual));
-        loop_closures.push(LoopClosure {
-            edge: k,
-            from: i,
-            to: j,
-            line: e.line,
-            mahalanobis_before: distance(&residual_before),
-            residual_before,
-            mahalanobis: distance(&residual),
-            predicted_position: predicted.to_se3().translation().to_owned(),
-            residual,
-            relative_cov: solution.edge_joints[k].as_ref().map(|joint| {
-                relative_covariance(&solution.poses[e.from], &solution.poses[e.to], joint)
-            }),
-        });
     }
-    let loop_edges: Vec<usize> = loop_closures
+    let loop_closures = loop_edges
         .iter()
-        .map(|l: &LoopClosure<N>| l.edge)
+        .map(|&k| {
+            let e = &graph.edges[k];
+            let lambda = e.information_in(settings.reading);
+            let distance = |r: &Tangent<N>| (r.transpose() * lambda * r)[(0, 0)].max(0.0).sqrt();
+            let residual_before = e.residual(&initial);
+            let residual = e.residual(&solution.poses);
+            // X_j = X_i · Z · Exp(r): the predicted pose is X_j · Exp(−r).
+            let predicted = solution.poses[e.to].compose(&G::exp(&-residual));
+            LoopClosure {
+                edge: k,
+                from: graph.vertices[e.from].id,
+                to: graph.vertices[e.to].id,
+                line: e.line,
+                mahalanobis_before: distance(&residual_before),
+                residual_before,
+                mahalanobis: distance(&residual),
+                predicted_position: predicted.to_se3().translation().to_owned(),
+                residual,
+                relative_cov: solution.edge_joints[k].as_ref().map(|joint| {
+                    relative_covariance(&solution.poses[e.from], &solution.poses[e.to], joint)
+                }),
+            }
+        })
         .collect();
-    let timeline = if solution.stop == Stop::Interrupted {
-        ClosureTimeline {
-            steps: Vec::new(),
-            too_large: None,
-            interrupted: true,
-        }
-    } else {
-        super::timeline::closure_timeline(graph, &loop_edges, &solution, &solver, progress)?
-    };
-    let dead_reckoning = super::timeline::dead_reckoning(
-        graph,
-        &loop_edges,
-        &solution,
-        &timeline,
-        &solver,
-        progress,
-    )?;
     let edge_chi2 = graph
         .edges
         .iter()
@@ -270,6 +306,19 @@ pub fn evaluate_graph<G: LieGroup<N>, const N: usize>(
         duplicates,
         edge_chi2,
     })
+}
+
+/// The loop closures of `graph`, indices into its edges in file order: every edge but the
+/// first between consecutive ids k, k + 1.
+fn loop_closure_edges<G: LieGroup<N>, const N: usize>(graph: &PoseGraph<G, N>) -> Vec<usize> {
+    let mut chain_taken = std::collections::HashSet::new();
+    (0..graph.edges.len())
+        .filter(|&k| {
+            let e = &graph.edges[k];
+            let (i, j) = (graph.vertices[e.from].id, graph.vertices[e.to].id);
+            !(i.abs_diff(j) == 1 && chain_taken.insert((i.min(j), i.max(j))))
+        })
+        .collect()
 }
 
 impl<G: LieGroup<N>, const N: usize> GraphEvaluation<G, N> {

@@ -65,7 +65,8 @@ mod timeline;
 
 pub use crate::plan::graph::GraphReading;
 pub use evaluate::{
-    GraphError, GraphEvaluation, GraphSettings, JointMarginal, LoopClosure, evaluate_graph,
+    GraphError, GraphEvaluation, GraphSettings, JointMarginal, LoopClosure, StepMarginals,
+    evaluate_graph,
 };
 pub use parts::{Anchor, Part, Parts, parts};
 pub use report::{
@@ -108,6 +109,9 @@ pub struct SolverSettings {
     pub pairs: Vec<(usize, usize)>,
     /// Set to stop between iterations (Ctrl-C): the last accepted estimate is kept.
     pub cancel: Option<Arc<AtomicBool>>,
+    /// Whether to compute the marginals once optimised (default true; without them every
+    /// covariance and joint is None and [`Solution::marginals_error`] says why).
+    pub marginals: bool,
 }
 
 impl Default for SolverSettings {
@@ -120,6 +124,7 @@ impl Default for SolverSettings {
             reading: GraphReading::default(),
             pairs: Vec::new(),
             cancel: None,
+            marginals: true,
         }
     }
 }
@@ -286,15 +291,19 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
     let mut covariances = vec![None; graph.vertices.len()];
     let mut edge_joints = vec![None; graph.edges.len()];
     let mut joints = vec![None; settings.pairs.len()];
-    let marginals_error = marginals_at(
-        &mut problem,
-        &run.poses,
-        &settings.pairs,
-        &mut covariances,
-        &mut edge_joints,
-        &mut joints,
-    )
-    .err();
+    let marginals_error = if settings.marginals {
+        marginals_at(
+            &mut problem,
+            &run.poses,
+            &settings.pairs,
+            &mut covariances,
+            &mut edge_joints,
+            &mut joints,
+        )
+        .err()
+    } else {
+        Some(NOT_ASKED.to_owned())
+    };
     let marginals_seconds = clock.elapsed().as_secs_f64();
     Ok(Solution {
         optimizer: settings.optimizer,
@@ -317,6 +326,10 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
         marginals_seconds,
     })
 }
+
+/// [`Solution::marginals_error`] of a solve whose marginals were not asked for
+/// ([`SolverSettings::marginals`] false).
+pub const NOT_ASKED: &str = "marginals not asked for";
 
 /// The joint marginal of two poses a, b: (Σ_aa, Σ_ab, Σ_bb), the blocks of H⁻¹ over
 /// [δ_a; δ_b] (right form, [ρ; θ]; Σ_ba = Σ_abᵀ).

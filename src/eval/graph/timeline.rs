@@ -12,7 +12,8 @@
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::plan::graph::PoseGraph;
 
-use super::{Iteration, Solution, SolverSettings, SparseError, Stage, Stop, optimize};
+use super::evaluate::StepMarginals;
+use super::{Iteration, SolverSettings, SparseError, Stage, Stop, optimize};
 
 /// Most poses a graph may have to be re-solved loop closure by loop closure.
 pub const MAX_TIMELINE_POSES: usize = 10_000;
@@ -28,7 +29,9 @@ pub struct ClosureStep<G, const N: usize> {
     pub closures: usize,
     /// The optimised poses, one per vertex.
     pub poses: Vec<G>,
-    /// Each vertex's marginal (right form, [ρ; θ]; None as in [`Solution::covariances`]).
+    /// Each vertex's marginal (right form, [ρ; θ]; None as in
+    /// [`Solution::covariances`](super::Solution::covariances), and for every vertex of a step
+    /// after 0 evaluated with [`StepMarginals::DeadReckoning`]).
     pub covariances: Vec<Option<TangentMatrix<N>>>,
     /// χ² at this step's optimum, over its own edges and priors.
     pub chi2: f64,
@@ -67,14 +70,15 @@ pub fn closure_counts(loops: usize) -> Vec<usize> {
     out
 }
 
-/// The timeline of `graph`, whose loop closures are the edges `loop_edges` (in file order),
-/// with `full` its solution with every edge (see the [module docs](self)).
+/// The timeline of `graph`, whose loop closures are the edges `loop_edges` (in file order):
+/// every step but the last, which is the full solution and is added by the caller (see the
+/// [module docs](self)). `marginals` says which steps get every pose's marginal.
 pub(super) fn closure_timeline<G: LieGroup<N>, const N: usize>(
     graph: &PoseGraph<G, N>,
     loop_edges: &[usize],
-    full: &Solution<G, N>,
     settings: &SolverSettings,
-    progress: &mut dyn FnMut(Stage, &Iteration),
+    marginals: StepMarginals,
+    progress: &(dyn Fn(Stage, &Iteration) + Sync),
 ) -> Result<ClosureTimeline<G, N>, SparseError> {
     let mut timeline = ClosureTimeline {
         steps: Vec::new(),
@@ -86,24 +90,18 @@ pub(super) fn closure_timeline<G: LieGroup<N>, const N: usize>(
         return Ok(timeline);
     }
     let rank = ranks(graph, loop_edges);
-    let solver = SolverSettings {
-        pairs: Vec::new(),
-        ..settings.clone()
-    };
     let mut start = graph.estimates();
     let counts = closure_counts(loop_edges.len());
     let of = counts.len().saturating_sub(1);
     for (step, k) in counts.into_iter().enumerate() {
         if k == loop_edges.len() {
-            timeline.steps.push(ClosureStep {
-                closures: k,
-                poses: full.poses.clone(),
-                covariances: full.covariances.clone(),
-                chi2: full.chi2_after,
-                stop: full.stop,
-            });
             break;
         }
+        let solver = SolverSettings {
+            pairs: Vec::new(),
+            marginals: k == 0 || marginals == StepMarginals::Every,
+            ..settings.clone()
+        };
         let sub = first_closures(graph, &rank, k, &start);
         let stage = Stage::Timeline { step: step + 1, of };
         let s = optimize(&sub, &solver, &mut |i| progress(stage, i))?;
@@ -162,22 +160,21 @@ fn first_closures<G: LieGroup<N>, const N: usize>(
 }
 
 /// Every pose's dead-reckoning marginal: of `graph` without its loop closures `loop_edges`
-/// (odometry and priors only), optimised — the timeline's step 0 when it has one, `full`'s
-/// marginals when there are no loop closures, else solved here once (a graph too large for
-/// the timeline).
+/// (odometry and priors only), optimised — the timeline's step 0 when it has one, else solved
+/// here once (a graph too large for the timeline); None when there are no loop closures (the
+/// full solution's marginals are then the dead reckoning's).
 pub(super) fn dead_reckoning<G: LieGroup<N>, const N: usize>(
     graph: &PoseGraph<G, N>,
     loop_edges: &[usize],
-    full: &Solution<G, N>,
     timeline: &ClosureTimeline<G, N>,
     settings: &SolverSettings,
-    progress: &mut dyn FnMut(Stage, &Iteration),
-) -> Result<Vec<Option<TangentMatrix<N>>>, SparseError> {
+    progress: &(dyn Fn(Stage, &Iteration) + Sync),
+) -> Result<Option<Vec<Option<TangentMatrix<N>>>>, SparseError> {
     if loop_edges.is_empty() {
-        return Ok(full.covariances.clone());
+        return Ok(None);
     }
     if let Some(step) = timeline.steps.first().filter(|s| s.closures == 0) {
-        return Ok(step.covariances.clone());
+        return Ok(Some(step.covariances.clone()));
     }
     let solver = SolverSettings {
         pairs: Vec::new(),
@@ -185,5 +182,7 @@ pub(super) fn dead_reckoning<G: LieGroup<N>, const N: usize>(
     };
     let sub = first_closures(graph, &ranks(graph, loop_edges), 0, &graph.estimates());
     let stage = Stage::Timeline { step: 1, of: 1 };
-    Ok(optimize(&sub, &solver, &mut |i| progress(stage, i))?.covariances)
+    Ok(Some(
+        optimize(&sub, &solver, &mut |i| progress(stage, i))?.covariances,
+    ))
 }
