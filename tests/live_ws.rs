@@ -378,6 +378,48 @@ fn a_live_view_grows_and_its_last_generation_is_the_one_shot_drawing() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The growing view draws NEES against `--reference` as it goes: a picture before the last
+/// already has NEES series with points.
+#[test]
+fn a_growing_view_draws_the_nees_so_far() {
+    let Some(python) = peer_python() else { return };
+    let dir = scratch("grow-nees");
+    let peer = Peer::start_spread(&python, "sdk", &dir, &[], 6.0);
+    let rrd = dir.join("grow.rrd");
+    let (url, n) = (peer.url(), peer.messages.to_string());
+    let out = posecov(&[
+        &url,
+        "--reference",
+        "/ground_truth",
+        "--duration",
+        "90s",
+        "--messages",
+        &n,
+        "--save",
+        &rrd.display().to_string(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    peer.finish();
+    let chunks = rrd::recording_chunks(&std::fs::read(&rrd).expect("the recording"));
+    // (generation, whether the series is a NEES one) of every temporal series with points.
+    let drawn: Vec<(u64, bool)> = chunks
+        .iter()
+        .filter(|c| !c.is_static() && c.num_rows() > 1)
+        .filter_map(|c| {
+            let p = c.entity_path().to_string();
+            let rest = p.strip_prefix("/plots/")?.split_once('/')?.1;
+            let (g, tail) = rest.strip_prefix('g')?.split_once('/')?;
+            Some((g.parse().ok()?, tail.contains("nees")))
+        })
+        .collect();
+    let last = drawn.iter().map(|d| d.0).max().expect("a generation");
+    assert!(
+        drawn.iter().any(|&(g, nees)| nees && g < last),
+        "no NEES before the last picture: {drawn:?}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 /// Every σ series with points: its plot and path below the plot (past `prefix`), its rows and
 /// their values.
 fn series(chunks: &[rerun::log::Chunk], prefix: &str) -> Vec<(String, usize, String)> {

@@ -295,3 +295,91 @@ fn a_stream_that_ends_early_is_exit_2_with_the_reason() {
         "{said}"
     );
 }
+
+/// `frame` (a [`pose_frame`]) with its covariance's first number NaN.
+fn with_nan(frame: tungstenite::Message) -> tungstenite::Message {
+    let mut bytes = frame.into_data().to_vec();
+    // 13 (message data) + 4 (CDR) + 8 (stamp) + 8 ("map") + 56 (pose).
+    bytes[89..97].copy_from_slice(&f64::NAN.to_le_bytes());
+    tungstenite::Message::binary(bytes)
+}
+
+#[test]
+fn bad_channels_and_messages_are_named_or_counted() {
+    let port = scripted(1, |ws, sub, _| {
+        use tungstenite::Message;
+        // A pose schema in an encoding posecov does not read, and a schema it does not know.
+        let more = r#"{"op":"advertise","channels":[{"id":2,"topic":"/pose_json","encoding":"json","schemaName":"geometry_msgs/msg/PoseWithCovarianceStamped","schema":""},{"id":3,"topic":"/widget","encoding":"cdr","schemaName":"acme_msgs/msg/Widget","schema":""}]}"#;
+        ws.send(Message::text(more)).expect("send");
+        for i in 0..5 {
+            ws.send(pose_frame(sub, i)).expect("send");
+        }
+        // A CDR payload cut short, a NaN covariance, a stamp out of order.
+        let mut cut = pose_frame(sub, 5).into_data().to_vec();
+        cut.truncate(50);
+        ws.send(Message::binary(cut)).expect("send");
+        ws.send(with_nan(pose_frame(sub, 6))).expect("send");
+        ws.send(pose_frame(sub, 2)).expect("send");
+        until_gone(ws);
+    });
+    let url = format!("ws://127.0.0.1:{port}");
+    let out = posecov(&[
+        "report",
+        &url,
+        "--json",
+        "--messages",
+        "8",
+        "--duration",
+        "20s",
+    ]);
+    let said = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{said}");
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let skipped = json["skipped"].to_string();
+    assert!(
+        skipped.contains(r#""name":"/pose_json""#)
+            && skipped.contains("in json encoding; posecov reads cdr or ros1"),
+        "{skipped}"
+    );
+    assert!(
+        skipped.contains(r#""message_type":"acme_msgs/msg/Widget""#),
+        "{skipped}"
+    );
+    let health = &json["topics"][0]["health"];
+    for (issue, count) in [("undecodable", 1), ("non_finite", 1), ("stamp_order", 1)] {
+        assert_eq!(health[issue]["count"], count, "{issue}: {health}");
+    }
+    assert_eq!(json["topics"][0]["messages"], 8);
+}
+
+#[test]
+fn a_flood_is_read_or_thinned_and_the_count_thinned_is_said() {
+    const SENT: u32 = 40_000;
+    let port = scripted(1, |ws, sub, _| {
+        for i in 0..SENT {
+            if ws.send(pose_frame(sub, i)).is_err() {
+                return;
+            }
+        }
+        until_gone(ws);
+    });
+    let url = format!("ws://127.0.0.1:{port}");
+    let out = posecov(&[
+        "report",
+        &url,
+        "--json",
+        "--messages",
+        &SENT.to_string(),
+        "--duration",
+        "300s",
+    ]);
+    let said = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{said}");
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let read = json["topics"][0]["messages"].as_u64().expect("messages");
+    let thinned = json["meta"]["stream"]["thinned"]
+        .as_u64()
+        .expect("meta.stream.thinned");
+    // Every message sent was read or thinned (and said so: `StreamNotes::thin`), none twice.
+    assert_eq!(read + thinned, u64::from(SENT), "{said}");
+}

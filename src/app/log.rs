@@ -67,19 +67,19 @@ pub(super) fn run(
                 .to_owned(),
         }));
     }
-    let mut reference = match &settings.reference {
-        Some(r) => Some(nees::prepare(
+    let reference = match &settings.reference {
+        Some(r) => Some(nees::SharedPrepared::new(nees::prepare(
             r,
             settings.eval.reading,
             settings.read.every,
-        )?),
+        )?)),
         None => None,
     };
     let mut options = settings.read.clone();
-    options.reference = reference.as_ref().and_then(|r| r.in_log.clone());
-    let observer = reference
-        .as_mut()
-        .map(|r| &mut r.observer as &mut dyn LogObserver);
+    options.reference = reference.as_ref().and_then(|r| r.borrow().in_log.clone());
+    // The read hands every message to the observer; the growing view reads its NEES so far.
+    let mut forward = reference.as_ref().map(nees::Forward);
+    let observer = forward.as_mut().map(|f| f as &mut dyn LogObserver);
     let title = match &located.place {
         Place::Bundled(e) => bundled::find(e.name).map_or(e.name, |l| l.title).to_owned(),
         Place::File(_) | Place::Live(_) => file.clone(),
@@ -94,11 +94,14 @@ pub(super) fn run(
         axis_length: None,
     };
     let growing_wanted = drawn && growing.is_some();
-    // What the stream has given so far, evaluated and drawn as the end's summary is (its NEES
-    // waits for the end: the observer is the read's); an undrawable one is left out.
+    // What the stream has given so far, evaluated and drawn as the end's summary is, with the
+    // NEES of the estimates matched so far; an undrawable one is left out.
     let mut grow = |mut plan: LogSummary| {
         if let Some(show) = growing.as_mut() {
-            let evaluation = evaluate_log(&mut plan, &settings.eval);
+            let mut evaluation = evaluate_log(&mut plan, &settings.eval);
+            if let Some(reference) = &reference {
+                evaluation = evaluation.with_consistency(nees::so_far(reference, &plan));
+            }
             let summary = describe(located, &plan, &evaluation, settings.confidence);
             let scene = draw_log(&evaluation, &draw, &summary);
             if scene.validate().is_ok() {
@@ -110,7 +113,8 @@ pub(super) fn run(
     let mut plan = read(located, &options, cancel, bar, observer, grow)?;
     let mut evaluation = evaluate_log(&mut plan, &settings.eval);
     if let Some(reference) = reference {
-        evaluation = evaluation.with_consistency(nees::finish(reference, &plan, &file)?);
+        let results = nees::finish(reference.into_inner(), &plan, &file)?;
+        evaluation = evaluation.with_consistency(results);
     }
     let summary = describe(located, &plan, &evaluation, settings.confidence);
     let scene = if drawn {

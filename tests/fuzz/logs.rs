@@ -361,8 +361,9 @@ pub(crate) const LOG_JSON_OPTIONAL: &[&str] = &[
     ".topics[#].consistency",
     // Read to the end of the file: no cut.
     ".meta.cut_short",
-    // A file, not a live stream.
+    // A file, not a live stream; a live stream that did not end on its own.
     ".meta.stream",
+    ".meta.stream.ended",
     // Drawn in its own frame; nothing left out of a join; a missing link has no stamp.
     ".topics[#].frame_join",
     "first_left_out_s",

@@ -12,6 +12,7 @@
 //! | `mcap` | the bundled MCAP, mutated by byte | the same |
 //! | `db3` | three ROS 2 SQLite bags of tests/data/ros2 (version 9, Humble's 5, zstd messages), mutated by byte | the same |
 //! | `ov_eval` | the OpenVINS text trajectories of tests/data/ov_eval (cut) and one mixing 8- and 20-column lines, mutated by token, line and byte | read as an estimate → evaluate → draw → validate → `report --json`; read as a NEES reference (the TUM reader) |
+//! | `live_ws` | a scripted Foxglove WebSocket server on 127.0.0.1, each session a good one (a ROS 2 and a ROS 1 pose topic) damaged: frames' JSON and bytes mutated, bad frames of the list inserted, frames dropped, repeated, swapped | `report --json` of `ws://127.0.0.1:PORT` (read → evaluate → report), Ctrl-C once the server is done |
 //! | `live_api` | raw HTTP requests to the live page's server: methods, paths, `Host`, `Origin`, content types, edits of every control to edge values | a real server on loopback |
 //!
 //! # Invariants
@@ -33,7 +34,9 @@
 //!    the place inside the text, the field in the file's words and no Rust words
 //!    (`error_unlocated`, `error_bad_location`, `error_field_*`, `error_rust_speak`); a graph
 //!    error names the file (and a place inside it when it gives one); a log error names the
-//!    file (an ov_eval trajectory's: a place inside the text). The live API answers every request, never with a 5xx (`server_error`).
+//!    file (an ov_eval trajectory's: a place inside the text); a live stream's error names
+//!    its URL, its report says what the stream did (`meta.stream`) and reads no more
+//!    messages than were sent (`stream_unsaid`, `accepted_invalid_value`). The live API answers every request, never with a 5xx (`server_error`).
 //!
 //! # Running
 //!
@@ -56,6 +59,7 @@ mod graph;
 mod harness;
 #[cfg(feature = "viewer")]
 mod live_api;
+mod live_ws;
 mod logs;
 mod oracle;
 mod ov_eval;
@@ -73,6 +77,7 @@ fn families() -> Vec<Box<dyn Family>> {
         Box::new(logs::Logs::new(logs::LogKind::Mcap)),
         Box::new(logs::Logs::new(logs::LogKind::Db3)),
         Box::new(ov_eval::OvEval::new()),
+        Box::new(live_ws::LiveWs),
     ];
     // The page server needs the viewer feature (axum, tokio).
     #[cfg(feature = "viewer")]

@@ -13,7 +13,9 @@ use crate::eval::log::nees::{NeesObserver, NeesSettings, TopicConsistency};
 use crate::input::InputError;
 use crate::input::tum::read_tum;
 use crate::interop::RosReading;
-use crate::plan::log::{LogSummary, Reference, ReferenceInLog};
+use crate::plan::log::{
+    EstimateMessage, LogObserver, LogSummary, Reference, ReferenceInLog, ReferenceSample,
+};
 
 /// A reference ready for the read: the observer, and what the reader must look for.
 pub(super) struct Prepared {
@@ -96,6 +98,39 @@ pub(super) fn prepare(
     })
 }
 
+/// The observer of a run whose view grows: the read hands it every message (through
+/// [`Forward`]), the growing view reads the NEES so far between messages ([`so_far`]).
+pub(super) type SharedPrepared = std::cell::RefCell<Prepared>;
+
+/// Hands every message of the read to a shared reference's observer.
+pub(super) struct Forward<'c>(pub(super) &'c SharedPrepared);
+
+impl LogObserver for Forward<'_> {
+    fn reference(&mut self, frame_id: &str, sample: ReferenceSample) {
+        self.0.borrow_mut().observer.reference(frame_id, sample);
+    }
+    fn estimate(&mut self, message: &EstimateMessage<'_>) {
+        self.0.borrow_mut().observer.estimate(message);
+    }
+}
+
+/// The NEES so far of a run still being read, for the growing view: each topic's series at
+/// the drawn messages of `plan` (the summary so far).
+pub(super) fn so_far(
+    prepared: &SharedPrepared,
+    plan: &LogSummary,
+) -> BTreeMap<String, TopicConsistency> {
+    prepared.borrow().observer.so_far(&strides(plan))
+}
+
+/// Each topic's drawn stride (the NEES series is kept at the drawn messages).
+fn strides(plan: &LogSummary) -> BTreeMap<String, u64> {
+    plan.topics
+        .iter()
+        .map(|t| (t.name.clone(), t.stride))
+        .collect()
+}
+
 /// After the read: the reference was in the log as asked (or, for a bare value read as a file,
 /// not also a topic), and some estimate message fell within it. Returns each topic's NEES.
 pub(super) fn finish(
@@ -165,12 +200,7 @@ pub(super) fn finish(
         _ => {}
     }
     let span = prepared.observer.reference_span();
-    let strides: BTreeMap<String, u64> = plan
-        .topics
-        .iter()
-        .map(|t| (t.name.clone(), t.stride))
-        .collect();
-    let results = prepared.observer.finish(&strides);
+    let results = prepared.observer.finish(&strides(plan));
     if plan.cancelled || results.values().any(|c| c.messages > 0) {
         return Ok(results);
     }

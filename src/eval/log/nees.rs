@@ -105,7 +105,7 @@ struct Waiting {
 }
 
 /// Sums over a topic's messages.
-#[derive(Default)]
+#[derive(Default, Clone)]
 struct Sums {
     messages: u64,
     joint: f64,
@@ -194,6 +194,53 @@ impl NeesObserver {
         }
     }
 
+    /// The NEES of every estimate matched so far, as [`finish`](Self::finish) gives it, the
+    /// stream going on (a growing live view draws it): estimates still waiting for the
+    /// reference are not in it yet; with `se3` alignment (which needs the whole run) no
+    /// estimate has a NEES before the end.
+    ///
+    /// ```
+    /// use posecov::eval::log::nees::{NeesObserver, NeesSettings};
+    /// use posecov::plan::log::{EstimateMessage, LogObserver, Reference, ReferenceInLog, ReferenceSample};
+    /// let truth = Reference::InLog(ReferenceInLog::Topic("/truth".into()));
+    /// let mut nees = NeesObserver::new(NeesSettings::new(truth));
+    /// let q = [0.0, 0.0, 0.0, 1.0];
+    /// for k in 0..3 {
+    ///     nees.reference("map", ReferenceSample { stamp_ns: k * 100, position: [0.0; 3], orientation_xyzw: q });
+    /// }
+    /// let mut cov = [0.0; 36];
+    /// for i in 0..6 { cov[i * 7] = 0.01; }
+    /// nees.estimate(&EstimateMessage { topic: "/ekf", frame_id: "map", index: 0, stamp_ns: 150,
+    ///     position: [0.1, 0.0, 0.0], orientation_xyzw: q, covariance: &cov,
+    ///     usable: true, unestimated: [false; 6] });
+    /// let drawn = [("/ekf".to_owned(), 1)].into();
+    /// let so_far = nees.so_far(&drawn);
+    /// assert_eq!(so_far["/ekf"].messages, 1);
+    /// assert_eq!(so_far, nees.finish(&drawn));
+    /// ```
+    pub fn so_far(&self, drawn: &BTreeMap<String, u64>) -> BTreeMap<String, TopicConsistency> {
+        let reference_frame = self.reference_frame.clone().unwrap_or_default();
+        self.topics
+            .iter()
+            .map(|(name, state)| {
+                let taken = TopicState {
+                    frame_id: state.frame_id.clone(),
+                    dof: state.dof,
+                    pending: VecDeque::new(),
+                    matched: Vec::new(),
+                    alignment: state.alignment,
+                    sums: state.sums.clone(),
+                    skipped: state.skipped,
+                    series: state.series.clone(),
+                    bound: state.bound,
+                };
+                let stride = stride_of(drawn, name);
+                let c = summary(&self.settings, &reference_frame, taken, stride);
+                (name.clone(), c)
+            })
+            .collect()
+    }
+
     /// Ends the stream: waiting estimates are after the reference; with `se3` alignment the
     /// transform is fitted and every matched message's NEES taken. `drawn` gives each topic's
     /// drawn stride by topic (the NEES series is kept at the drawn messages). Returns each
@@ -224,7 +271,7 @@ impl NeesObserver {
                     }
                 }
             }
-            let stride = drawn.get(&name).map_or(1, |s| (*s).max(1));
+            let stride = stride_of(drawn, &name);
             let consistency = summary(&settings, &reference_frame, state, stride);
             out.insert(name, consistency);
         }
@@ -453,6 +500,11 @@ fn add_nees(state: &mut TopicState, w: &Waiting, truth: &Se3) {
     if state.series.wants(w.index) {
         state.series.push(w.index, (w.index, w.stamp_ns, joint));
     }
+}
+
+/// The drawn stride of topic `name` in `drawn` (1 when not there).
+fn stride_of(drawn: &BTreeMap<String, u64>, name: &str) -> u64 {
+    drawn.get(name).map_or(1, |s| (*s).max(1))
 }
 
 fn summary(

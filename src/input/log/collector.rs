@@ -10,8 +10,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use crate::plan::log::{
-    EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessage, PoseMessageKind, ReferenceInLog,
-    ReferenceRead, SkippedTopic, StreamNotes,
+    Decimator, EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessage, PoseMessageKind,
+    ReferenceInLog, ReferenceRead, SkippedTopic, StreamNotes,
 };
 
 use super::decode::{ros1_kind, ros2_kind};
@@ -81,6 +81,22 @@ impl Stream {
     }
 }
 
+impl LogOptions {
+    /// Whether `topic` is read (`--topic`, or every pose topic when none is given).
+    pub(super) fn selects(&self, topic: &str) -> bool {
+        self.topics.is_empty() || self.topics.iter().any(|t| t == topic)
+    }
+
+    /// Whether `topic` carries the reference asked for (its topic, or `/tf` for `tf:CHILD`).
+    pub(super) fn carries_reference(&self, topic: &str) -> bool {
+        match &self.reference {
+            Some(ReferenceInLog::Topic(name)) => name == topic,
+            Some(ReferenceInLog::Tf { .. }) => topic == "/tf",
+            None => false,
+        }
+    }
+}
+
 /// Receives every message of a log in file order.
 pub(super) struct Collector<'a, 'o> {
     options: &'a LogOptions,
@@ -100,6 +116,12 @@ pub(super) struct Collector<'a, 'o> {
     /// when the next summary is due.
     growth: Option<Growth<'o>>,
 }
+
+/// Points kept per topic for the trajectory and each series in a summary handed to the
+/// growing view (the end's keeps [`MAX_SERIES`](super::MAX_SERIES)): a plot a thousand points
+/// wide still shows an hour's shape, and the viewer's recording, which keeps every picture
+/// of a growing run, holds at most this many points per line and picture.
+pub const GROWN_SERIES: usize = 1000;
 
 /// A growing read ([`Collector::growing`]): where its summaries go, when it began, when the
 /// next summary is due (`None`: at the first pose message).
@@ -158,12 +180,12 @@ impl<'a, 'o> Collector<'a, 'o> {
         self
     }
 
-    /// Hands the summary read so far (with the stream's `notes`) to the `show` of
+    /// Hands the summary read so far (with the stream's `notes` so far) to the `show` of
     /// [`Self::growing`] when one is due and a pose message has arrived: a copy of the bounded
     /// state, the collector goes on unchanged. The next is due [`growth_interval`] after this
     /// one was shown, or four times what showing it took if longer (redraws take at most a
     /// fifth of the time, whatever the machine).
-    pub(super) fn grow(&mut self, notes: &StreamNotes) {
+    pub(super) fn grow(&mut self, notes: &dyn Fn() -> StreamNotes) {
         let Some(growth) = &self.growth else {
             return;
         };
@@ -183,7 +205,14 @@ impl<'a, 'o> Collector<'a, 'o> {
         if plan.topics.iter().all(|t| t.count == 0) {
             return;
         }
-        plan.stream = Some(notes.clone());
+        // A picture of the run so far: its series thinner than the end's (every one stays in
+        // the viewer's recording).
+        for topic in &mut plan.topics {
+            topic.series = Decimator::thinned(std::mem::take(&mut topic.series), GROWN_SERIES);
+            topic.trajectory =
+                Decimator::thinned(std::mem::take(&mut topic.trajectory), GROWN_SERIES);
+        }
+        plan.stream = Some(notes());
         if let Some(growth) = &mut self.growth {
             let before = Instant::now();
             (growth.show)(plan);
@@ -196,11 +225,7 @@ impl<'a, 'o> Collector<'a, 'o> {
 
     /// Whether `topic` carries the reference asked for (its topic, or `/tf` for `tf:CHILD`).
     pub(super) fn is_reference(&self, topic: &str) -> bool {
-        match &self.options.reference {
-            Some(ReferenceInLog::Topic(name)) => name == topic,
-            Some(ReferenceInLog::Tf { .. }) => topic == "/tf",
-            None => false,
-        }
+        self.options.carries_reference(topic)
     }
 
     /// A stream the log declares: its topic, and the reference if it is the reference's.
@@ -313,7 +338,7 @@ impl<'a, 'o> Collector<'a, 'o> {
     }
 
     pub(super) fn selected(&self, topic: &str) -> bool {
-        self.options.topics.is_empty() || self.options.topics.iter().any(|t| t == topic)
+        self.options.selects(topic)
     }
 
     /// One message on stream `id` (`streams[id]`), logged at `log_time` ns; an undeclared

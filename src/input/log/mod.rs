@@ -41,8 +41,8 @@ mod tf;
 mod topic;
 pub mod ws;
 
-pub use collector::growth_interval;
 use collector::{Codec, Collector, Stream};
+pub use collector::{GROWN_SERIES, growth_interval};
 use topic::no_pose_topic;
 
 /// The largest record or decompressed chunk of a log read (1 GiB): larger ones are refused,
@@ -151,9 +151,9 @@ pub fn read_located_observed(
 
 /// [`read_located_observed`], and for a live stream the summary read so far handed to
 /// `grow` as messages arrive, at most once per [`growth_interval`] (a file is read whole:
-/// `grow` is not called). Each is a bounded copy (the drawn set, series and statistics as
-/// the end's summary keeps them), `stream` with the stream's notes so far; what the observer
-/// saw is not in it.
+/// `grow` is not called). Each is a bounded copy (the drawn set and statistics as the end's
+/// summary keeps them, the trajectory and series thinned to [`GROWN_SERIES`] points), `stream`
+/// with the stream's notes so far; what the observer saw is not in it.
 ///
 /// ```
 /// use posecov::input::{locate, log::{LogOptions, read_located_growing}};
@@ -179,7 +179,7 @@ pub fn read_located_growing(
             let observer = observer.map(|o| o as &mut dyn LogObserver);
             let grow = grow.map(|g| g as &mut dyn FnMut(LogSummary));
             let mut collector = Collector::new(options, cancel, observer).growing(grow);
-            let notes = ws::read(url, &options.live, &mut collector, progress)?;
+            let notes = ws::read(url, options, &mut collector, progress)?;
             let mut plan = summary(collector, ws::origin(url))?;
             plan.stream = Some(notes);
             return Ok(plan);

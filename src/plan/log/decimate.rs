@@ -60,6 +60,25 @@ impl<T> Decimator<T> {
     pub fn into_items(self) -> Vec<T> {
         self.items.into_iter().map(|(_, t)| t).collect()
     }
+
+    /// `items` thinned as a decimator of `cap` keeps them: every stride-th from the first,
+    /// the stride doubled until at most `cap` are left.
+    ///
+    /// ```
+    /// use posecov::plan::log::Decimator;
+    /// assert_eq!(Decimator::thinned((0..10).collect(), 4), [0, 4, 8]);
+    /// assert_eq!(Decimator::thinned(vec![1, 2], 4), [1, 2]);
+    /// ```
+    pub fn thinned(items: Vec<T>, cap: usize) -> Vec<T> {
+        if items.len() <= cap {
+            return items;
+        }
+        let mut d = Self::new(1, cap);
+        for (i, item) in (0u64..).zip(items) {
+            d.push(i, item);
+        }
+        d.into_items()
+    }
 }
 
 #[cfg(test)]

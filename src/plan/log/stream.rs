@@ -1,6 +1,7 @@
 //! What a live stream (`ws://…`) did besides carrying messages ([`StreamNotes`]): frames
-//! posecov could not read and skipped (the run went on), and connections lost and made again.
-//! Bounded: counts, and the first few of each in words.
+//! posecov could not read and skipped (the run went on), messages thinned because they came
+//! faster than posecov read them, and connections lost and made again. Bounded: counts, and
+//! the first few of each in words.
 
 use serde::Serialize;
 
@@ -28,6 +29,10 @@ pub struct StreamNotes {
     pub damaged: u64,
     /// The first [`MAX_NOTED`] of them, each in words.
     pub damaged_first: Vec<String>,
+    /// Messages received on the subscribed topics but not read: they arrived while the
+    /// queue between the socket and the collector was full (the server sent faster than
+    /// posecov reads and draws). Counts, health and statistics are of the messages read.
+    pub thinned: u64,
     /// Connections lost and made again.
     pub lost: u64,
     /// The first [`MAX_NOTED`] losses: why, and when (seconds since the first connection).
@@ -64,6 +69,18 @@ impl StreamNotes {
         }
     }
 
+    /// A message received and thinned (not read: posecov was behind).
+    ///
+    /// ```
+    /// let mut notes = posecov::plan::log::StreamNotes::new("ws://robot:8765");
+    /// notes.thin();
+    /// assert_eq!(notes.thinned, 1);
+    /// assert!(notes.sentences()[0].contains("thinned 1 message(s)"));
+    /// ```
+    pub fn thin(&mut self) {
+        self.thinned += 1;
+    }
+
     /// The connection lost, `why` in words, `at_s` seconds after the first connection.
     ///
     /// ```
@@ -98,6 +115,12 @@ impl StreamNotes {
                 self.damaged,
                 self.damaged_first.join("; "),
                 more(self.damaged_first.len(), self.damaged)
+            ));
+        }
+        if self.thinned > 0 {
+            lines.push(format!(
+                "{}: thinned {} message(s) that arrived faster than posecov read them (none queued without bound); counts, health and statistics are of the messages read",
+                self.url, self.thinned
             ));
         }
         if self.lost > 0 {

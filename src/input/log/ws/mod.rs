@@ -8,7 +8,9 @@
 //!   bounded frames, both subprotocols offered, errors in words;
 //! - `protocol.rs`: the protocol's messages (`serverInfo`, `advertise`, `unadvertise`,
 //!   message data; `subscribe`, `unsubscribe`);
-//! - `record.rs`: `--record run.mcap`, every received message written as it arrives.
+//! - `record.rs`: `--record run.mcap`, every received message written as it arrives;
+//! - `session.rs`: the thread that reads the socket, across its connections;
+//! - `queue.rs`: the bounded hand-off from that thread to the collector.
 //!
 //! The read subscribes to the channels posecov reads (the pose-with-covariance topics chosen,
 //! the reference, `/tf` and `/tf_static`), declares every other advertised channel (listed as
@@ -19,8 +21,14 @@
 //! read (malformed JSON, a truncated frame, an unknown subscription) is skipped and noted
 //! ([`StreamNotes`]); a frame beyond [`client::MAX_FRAME`] ends the read with an error. It
 //! unsubscribes and closes on exit.
-//! No async runtime: one thread reads frames as they come (the server, not posecov, holds back
-//! what a slow reader has not taken, so nothing queues here without bound).
+//!
+//! No async runtime: one thread reads frames as they come and hands them to the thread that
+//! collects and draws through a queue of at most [`QUEUE_MESSAGES`] messages and
+//! [`QUEUE_BYTES`] bytes. A server that sends faster than posecov reads and draws fills it;
+//! what arrives then is thinned (recorded by `--record`, not read) and counted
+//! ([`StreamNotes::thinned`], said in the panel and in `report --json`'s `meta.stream`):
+//! nothing queues without bound, and the socket is always read, so the server never holds
+//! back a backlog of its own on posecov's account.
 //!
 //! ```
 //! use posecov::input::log::ws::{LiveOptions, is_live};
@@ -28,20 +36,25 @@
 //! assert!(LiveOptions::default().is_empty());
 //! ```
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use super::{Codec, Collector, Stream};
+use super::{Collector, LogOptions};
 use crate::input::InputError;
 
 pub mod client;
+#[cfg(test)]
+mod long_run;
 pub mod protocol;
+mod queue;
 mod record;
+mod session;
 
 use crate::plan::log::StreamNotes;
-use client::Read;
-use protocol::{Channel, ServerMessage};
+use queue::{Event, Next};
+pub use queue::{QUEUE_BYTES, QUEUE_MESSAGES};
+use session::{Session, Shared};
 
 /// The connection's socket.
 type Socket = tungstenite::WebSocket<std::net::TcpStream>;
@@ -89,30 +102,6 @@ pub fn is_live(name: &str) -> bool {
     name.starts_with("ws://") || name.starts_with("wss://")
 }
 
-/// One advertised channel as posecov reads it.
-struct Live {
-    stream: Stream,
-    codec: Codec,
-    subscription: Option<u32>,
-}
-
-/// What posecov makes of an advertised channel: the same rules as an MCAP channel's
-/// (`cdr`: the ROS 2 schema name; `ros1`: the ROS 1 name, its definition by name).
-fn stream_of(channel: &Channel) -> (Stream, Codec) {
-    let schema = channel.schema_name.clone();
-    let encoding = channel.encoding.as_str();
-    let other = || format!("{schema} in {encoding} encoding; posecov reads cdr or ros1");
-    Stream::of_channel(channel.topic.clone(), schema.clone(), encoding, other)
-}
-
-/// Whether posecov subscribes to a stream: a chosen pose topic, the reference, or `/tf`.
-fn wanted(collector: &Collector<'_, '_>, stream: &Stream) -> bool {
-    let pose = matches!(stream.kind, Some(Ok(_))) && collector.selected(&stream.topic);
-    let tf = matches!(stream.topic.as_str(), "/tf" | "/tf_static")
-        && matches!(stream.reference, Some(Ok(_)));
-    pose || tf || collector.is_reference(&stream.topic)
-}
-
 /// The waits before each attempt to connect again after the connection was lost: bounded
 /// (under 4 s in all), and cut short by a limit or Ctrl-C.
 pub const RECONNECT_BACKOFF: [Duration; 4] = [
@@ -122,12 +111,14 @@ pub const RECONNECT_BACKOFF: [Duration; 4] = [
     Duration::from_secs(2),
 ];
 
-/// Reads the stream at `url` into `collector` until a limit of `live`, Ctrl-C or the end of
-/// the stream; a lost connection is made again (after [`RECONNECT_BACKOFF`]). Returns what
-/// the stream did besides carrying messages. `progress(done, total)`: messages or ms.
+/// Reads the stream at `url` into `collector` until a limit of `options.live`, Ctrl-C or the
+/// end of the stream; a lost connection is made again (after [`RECONNECT_BACKOFF`]). A thread
+/// reads the socket (`session.rs`) and hands on through the bounded queue (`queue.rs`); this
+/// one feeds the collector and shows the growing view. Returns what the stream did besides
+/// carrying messages. `progress(done, total)`: messages or ms.
 pub(super) fn read(
     url: &str,
-    live: &LiveOptions,
+    options: &LogOptions,
     collector: &mut Collector<'_, '_>,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<StreamNotes, InputError> {
@@ -136,273 +127,70 @@ pub(super) fn read(
         reason,
     };
     let parsed = client::parse_url(url).map_err(fail)?;
-    let recorder = match &live.record {
+    let recorder = match &options.live.record {
         Some(path) => Some(record::Recorder::create(path).map_err(fail)?),
         None => None,
     };
-    let mut connection = client::connect(&parsed).map_err(fail)?;
-    let mut session = Session {
-        channels: BTreeMap::new(),
-        subscriptions: BTreeMap::new(),
-        next_subscription: 1,
-        received: 0,
-        recorder,
-        notes: StreamNotes::new(url),
-        start: Instant::now(),
-    };
-    let outcome = loop {
-        let end = session.run(&mut connection.socket, live, collector, progress);
-        session.leave(&mut connection.socket);
-        match end {
-            Ok(None) => break Ok(()),
-            Err(e) => break Err(e),
-            Ok(Some(why)) => match session.reconnect(&parsed, live, collector) {
-                Again::Connected(next) => {
-                    session
-                        .notes
-                        .lost(why, session.start.elapsed().as_secs_f64());
-                    connection = *next;
-                }
-                Again::Stopped => break Ok(()),
-                Again::Failed(last) => break session.ended(live, &why, &last),
-            },
-        }
-    };
-    // A complete recording whatever happened.
-    let finished = session.recorder.take().map(record::Recorder::finish);
+    let connection = client::connect(&parsed).map_err(fail)?;
+    let shared = Shared::new(url);
+    let (sender, taker) = queue::bounded(&shared.queued);
+    let outcome = std::thread::scope(|scope| {
+        let session = Session::new(&parsed, options, &shared, sender, recorder);
+        let reader = std::thread::Builder::new()
+            .name("posecov-ws".to_owned())
+            .spawn_scoped(scope, move || session.serve(connection))
+            .map_err(|e| format!("cannot start the thread that reads the stream ({e})"))?;
+        let taken = take(taker, &options.live, &shared, collector, progress);
+        shared.stop.store(true, Ordering::Release);
+        let served = reader
+            .join()
+            .unwrap_or_else(|_| Err("the thread that reads the stream failed".to_owned()));
+        served.and(taken)
+    });
     outcome.map_err(fail)?;
-    if let Some(Err(e)) = finished {
-        return Err(fail(e));
-    }
-    Ok(session.notes)
+    Ok(shared.into_notes())
 }
 
-/// What trying to connect again gave.
-enum Again {
-    Connected(Box<client::Connection>),
-    /// A limit or Ctrl-C came first: the run ends as asked.
-    Stopped,
-    /// Every attempt failed: the last reason.
-    Failed(String),
-}
-
-/// One stream's state, across its connections.
-struct Session {
-    channels: BTreeMap<u64, Live>,
-    /// Subscription id → channel id (this connection's).
-    subscriptions: BTreeMap<u32, u64>,
-    /// Ids below it were made by posecov (a frame for one no longer held is skipped quietly).
-    next_subscription: u32,
-    received: u64,
-    recorder: Option<record::Recorder>,
-    notes: StreamNotes,
-    start: Instant,
-}
-
-impl Session {
-    /// Whether a limit of `live` is reached.
-    fn done(&self, live: &LiveOptions) -> bool {
-        live.duration.is_some_and(|d| self.start.elapsed() >= d)
-            || live.messages.is_some_and(|n| self.received >= n)
-    }
-
-    /// Reads frames until a limit or Ctrl-C (`Ok(None)`) or until the connection is lost
-    /// (`Ok(Some(why))`); a frame posecov cannot read is noted and skipped.
-    fn run(
-        &mut self,
-        socket: &mut Socket,
-        live: &LiveOptions,
-        collector: &mut Collector<'_, '_>,
-        progress: &mut dyn FnMut(u64, u64),
-    ) -> Result<Option<String>, String> {
-        let mut last_progress = Instant::now();
-        loop {
-            if collector.stop() || self.done(live) {
-                return Ok(None);
-            }
-            if last_progress.elapsed() >= Duration::from_millis(200) {
-                let elapsed = self.start.elapsed();
-                match (live.messages, live.duration) {
-                    (Some(n), _) => progress(self.received, n),
-                    (None, Some(d)) => progress(elapsed.as_millis() as u64, d.as_millis() as u64),
-                    (None, None) => progress(self.received, 0),
-                }
-                last_progress = Instant::now();
-            }
-            collector.grow(&self.notes);
-            let frame = match client::read(socket)? {
-                Read::Idle => continue,
-                Read::Closed(why) => return Ok(Some(why)),
-                Read::Frame(frame) => frame,
-            };
-            match frame {
-                tungstenite::Message::Text(text) => match protocol::parse_text(text.as_str()) {
-                    Ok(message) => self.server_message(socket, message, collector)?,
-                    Err(e) => self.notes.damaged(format!("a text frame: {e}")),
-                },
-                tungstenite::Message::Binary(bytes) => self.binary(&bytes, collector)?,
-                _ => {}
-            }
+/// Feeds the collector what the reading thread hands on until it ends (Ctrl-C stops it),
+/// calling `progress` and showing the growing view as it goes.
+fn take(
+    taker: queue::Taker<'_>,
+    live: &LiveOptions,
+    shared: &Shared,
+    collector: &mut Collector<'_, '_>,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<(), String> {
+    let mut last_progress = Instant::now();
+    loop {
+        if collector.stop() {
+            shared.stop.store(true, Ordering::Release);
         }
-    }
-
-    /// Unsubscribes and closes the connection (whatever state it is in).
-    fn leave(&mut self, socket: &mut Socket) {
-        let ids: Vec<u32> = self.subscriptions.keys().copied().collect();
-        if !ids.is_empty() {
-            let _ = client::send(socket, protocol::unsubscribe(&ids));
+        if last_progress.elapsed() >= Duration::from_millis(200) {
+            let received = shared.received.load(Ordering::Acquire);
+            match (live.messages, live.duration) {
+                (Some(n), _) => progress(received, n),
+                (None, Some(d)) => progress(
+                    shared.start.elapsed().as_millis() as u64,
+                    d.as_millis() as u64,
+                ),
+                (None, None) => progress(received, 0),
+            }
+            last_progress = Instant::now();
         }
-        client::close(socket);
-    }
-
-    /// Connects again after a loss, waiting [`RECONNECT_BACKOFF`] before each attempt; the
-    /// new connection's channels are advertised afresh (the recording keeps its channels).
-    fn reconnect(
-        &mut self,
-        url: &client::WsUrl,
-        live: &LiveOptions,
-        collector: &mut Collector<'_, '_>,
-    ) -> Again {
-        let mut last = String::new();
-        for wait in RECONNECT_BACKOFF {
-            let until = Instant::now() + wait;
-            while Instant::now() < until {
-                if collector.stop() || self.done(live) {
-                    return Again::Stopped;
-                }
-                std::thread::sleep(client::POLL.min(until - Instant::now()));
-            }
-            match client::connect(url) {
-                Ok(connection) => {
-                    self.channels.clear();
-                    self.subscriptions.clear();
-                    if let Some(recorder) = &mut self.recorder {
-                        recorder.reconnected();
-                    }
-                    return Again::Connected(Box::new(connection));
-                }
-                Err(e) => last = e,
-            }
+        collector.grow(&|| shared.notes());
+        match taker.next(client::POLL) {
+            Next::Event(Event::Declare(stream)) => collector.declare_stream(&stream.0),
+            Next::Event(Event::Message(m)) => collector.message_on(
+                Some(&m.stream.0),
+                "channel",
+                m.channel,
+                m.log_time_ns,
+                m.payload(),
+                m.stream.1,
+            )?,
+            Next::Idle => {}
+            Next::Done => return Ok(()),
         }
-        Again::Failed(last)
-    }
-
-    /// The connection lost for good (`why`; connecting again failed with `last`): an error
-    /// when a limit was asked for and not reached, else the end of the run, noted.
-    fn ended(&mut self, live: &LiveOptions, why: &str, last: &str) -> Result<(), String> {
-        let again = format!(
-            "{why}; connecting again failed {} time(s) (last: {last})",
-            RECONNECT_BACKOFF.len()
-        );
-        let asked = match (live.duration, live.messages) {
-            (_, Some(n)) => format!("--messages {n}"),
-            (Some(d), None) => format!("--duration {}s", d.as_secs_f64()),
-            (None, None) => {
-                self.notes.ended = Some(again);
-                return Ok(());
-            }
-        };
-        Err(format!(
-            "the stream ended early: {again}; after {:.1} s and {} message(s), before {asked}",
-            self.start.elapsed().as_secs_f64(),
-            self.received
-        ))
-    }
-
-    fn server_message(
-        &mut self,
-        socket: &mut Socket,
-        message: ServerMessage,
-        collector: &mut Collector<'_, '_>,
-    ) -> Result<(), String> {
-        match message {
-            ServerMessage::Advertise(channels) => {
-                let mut pairs = Vec::new();
-                for channel in channels {
-                    if self.channels.contains_key(&channel.id) {
-                        continue;
-                    }
-                    let (stream, codec) = stream_of(&channel);
-                    collector.declare_stream(&stream);
-                    let subscription = wanted(collector, &stream).then(|| {
-                        let id = self.next_subscription;
-                        self.next_subscription = self.next_subscription.wrapping_add(1);
-                        pairs.push((id, channel.id));
-                        self.subscriptions.insert(id, channel.id);
-                        id
-                    });
-                    if let Some(recorder) = &mut self.recorder {
-                        recorder.channel(&channel)?;
-                    }
-                    self.channels.insert(
-                        channel.id,
-                        Live {
-                            stream,
-                            codec,
-                            subscription,
-                        },
-                    );
-                }
-                if !pairs.is_empty() {
-                    client::send(socket, protocol::subscribe(&pairs))?;
-                }
-            }
-            ServerMessage::Unadvertise(ids) => {
-                for id in ids {
-                    if let Some(Live {
-                        subscription: Some(s),
-                        ..
-                    }) = self.channels.remove(&id)
-                    {
-                        self.subscriptions.remove(&s);
-                    }
-                }
-            }
-            ServerMessage::ServerInfo { .. }
-            | ServerMessage::Status { .. }
-            | ServerMessage::Other(_) => {}
-        }
-        Ok(())
-    }
-
-    /// A binary frame: a message on a subscription goes to the collector (and the recording);
-    /// a frame for a subscription no longer held (one in flight when a channel went) is
-    /// skipped; a damaged one, or one for a subscription posecov never made, is noted.
-    fn binary(&mut self, frame: &[u8], collector: &mut Collector<'_, '_>) -> Result<(), String> {
-        let data = match protocol::parse_binary(frame) {
-            Ok(Some(data)) => data,
-            Ok(None) => return Ok(()),
-            Err(e) => {
-                self.notes.damaged(e);
-                return Ok(());
-            }
-        };
-        let Some(live) = self
-            .subscriptions
-            .get(&data.subscription)
-            .and_then(|channel| self.channels.get(channel).map(|live| (*channel, live)))
-        else {
-            if data.subscription == 0 || data.subscription >= self.next_subscription {
-                self.notes.damaged(format!(
-                    "a message-data frame for subscription {}, which posecov never made",
-                    data.subscription
-                ));
-            }
-            return Ok(());
-        };
-        let (channel, live) = live;
-        self.received += 1;
-        if let Some(recorder) = &mut self.recorder {
-            recorder.message(channel, data.log_time_ns, data.payload)?;
-        }
-        collector.message_on(
-            Some(&live.stream),
-            "channel",
-            channel,
-            data.log_time_ns,
-            data.payload,
-            live.codec,
-        )
     }
 }
 
