@@ -146,13 +146,16 @@ fn save_writes_a_recording_and_every_thins_it() {
         .iter()
         .filter(|c| c.entity_path().to_string().ends_with("/TimeAxis"))
         .count();
-    assert_eq!(ranges, 3, "σ of position, σ of rotation, trace");
+    assert_eq!(
+        ranges, 6,
+        "σ of position, σ of rotation, trace; the IMU's σ orientation, angular velocity, linear acceleration"
+    );
     // And each plot's value axis is fitted to the data (a flat σ is not lost in ±1).
     let values = rrd::store_chunks(&bytes, rerun::StoreKind::Blueprint)
         .iter()
         .filter(|c| c.entity_path().to_string().ends_with("/ScalarAxis"))
         .count();
-    assert_eq!(values, 3);
+    assert_eq!(values, 6);
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -104,6 +104,7 @@ pub(super) fn sensor_defects(
             .filter(|f| f.3 == Class::Note)
             .map(|f| f.1)
             .collect();
+        kinds.sort();
         kinds.dedup();
         notes += kinds.len();
         for f in findings.iter().filter(|f| f.3 == Class::Defect) {
