@@ -179,7 +179,7 @@ struct ScenarioArgs {
     scenario: Option<String>,
     #[command(flatten)]
     settings: EvalArgs,
-    /// Robot logs: read only this topic (repeatable; default every pose-with-covariance topic).
+    /// Robot logs: read only this topic (repeatable; default every topic with a covariance).
     #[arg(long = "topic", value_name = "NAME")]
     topics: Vec<String>,
     /// Robot logs: draw every N-th message (default: at most ~200 per topic, evenly spaced).

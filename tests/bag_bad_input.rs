@@ -151,7 +151,7 @@ fn a_cut_before_any_whole_chunk_is_no_pose_topic() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("early.bag") && e.contains("no pose-with-covariance topic"),
+        e.contains("early.bag") && e.contains("no topic with a covariance to check"),
         "{e}"
     );
     assert!(

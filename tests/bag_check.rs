@@ -1,5 +1,5 @@
 //! `posecov check` as CI gates on it, and the exit-code table (docs/guide/cli.md, `--help`): 1 on a
-//! log's defects, 2 when a log cannot be processed (no pose-with-covariance topic), no empty
+//! log's defects, 2 when a log cannot be processed (no topic with a covariance), no empty
 //! recording written, `--allow` by name, a closed stdout ends quietly with 0.
 
 use std::collections::BTreeMap;
@@ -36,12 +36,16 @@ fn cdr<T: serde::Serialize>(msg: &T) -> Vec<u8> {
 }
 
 /// An MCAP file with a ROS 2 `/odom` whose covariances are `cov` (the robot drives 0.1 m per
-/// message), and a `/imu` topic; or the `/imu` topic alone.
+/// message), and a `/camera` topic of a type posecov skips; or the `/camera` topic alone.
 fn write_log(path: &PathBuf, odom_cov: Option<[f64; 36]>) {
     let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
     let none = BTreeMap::new();
-    let imu_schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
-    let imu = w.add_channel(imu_schema, "/imu", "cdr", &none).unwrap();
+    let image_schema = w
+        .add_schema("sensor_msgs/msg/Image", "ros2msg", b"")
+        .unwrap();
+    let image = w
+        .add_channel(image_schema, "/camera", "cdr", &none)
+        .unwrap();
     let odom_schema = w
         .add_schema("nav_msgs/msg/Odometry", "ros2msg", b"")
         .unwrap();
@@ -60,7 +64,7 @@ fn write_log(path: &PathBuf, odom_cov: Option<[f64; 36]>) {
             )
             .unwrap();
         };
-        put(imu, &[1, 2, 3, 4]);
+        put(image, &[1, 2, 3, 4]);
         if let Some(cov) = odom_cov {
             let msg = Odometry {
                 header: Header {
@@ -93,13 +97,17 @@ fn write_log(path: &PathBuf, odom_cov: Option<[f64; 36]>) {
 #[test]
 fn a_log_without_pose_topics_cannot_be_processed_and_writes_nothing() {
     let dir = scratch("nopose");
-    let log = dir.join("imu_only.mcap");
+    let log = dir.join("camera_only.mcap");
     write_log(&log, None);
     let log = log.to_str().unwrap();
     let (code, out, err) = run(&["check", log]);
     assert_eq!(code, Some(2), "{out}{err}");
     assert!(
-        err.contains("imu_only.mcap: no pose-with-covariance topic to draw; the log has /imu (sensor_msgs/msg/Imu, 30 messages), pose topics without messages: /odom; posecov reads nav_msgs/Odometry (ROS 2: nav_msgs/msg/Odometry)"),
+        err.contains("camera_only.mcap: no topic with a covariance to check; the log has /camera (sensor_msgs/msg/Image, 30 messages), topics with a covariance but no messages: /odom; posecov reads nav_msgs/Odometry (ROS 2: nav_msgs/msg/Odometry)"),
+        "{err}"
+    );
+    assert!(
+        err.ends_with("sensor_msgs/Imu (ROS 2: sensor_msgs/msg/Imu)\n"),
         "{err}"
     );
     let (code, _, err) = run(&["report", "--json", log]);

@@ -34,7 +34,7 @@ fn check_and_list_know_both_log_formats() {
     let (code, out, err) = run(&["check", TEST2]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
-        out.contains(": defects on 1 of 1 pose topic(s) (6121 messages"),
+        out.contains(": defects on 1 of 1 pose topic(s) and 0 of 1 sensor topic(s) (6121 messages"),
         "{out}"
     );
     assert!(
@@ -46,7 +46,7 @@ fn check_and_list_know_both_log_formats() {
     let (code, out, err) = run(&["check", TEST2, "--allow", "constant"]);
     assert_eq!(code, Some(0), "{err}");
     assert!(
-        out.contains(": ok (1 pose topic(s), 6121 messages"),
+        out.contains(": ok (1 pose topic(s), 1 sensor topic(s), 6121 messages"),
         "{out}"
     );
     let (code, out, _) = run(&["list"]);
@@ -80,7 +80,8 @@ fn report_json_gives_the_health_to_scripts() {
     );
     assert_eq!(odom["health"]["placeholder"]["count"], 3060);
     assert_eq!(odom["health"]["placeholder"]["first_stamp_s"], 47.584);
-    assert_eq!(v["skipped"][0]["message_type"], "sensor_msgs/Imu");
+    assert_eq!(v["sensors"][0]["type"], "sensor_msgs/Imu");
+    assert_eq!(v["skipped"], serde_json::json!([]));
     let (_, out, _) = run(&[
         "report",
         "--json",
@@ -124,7 +125,7 @@ fn save_writes_a_recording_and_every_thins_it() {
         size(&thin),
         size(&all)
     );
-    // The Jackal's stamps are simulated time (47.584 s … 108.764 s): the `stamp` timeline
+    // The Jackal's stamps are simulated time (47.580 s, its IMU's first σ plotted, … 108.764 s): the `stamp` timeline
     // holds durations, not 1970 dates, and every stamped chunk agrees.
     let bytes = std::fs::read(&thin).unwrap();
     let stamped: Vec<_> = rrd::recording_chunks(&bytes)
@@ -139,19 +140,22 @@ fn save_writes_a_recording_and_every_thins_it() {
         );
     }
     let first = stamped.iter().map(|c| c.time_range().min().as_i64()).min();
-    assert_eq!(first, Some(47_584_000_000), "{first:?}");
+    assert_eq!(first, Some(47_580_000_000), "{first:?}");
     // Each plot's time axis spans the log (the viewer's default window would cut its start).
     let ranges = rrd::store_chunks(&bytes, rerun::StoreKind::Blueprint)
         .iter()
         .filter(|c| c.entity_path().to_string().ends_with("/TimeAxis"))
         .count();
-    assert_eq!(ranges, 3, "σ of position, σ of rotation, trace");
+    assert_eq!(
+        ranges, 6,
+        "σ of position, σ of rotation, trace; the IMU's σ orientation, angular velocity, linear acceleration"
+    );
     // And each plot's value axis is fitted to the data (a flat σ is not lost in ±1).
     let values = rrd::store_chunks(&bytes, rerun::StoreKind::Blueprint)
         .iter()
         .filter(|c| c.entity_path().to_string().ends_with("/ScalarAxis"))
         .count();
-    assert_eq!(values, 3);
+    assert_eq!(values, 6);
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -159,7 +163,7 @@ fn save_writes_a_recording_and_every_thins_it() {
 fn errors_name_the_file_and_the_flag() {
     let (code, _, err) = run(&["check", TEST2, "--topic", "/odom"]);
     assert_eq!(code, Some(2));
-    assert!(err.contains("test2.bag: --topic /odom: no such topic; pose topics in this log: /jackal_velocity_controller/odom"), "{err}");
+    assert!(err.contains("test2.bag: --topic /odom: no such topic; topics with a covariance in this log: /imu/data, /jackal_velocity_controller/odom"), "{err}");
     let (code, _, err) = run(&["check", "camera_on_robot", "--topic", "/odom"]);
     assert_eq!(code, Some(2));
     assert!(

@@ -113,7 +113,9 @@ fn write_example() -> Vec<u8> {
     let pwc_schema = w
         .add_schema("geometry_msgs/msg/PoseWithCovariance", "ros2msg", b"")
         .unwrap();
-    let imu_schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
+    let image_schema = w
+        .add_schema("sensor_msgs/msg/Image", "ros2msg", b"")
+        .unwrap();
     let odom = w
         .add_channel(odom_schema, "/planar/odom", "cdr", &none)
         .unwrap();
@@ -121,7 +123,9 @@ fn write_example() -> Vec<u8> {
         .add_channel(pwcs_schema, "/amcl_pose", "cdr", &none)
         .unwrap();
     let bare = w.add_channel(pwc_schema, "/bare", "cdr", &none).unwrap();
-    let imu = w.add_channel(imu_schema, "/imu", "cdr", &none).unwrap();
+    let image = w
+        .add_channel(image_schema, "/camera", "cdr", &none)
+        .unwrap();
     let json = w
         .add_channel(odom_schema, "/odom_json", "json", &none)
         .unwrap();
@@ -186,7 +190,7 @@ fn write_example() -> Vec<u8> {
         put(&mut w, bare, 200.0 + k as f64, &cdr(&msg));
     }
     for k in 0..4 {
-        put(&mut w, imu, 300.0 + k as f64, &[1, 2, 3, 4]);
+        put(&mut w, image, 300.0 + k as f64, &[1, 2, 3, 4]);
     }
     put(&mut w, json, 400.0, b"{}");
     w.finish().unwrap();
@@ -241,8 +245,8 @@ fn topics_types_and_skips() {
         ]
     );
     assert_eq!(plan.skipped.len(), 2);
-    assert_eq!(plan.skipped[0].name, "/imu");
-    assert_eq!(plan.skipped[0].message_type, "sensor_msgs/msg/Imu");
+    assert_eq!(plan.skipped[0].name, "/camera");
+    assert_eq!(plan.skipped[0].message_type, "sensor_msgs/msg/Image");
     assert_eq!(plan.skipped[0].count, 4);
     assert_eq!(plan.skipped[1].name, "/odom_json");
     assert!(
@@ -497,7 +501,7 @@ fn a_topic_without_messages_is_drawn() {
         .to_string();
     std::fs::remove_file(&path).ok();
     assert!(
-        err.contains("pose topics without messages: /empty"),
+        err.contains("topics with a covariance but no messages: /empty"),
         "{err}"
     );
     let mut plan = read(&log(true), &LogOptions::default());

@@ -44,11 +44,11 @@ fn test2_bag_reads_with_its_placeholders() {
     assert_eq!(first.covariance[14], 1e6);
     assert_eq!(first.covariance[35], 0.03);
     assert!((first.position[0] - 0.1571574254425733).abs() < 1e-12);
-    // The IMU is another type: skipped and listed.
-    assert_eq!(plan.skipped.len(), 1);
-    assert_eq!(plan.skipped[0].name, "/imu/data");
-    assert_eq!(plan.skipped[0].message_type, "sensor_msgs/Imu");
-    assert_eq!(plan.skipped[0].count, 3061);
+    // The IMU is a sensor topic: its three covariances checked (bag_imu.rs).
+    assert!(plan.skipped.is_empty());
+    assert_eq!(plan.sensors[0].name, "/imu/data");
+    assert_eq!(plan.sensors[0].kind, posecov::plan::log::SensorKind::Imu);
+    assert_eq!(plan.sensors[0].count, 3061);
     assert_eq!(plan.messages_total, 3060 + 3061);
 }
 
@@ -67,15 +67,10 @@ fn topic_selection_and_every() {
         every: None,
         ..Default::default()
     };
-    let e = read_log(TEST2.as_ref(), &wrong, &mut |_, _| {}, None)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.ends_with(
-            "--topic /imu/data: its messages are sensor_msgs/Imu, not a pose with covariance"
-        ),
-        "{e}"
-    );
+    // The IMU alone: read as the one sensor topic, the odometry not selected.
+    let imu = read_log(TEST2.as_ref(), &wrong, &mut |_, _| {}, None).unwrap();
+    assert!(imu.topics.is_empty() && imu.sensors.len() == 1);
+    assert_eq!(imu.not_selected, ["/jackal_velocity_controller/odom"]);
     let missing = LogOptions {
         topics: vec!["/odom".into()],
         every: None,
@@ -85,7 +80,7 @@ fn topic_selection_and_every() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("no such topic; pose topics in this log: /jackal_velocity_controller/odom"),
+        e.contains("no such topic; topics with a covariance in this log: /imu/data, /jackal_velocity_controller/odom"),
         "{e}"
     );
 }

@@ -99,7 +99,10 @@ fn every_db3_bag_reports_what_the_mcap_of_the_same_messages_reports() {
 fn check_and_several_bags_at_once_work_as_for_mcap() {
     let (code, out, err) = run(&["check", &data("arc_humble")]);
     assert_eq!(code, Some(0), "{err}");
-    assert!(out.contains("ok (2 pose topic(s), 245 messages"), "{out}");
+    assert!(
+        out.contains("ok (2 pose topic(s), 1 sensor topic(s), 245 messages"),
+        "{out}"
+    );
     let (mcap_code, ..) = run(&["check", &data("arc.mcap")]);
     assert_eq!(code, mcap_code);
     // The directory holds five bag directories and arc.mcap: six logs, one line each.

@@ -75,7 +75,7 @@ fn a_directory_of_logs_reports_json_lines_one_per_log() {
     let names: Vec<&str> = lines.iter().map(|(n, _)| file_name(n)).collect();
     assert_eq!(names, ["a.bag", "b.MCAP"]);
     for (_, report) in &lines {
-        assert_eq!(report["schema_version"], 1);
+        assert_eq!(report["schema_version"], 2);
     }
     // The same numbers as one log's report, which stays one indented object.
     let (_, one, _) = run(&["report", &data("robot_localization/test2.bag"), "--json"]);

@@ -201,7 +201,7 @@ fn every_bundled_example_validates_against_the_schema_and_every_key_is_documente
         let value: Value = serde_json::from_str(&text).expect("JSON");
         let found = dedup(problems(&schema, &value, example.name));
         assert!(found.is_empty(), "{}: {found:#?}", example.name);
-        assert_eq!(value["schema_version"], 1);
+        assert_eq!(value["schema_version"], 2);
         assert_eq!(value["posecov_version"], env!("CARGO_PKG_VERSION"));
         formats.insert(value["format"].as_str().unwrap().to_owned());
     }

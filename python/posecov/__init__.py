@@ -23,7 +23,7 @@ message; nothing crashes the interpreter.
 
 >>> import posecov
 >>> posecov.report("camera_on_robot")["schema_version"]
-1
+2
 """
 
 from __future__ import annotations

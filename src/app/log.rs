@@ -12,6 +12,7 @@
 
 mod frames;
 mod nees;
+mod sensors;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -371,6 +372,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
             "stream": plan.stream,
         },
         "topics": topics,
+        "sensors": sensors::sensors_json(plan, &run.evaluation.sensors),
         "frames": frames::frames_json(&plan.tf, &run.evaluation),
         "skipped": plan.skipped,
         "not_selected": plan.not_selected,
@@ -451,6 +453,11 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
             ));
         }
     }
+    let pose_defects = defects.len();
+    let (sensor_lines, sensor_notes) = sensors::sensor_defects(&file, plan, allow, &mut allowed);
+    let sensor_defects = sensor_lines.len();
+    defects.extend(sensor_lines);
+    notes += sensor_notes;
     if let Some(cut) = &plan.cut {
         // Not a covariance defect, but the log cannot be trusted whole: CI must see it.
         defects.push(format!(
@@ -483,12 +490,22 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
             ),
         }
     );
+    let sensors = match plan.sensors.len() {
+        0 => String::new(),
+        n => format!(", {n} sensor topic(s)"),
+    };
+    let sensors_defects = match plan.sensors.len() {
+        0 => String::new(),
+        n => format!(" and {sensor_defects} of {n} sensor topic(s)"),
+    };
     let line = if defects.is_empty() {
-        format!("{name}: ok ({} pose topic(s), {facts})", plan.topics.len())
+        format!(
+            "{name}: ok ({} pose topic(s){sensors}, {facts})",
+            plan.topics.len()
+        )
     } else {
         format!(
-            "{name}: defects on {} of {} pose topic(s){} ({facts}; the first of each on stderr)",
-            defects.len() - log_defects,
+            "{name}: defects on {pose_defects} of {} pose topic(s){sensors_defects}{} ({facts}; the first of each on stderr)",
             plan.topics.len(),
             match (
                 plan.cut.is_some(),

@@ -95,7 +95,7 @@ Exit codes (every command; `check` differs where shown):
   0    success (notes in a log are allowed); stdout closed by the reader (`… | head`): quiet
   1    check: defects found in a log (other commands show and report them, exit 0);
        every command: a scenario, graph or text trajectory error located at file:line:column
-  2    cannot process: unreadable file, unknown format, no pose-with-covariance topic,
+  2    cannot process: unreadable file, unknown format, no topic with a covariance,
        a damaged log, a usage error
   130  interrupted (Ctrl-C)
 Several inputs (`report`, `check`): the worst code of any input.";
@@ -353,7 +353,10 @@ fn undrawable(scene: &Scene, error: SceneError) -> AppError {
 /// The layout version of `report --json` (top-level `schema_version`): raised only when a key
 /// is removed, renamed or changes meaning; new keys do not raise it. Every key is documented
 /// in `docs/report.schema.json`, which every bundled example's report validates against.
-pub const REPORT_SCHEMA_VERSION: u32 = 1;
+///
+/// 2 (issue 32): `sensor_msgs/Imu` topics are read into `sensors` (they were `skipped`), and
+/// `unknown_marker` is a note on them (REP 145's "not provided").
+pub const REPORT_SCHEMA_VERSION: u32 = 2;
 
 /// The posecov that wrote a report (`posecov_version`).
 pub const POSECOV_VERSION: &str = env!("CARGO_PKG_VERSION");

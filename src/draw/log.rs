@@ -42,10 +42,12 @@ mod nees;
 mod plots;
 mod robot;
 mod rviz;
+mod sensor;
 mod text;
 
 pub use frames::frame_problem_sentence;
 pub use nees::verdict_word;
+pub use sensor::sensor_sentence;
 pub use text::{description, issue_sentence, issue_word};
 
 /// RViz's default covariance colour (its position shape).
@@ -130,9 +132,14 @@ fn build(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene 
         .series
         .iter()
         .flat_map(|s| s.points.iter().map(|q| q.0));
-    p.scene.timeline = Timeline::for_stamps(stamps.chain(series));
+    let sensors = e
+        .sensors
+        .iter()
+        .flat_map(|t| t.series.iter().map(|q| q.stamp_ns));
+    p.scene.timeline = Timeline::for_stamps(stamps.chain(series).chain(sensors));
     plots::plots(&mut p.scene, e);
     nees::plots(&mut p.scene, e);
+    sensor::sensor_plots(&mut p.scene, e);
     p.scene.views = log_views(&p.scene, e, planar);
     p.scene
 }

@@ -31,6 +31,10 @@ mod tf;
 pub use tf::{MAX_TF_EDGES, MAX_TF_SAMPLES, TfEdge, TfTree, UndecodableTf};
 mod health;
 pub use health::{Class, Health, Issue, IssueCount, Stretch};
+mod sensor;
+pub use sensor::{
+    BlockSpec, BlockSummary, MAX_BLOCKS, SensorKind, SensorSeriesPoint, SensorTopicSummary,
+};
 
 /// A variance at or above this is a placeholder ("not estimated"), not a measurement.
 pub const PLACEHOLDER: f64 = 1e6;
@@ -393,11 +397,14 @@ pub struct SkippedTopic {
     pub count: u64,
 }
 
-/// A whole log, reduced: the pose topics and what was skipped.
+/// A whole log, reduced: the pose topics, the sensor topics and what was skipped.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LogSummary {
     /// The pose-with-covariance topics read (filtered by `--topic`), in name order.
     pub topics: Vec<TopicSummary>,
+    /// The covariance-carrying topics that are not poses (`sensor_msgs/Imu`), filtered by
+    /// `--topic`, in name order.
+    pub sensors: Vec<SensorTopicSummary>,
     /// Other topics, in name order.
     pub skipped: Vec<SkippedTopic>,
     /// Pose topics present but not asked for with `--topic`.

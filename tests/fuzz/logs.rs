@@ -30,9 +30,11 @@ pub enum LogKind {
     Ros1,
     Mcap,
     Db3,
+    /// ROS 1 bags of `sensor_msgs/Imu` (tests/data/imu): mutations reach the IMU messages.
+    Imu,
 }
 
-/// A log family (`ros1`, `mcap` or `db3`).
+/// A log family (`ros1`, `mcap`, `db3` or `imu`).
 pub struct Logs {
     kind: LogKind,
     seeds: Vec<Vec<u8>>,
@@ -48,6 +50,7 @@ impl Logs {
             LogKind::Ros1 => bundled.chain([small_bag()]).collect(),
             LogKind::Mcap => bundled.collect(),
             LogKind::Db3 => DB3_SEEDS.iter().map(|s| s.to_vec()).collect(),
+            LogKind::Imu => vec![IMU_SEED.to_vec()],
         };
         Self { kind, seeds }
     }
@@ -56,7 +59,7 @@ impl Logs {
 impl LogKind {
     fn extension(self) -> &'static str {
         match self {
-            LogKind::Ros1 => "bag",
+            LogKind::Ros1 | LogKind::Imu => "bag",
             LogKind::Mcap => "mcap",
             LogKind::Db3 => "db3",
         }
@@ -69,6 +72,10 @@ pub const DB3_SEEDS: [&[u8]; 3] = [
     include_bytes!("../data/ros2/arc_humble/arc_humble_0.db3"),
     include_bytes!("../data/ros2/arc_zstd_message/arc_zstd_message.db3"),
 ];
+
+/// The `imu` seed: an uncompressed ROS 1 bag of two IMU topics (−1 "not provided", all zero),
+/// written by PyPI `rosbags` (tests/data/imu/make_imu.py).
+pub const IMU_SEED: &[u8] = include_bytes!("../data/imu/imu_rep145.bag");
 
 /// Strings the mutator inserts: record field names and values of both formats.
 const TOKENS: &[&str] = &[
@@ -92,6 +99,8 @@ const TOKENS: &[&str] = &[
     "compression_format: lz4",
     "nav_msgs/msg/Odometry",
     "geometry_msgs/msg/PoseWithCovarianceStamped",
+    "type=sensor_msgs/Imu",
+    "sensor_msgs/msg/Imu",
 ];
 
 impl Family for Logs {
@@ -100,6 +109,7 @@ impl Family for Logs {
             LogKind::Ros1 => "ros1",
             LogKind::Mcap => "mcap",
             LogKind::Db3 => "db3",
+            LogKind::Imu => "imu",
         }
     }
     fn extension(&self) -> &'static str {

@@ -166,18 +166,28 @@ pub fn description(
     confidence: Confidence,
 ) -> String {
     let mut s = String::new();
+    let sensor_defects = plan.sensors.iter().flat_map(|t| {
+        t.findings()
+            .filter(|f| f.3 == Class::Defect)
+            .map(|f| f.2.count)
+    });
     let defects: u64 = plan
         .topics
         .iter()
         .flat_map(|t| t.defects().map(|(_, c)| c.count))
+        .chain(sensor_defects)
         .sum();
     let verdict = match defects {
         0 => "no covariance defect".to_owned(),
         n => format!("**{n} message(s) with defects** (`posecov check` fails)"),
     };
+    let sensors = match plan.sensors.len() {
+        0 => String::new(),
+        n => format!(", {n} sensor topic(s)"),
+    };
     let _ = writeln!(
         s,
-        "**{format}**: {} messages, {} pose topic(s) read; {verdict}.",
+        "**{format}**: {} messages, {} pose topic(s){sensors} read; {verdict}.",
         plan.messages_total,
         plan.topics.len()
     );
@@ -229,6 +239,7 @@ pub fn description(
     for (t, te) in plan.topics.iter().zip(&e.topics) {
         topic(&mut s, t, te, confidence, e.reading);
     }
+    super::sensor::sensor_paragraph(plan, &mut s);
     if !plan.skipped.is_empty() {
         let _ = writeln!(s, "\n---\n\n**Skipped** (other message types):\n");
         for k in &plan.skipped {

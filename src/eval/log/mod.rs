@@ -20,6 +20,7 @@
 pub mod frames;
 mod meaning;
 pub mod nees;
+pub mod sensor;
 pub mod stamped;
 
 use std::collections::BTreeMap;
@@ -170,8 +171,12 @@ pub fn sigma_summary(
     series: &[SeriesPoint],
     axis: usize,
 ) -> Option<SigmaSummary> {
+    summary_of(stats, series.iter().filter_map(|p| p.sigma[axis]).collect())
+}
+
+/// The σ summary of streamed `stats` and the `kept` σ's of the series (their median).
+fn summary_of(stats: Option<AxisStats>, mut kept: Vec<f64>) -> Option<SigmaSummary> {
     let stats = stats?;
-    let mut kept: Vec<f64> = series.iter().filter_map(|p| p.sigma[axis]).collect();
     kept.sort_by(f64::total_cmp);
     let n = kept.len();
     let median_of_kept = match n {
@@ -228,6 +233,8 @@ pub struct LogEvaluation {
     pub reading: RosReading,
     /// What kept topics in different frames apart ([`crate::eval::log::frames`]).
     pub frames: FrameFindings,
+    /// Per sensor topic, in the plan's order ([`sensor`]).
+    pub sensors: Vec<sensor::SensorEvaluation>,
 }
 
 impl LogEvaluation {
@@ -342,6 +349,11 @@ pub fn evaluate_log(plan: &mut LogSummary, settings: &LogEvalSettings) -> LogEva
         .collect();
     LogEvaluation {
         topics,
+        sensors: plan
+            .sensors
+            .iter_mut()
+            .map(sensor::evaluate_sensor)
+            .collect(),
         reading: settings.reading,
         frames: FrameFindings {
             has_tf: !plan.tf.edges.is_empty(),

@@ -11,75 +11,15 @@ use std::time::{Duration, Instant};
 
 use crate::plan::log::{
     Decimator, EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessage, PoseMessageKind,
-    ReferenceInLog, ReferenceRead, SkippedTopic, StreamNotes,
+    ReferenceInLog, ReferenceRead, SensorKind, SkippedTopic, StreamNotes,
 };
 
-use super::decode::{ros1_kind, ros2_kind};
-use super::reference::{self, ReferenceType, ros1_reference_type, ros2_reference_type};
+use super::reference::{self, ReferenceType};
+use super::sensor::{SensorState, decode_sensor};
+use super::stream::{Codec, Stream};
 use super::topic::TopicState;
 use super::{InputError, LogOptions, decode, tf};
 use crate::input::suggest;
-
-/// A connection (ROS 1) or channel (MCAP): its topic, type and what posecov makes of it
-/// (`None`: another type; `Some(Err(why))`: a pose type in another definition or encoding).
-pub(super) struct Stream {
-    pub(super) topic: String,
-    pub(super) type_name: String,
-    pub(super) kind: Option<Result<PoseMessageKind, String>>,
-    /// What a reference can be read from it (`Err(why)`: a reference type in another
-    /// definition or encoding).
-    pub(super) reference: Option<Result<ReferenceType, String>>,
-}
-
-/// How a message's bytes are encoded.
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Codec {
-    Ros1,
-    Cdr,
-}
-
-impl Stream {
-    /// A channel of schema name `schema` in `encoding` (an MCAP channel, a live stream's
-    /// channel): `cdr` reads the ROS 2 name, `ros1` the ROS 1 name with its definition taken
-    /// by name (`mcap convert` of a ROS 1 bag writes no MD5 sum); a pose or reference type in
-    /// any other encoding is named with `other`'s words, and read as nothing.
-    pub(super) fn of_channel(
-        topic: String,
-        schema: String,
-        encoding: &str,
-        other: impl Fn() -> String,
-    ) -> (Stream, Codec) {
-        let (kind, reference, codec) = match encoding {
-            "cdr" => (
-                ros2_kind(&schema).map(Ok),
-                ros2_reference_type(&schema).map(Ok),
-                Codec::Cdr,
-            ),
-            "ros1" => (
-                ros1_kind(&schema, "*"),
-                ros1_reference_type(&schema, "*"),
-                Codec::Ros1,
-            ),
-            _ => (
-                ros2_kind(&schema).map(|_| Err(other())),
-                ros2_reference_type(&schema).map(|_| Err(other())),
-                Codec::Cdr,
-            ),
-        };
-        let type_name = if schema.is_empty() {
-            format!("(no schema, {encoding} encoding)")
-        } else {
-            schema
-        };
-        let stream = Stream {
-            topic,
-            type_name,
-            kind,
-            reference,
-        };
-        (stream, codec)
-    }
-}
 
 impl LogOptions {
     /// Whether `topic` is read (`--topic`, or every pose topic when none is given).
@@ -103,6 +43,8 @@ pub(super) struct Collector<'a, 'o> {
     cancel: Option<&'a AtomicBool>,
     cancelled: bool,
     topics: BTreeMap<String, TopicState>,
+    /// The sensor topics (covariance-carrying messages that are not poses).
+    sensors: BTreeMap<String, SensorState>,
     /// Per topic of another type: its type, messages and the first one's log time.
     skipped: BTreeMap<String, (String, u64, i64)>,
     not_selected: BTreeMap<String, ()>,
@@ -158,6 +100,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             cancel,
             cancelled: false,
             topics: BTreeMap::new(),
+            sensors: BTreeMap::new(),
             skipped: BTreeMap::new(),
             not_selected: BTreeMap::new(),
             total: 0,
@@ -194,6 +137,7 @@ impl<'a, 'o> Collector<'a, 'o> {
         }
         let mut plan = assemble(
             self.topics.clone(),
+            self.sensors.clone(),
             self.skipped.clone(),
             self.not_selected.clone(),
             self.total,
@@ -202,7 +146,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             self.cut.clone(),
             self.tf.clone().finish(),
         );
-        if plan.topics.iter().all(|t| t.count == 0) {
+        if plan.topics.iter().all(|t| t.count == 0) && plan.sensors.iter().all(|t| t.count == 0) {
             return;
         }
         // A picture of the run so far: its series thinner than the end's (every one stays in
@@ -230,8 +174,58 @@ impl<'a, 'o> Collector<'a, 'o> {
 
     /// A stream the log declares: its topic, and the reference if it is the reference's.
     pub(super) fn declare_stream(&mut self, stream: &Stream) {
-        self.declare(&stream.topic, &stream.type_name, stream.kind.as_ref());
+        match &stream.sensor {
+            Some(Ok(kind)) if self.selected(&stream.topic) => {
+                // A topic declared as a pose topic first stays one (its sensor messages are
+                // a type change).
+                let known = self.topics.contains_key(&stream.topic);
+                if !known && !self.sensors.contains_key(&stream.topic) {
+                    let state = SensorState::new(*kind);
+                    self.sensors.insert(stream.topic.clone(), state);
+                }
+            }
+            Some(Ok(_)) => _ = self.not_selected.insert(stream.topic.clone(), ()),
+            Some(Err(why)) => {
+                let why = Err(why.clone());
+                self.declare(&stream.topic, &stream.type_name, Some(&why));
+            }
+            None => self.declare(&stream.topic, &stream.type_name, stream.kind.as_ref()),
+        }
         self.declare_reference(stream);
+    }
+
+    /// One message of a sensor `kind` on `topic`, logged at `log_time_ns`.
+    fn sensor_message(
+        &mut self,
+        stream: &Stream,
+        kind: SensorKind,
+        log_time_ns: i64,
+        bytes: &[u8],
+        codec: Codec,
+    ) {
+        self.total += 1;
+        let topic = &stream.topic;
+        if !self.selected(topic) {
+            self.not_selected.insert(topic.to_owned(), ());
+            return;
+        }
+        if let Some(state) = self.topics.get_mut(topic) {
+            // A pose topic that carries a sensor type too: not read, a defect.
+            state.other_type(&stream.type_name, log_time_ns);
+            return;
+        }
+        let state = self
+            .sensors
+            .entry(topic.to_owned())
+            .or_insert_with(|| SensorState::new(kind));
+        if state.kind != kind {
+            let index = state.count();
+            state
+                .health
+                .other_type(&stream.type_name, log_time_ns, index);
+            return;
+        }
+        state.add(decode_sensor(kind, codec, bytes), log_time_ns);
     }
 
     /// Notes the reference's stream (its type), once.
@@ -319,7 +313,7 @@ impl<'a, 'o> Collector<'a, 'o> {
     ) {
         match kind {
             Some(Ok(kind)) if self.selected(topic) => {
-                if !self.topics.contains_key(topic) {
+                if !self.topics.contains_key(topic) && !self.sensors.contains_key(topic) {
                     let state = TopicState::new(*kind, self.options.every);
                     self.topics.insert(topic.to_owned(), state);
                 }
@@ -362,6 +356,10 @@ impl<'a, 'o> Collector<'a, 'o> {
             self.reference_message(stream, log_ns, bytes, codec);
         }
         self.tf.message(stream, log_ns, bytes, codec);
+        if let Some(Ok(sensor)) = stream.sensor {
+            self.sensor_message(stream, sensor, log_ns, bytes, codec);
+            return Ok(());
+        }
         let kind = stream.kind.as_ref();
         self.message(&stream.topic, &stream.type_name, kind, log_ns, bytes, codec);
         Ok(())
@@ -389,6 +387,9 @@ impl<'a, 'o> Collector<'a, 'o> {
                 if let Some(state) = self.topics.get_mut(topic) {
                     // A pose topic that carries another type too: not read, a defect.
                     state.other_type(&label(other), log_time_ns);
+                } else if let Some(state) = self.sensors.get_mut(topic) {
+                    let index = state.count();
+                    state.health.other_type(&label(other), log_time_ns, index);
                 } else if let Some(entry) = self.skipped.get_mut(topic) {
                     entry.1 += 1;
                     entry.2 = entry.2.min(log_time_ns);
@@ -418,6 +419,16 @@ impl<'a, 'o> Collector<'a, 'o> {
     ) {
         if !self.selected(topic) {
             self.not_selected.insert(topic.to_owned(), ());
+            return;
+        }
+        if self.sensors.get(topic).is_some_and(|s| s.count() == 0) {
+            // Declared as a sensor topic but without its messages yet: the pose type's.
+            self.sensors.remove(topic);
+        }
+        if let Some(state) = self.sensors.get_mut(topic) {
+            // A sensor topic that carries a pose type too: not read, a defect.
+            let index = state.count();
+            state.health.other_type(type_name, log_time_ns, index);
             return;
         }
         let every = self.options.every;
@@ -453,18 +464,22 @@ impl<'a, 'o> Collector<'a, 'o> {
 
     pub(super) fn finish(self, path: &Path) -> Result<LogSummary, InputError> {
         for wanted in &self.options.topics {
-            if !self.topics.contains_key(wanted) && !self.cancelled {
+            let read = self.topics.contains_key(wanted) || self.sensors.contains_key(wanted);
+            if !read && !self.cancelled {
                 let why = match self.skipped.get(wanted) {
-                    Some((t, ..)) => format!("its messages are {t}, not a pose with covariance"),
+                    Some((t, ..)) => {
+                        format!("its messages are {t}, not a message with a covariance")
+                    }
                     None => {
                         let have: Vec<&str> = self
                             .topics
                             .keys()
+                            .chain(self.sensors.keys())
                             .chain(self.not_selected.keys())
                             .map(String::as_str)
                             .collect();
                         format!(
-                            "no such topic; {}pose topics in this log: {}",
+                            "no such topic; {}topics with a covariance in this log: {}",
                             suggest::did_you_mean(wanted, have.iter().copied()),
                             if have.is_empty() {
                                 "none".to_owned()
@@ -482,6 +497,7 @@ impl<'a, 'o> Collector<'a, 'o> {
         }
         Ok(assemble(
             self.topics,
+            self.sensors,
             self.skipped,
             self.not_selected,
             self.total,
@@ -497,6 +513,7 @@ impl<'a, 'o> Collector<'a, 'o> {
 #[allow(clippy::too_many_arguments)]
 fn assemble(
     mut topics: BTreeMap<String, TopicState>,
+    mut sensors: BTreeMap<String, SensorState>,
     mut skipped: BTreeMap<String, (String, u64, i64)>,
     not_selected: BTreeMap<String, ()>,
     total: u64,
@@ -512,8 +529,17 @@ fn assemble(
             state.other_type_before(label, count, first);
         }
     }
+    for (name, state) in &mut sensors {
+        if let Some((label, count, first)) = skipped.remove(name) {
+            state.health.other_type_before(label, count, first);
+        }
+    }
     LogSummary {
         topics: topics
+            .into_iter()
+            .map(|(name, s)| s.into_plan(name))
+            .collect(),
+        sensors: sensors
             .into_iter()
             .map(|(name, s)| s.into_plan(name))
             .collect(),

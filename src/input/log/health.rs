@@ -4,8 +4,10 @@
 
 use crate::plan::log::{AxisStats, COV_LEN, Health, Issue, IssueCount, PoseMessage, Stretch};
 
+mod block;
 mod classify;
 mod issues;
+pub use block::{BlockHealth, classify_block};
 pub use classify::{MessageHealth, classify};
 use classify::{classify_covariance, with_orientation};
 pub use issues::Issues;

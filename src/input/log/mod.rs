@@ -6,8 +6,9 @@
 //! drawing, and time series are kept at a bounded length (halving their density when full).
 //!
 //! Messages read: `nav_msgs/Odometry`, `geometry_msgs/PoseWithCovarianceStamped`,
-//! `geometry_msgs/PoseWithCovariance`, and `/tf` + `/tf_static` kept per edge (`tf.rs`); other
-//! types are listed as skipped. Stamps are the header stamp, or the log time when it is zero.
+//! `geometry_msgs/PoseWithCovariance` (pose topics), `sensor_msgs/Imu` (sensor topics,
+//! `sensor.rs`: health and σ of each covariance block), and `/tf` + `/tf_static` kept per edge
+//! (`tf.rs`); other types are listed as skipped. Stamps are the header stamp, or the log time when it is zero.
 //!
 //! ```
 //! use posecov::input::log::{LogOptions, read_log};
@@ -36,14 +37,18 @@ pub mod reference;
 mod ros1;
 mod ros1_linear;
 pub mod rosbag2;
+pub mod sensor;
 mod sqlite;
+mod stream;
 mod tf;
 mod topic;
 pub mod ws;
 
-use collector::{Codec, Collector, Stream};
+use collector::Collector;
 pub use collector::{GROWN_SERIES, growth_interval};
-use topic::no_pose_topic;
+pub use stream::Codec;
+use stream::Stream;
+use topic::no_covariance_topic;
 
 /// The largest record or decompressed chunk of a log read (1 GiB): larger ones are refused,
 /// not allocated.
@@ -265,14 +270,16 @@ fn summary(collector: Collector<'_, '_>, path: &Path) -> Result<LogSummary, Inpu
     let plan = collector.finish(path)?;
     // Nothing to draw is an error for every command (no empty recording), unless Ctrl-C
     // stopped the read before the first pose message.
-    if !plan.cancelled && plan.topics.iter().all(|t| t.count == 0) {
+    let empty =
+        plan.topics.iter().all(|t| t.count == 0) && plan.sensors.iter().all(|t| t.count == 0);
+    if !plan.cancelled && empty {
         let cut = match &plan.cut {
             Some(cut) => format!("; the log stops early: {}", cut.reason),
             None => String::new(),
         };
         return Err(InputError::Format {
             file: path.display().to_string(),
-            message: format!("{}{cut}", no_pose_topic(&plan)),
+            message: format!("{}{cut}", no_covariance_topic(&plan)),
         });
     }
     Ok(plan)

@@ -23,6 +23,7 @@ fn conn_of(c: &rosbag::record_types::Connection<'_>) -> Stream {
         type_name: c.tp.to_owned(),
         kind: ros1_kind(c.tp, &md5),
         reference: super::reference::ros1_reference_type(c.tp, &md5),
+        sensor: super::sensor::ros1_sensor(c.tp, &md5),
     }
 }
 

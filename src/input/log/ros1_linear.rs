@@ -99,6 +99,7 @@ fn connection(header: &[(&str, &[u8])], data: &[u8]) -> Result<(u32, Stream), St
         Stream {
             kind: ros1_kind(&type_name, &md5),
             reference: ros1_reference_type(&type_name, &md5),
+            sensor: super::sensor::ros1_sensor(&type_name, &md5),
             topic,
             type_name,
         },

@@ -140,6 +140,7 @@ mod tests {
             type_name: "tf2_msgs/msg/TFMessage".into(),
             kind: None,
             reference: Some(Ok(ReferenceType::TfMessage)),
+            sensor: None,
         }
     }
 

@@ -5,8 +5,8 @@
 
 use crate::lie::GroupKind;
 use crate::plan::log::{
-    Decimator, DrawnMessage, Issue, IssueCount, LogSummary, PoseMessage, PoseMessageKind,
-    SeriesPoint, StampRange, TopicSummary, TrackPoint, is_odom_frame,
+    Decimator, DrawnMessage, Health, Issue, IssueCount, LogSummary, PoseMessage, PoseMessageKind,
+    SensorKind, SeriesPoint, StampRange, TopicSummary, TrackPoint, is_odom_frame,
 };
 
 use super::decode::DecodeError;
@@ -21,6 +21,49 @@ pub(super) struct Added {
     pub(super) unestimated: [bool; 6],
 }
 
+/// A topic's stamps, streamed: the one place their findings are made (`stamp_fallback`,
+/// `stamp_order`, `frozen_stamp`) for pose and sensor topics alike.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Stamps {
+    /// Messages whose header stamp was zero (the log time used).
+    pub(super) from_log: u64,
+    /// Messages earlier than the one before.
+    pub(super) out_of_order: u64,
+    last: Option<i64>,
+    /// Earliest and latest stamp.
+    pub(super) range: Option<StampRange>,
+}
+
+impl Stamps {
+    /// Message `index`'s stamp (`from_log_time`: its header's was zero; `headed`: its type has
+    /// a header, so a zero or repeated stamp is a finding), its findings noted in `health`.
+    pub(super) fn next(
+        &mut self,
+        stamp_ns: i64,
+        from_log_time: bool,
+        headed: bool,
+        index: u64,
+        health: &mut Health,
+    ) {
+        if from_log_time && headed {
+            self.from_log += 1;
+            health.note(Issue::StampFallback, stamp_ns, index);
+        }
+        if self.last.is_some_and(|last| stamp_ns < last) {
+            self.out_of_order += 1;
+            health.note(Issue::StampOrder, stamp_ns, index);
+        }
+        if headed && !from_log_time && self.last == Some(stamp_ns) {
+            health.note(Issue::FrozenStamp, stamp_ns, index);
+        }
+        self.last = Some(stamp_ns);
+        self.range = Some(
+            self.range
+                .map_or(StampRange::new(stamp_ns), |r| r.widened(stamp_ns)),
+        );
+    }
+}
+
 /// The per-topic streaming state (cloned for the summary so far of a growing live read).
 #[derive(Clone)]
 pub(super) struct TopicState {
@@ -28,10 +71,7 @@ pub(super) struct TopicState {
     frame_id: Option<String>,
     child_frame_id: Option<String>,
     count: u64,
-    from_log: u64,
-    out_of_order: u64,
-    last_stamp: Option<i64>,
-    range: Option<StampRange>,
+    stamps: Stamps,
     /// Health classes and σ statistics.
     pub(super) checks: TopicHealth,
     drawn: Decimator<DrawnMessage>,
@@ -48,10 +88,7 @@ impl TopicState {
             frame_id: None,
             child_frame_id: None,
             count: 0,
-            from_log: 0,
-            out_of_order: 0,
-            last_stamp: None,
-            range: None,
+            stamps: Stamps::default(),
             checks: TopicHealth::default(),
             drawn: match every {
                 Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
@@ -84,25 +121,14 @@ impl TopicState {
         if d.from_log_time {
             d.stamp_ns = log_time_ns;
         }
-        let (stamp_ns, from_log_time) = (d.stamp_ns, d.from_log_time);
+        let stamp_ns = d.stamp_ns;
         let headed = self.kind != PoseMessageKind::PoseWithCovariance;
-        if from_log_time && headed {
-            self.from_log += 1;
-            self.checks
-                .health
-                .note(Issue::StampFallback, stamp_ns, index);
-        }
-        if self.last_stamp.is_some_and(|last| stamp_ns < last) {
-            self.out_of_order += 1;
-            self.checks.health.note(Issue::StampOrder, stamp_ns, index);
-        }
-        if headed && !from_log_time && self.last_stamp == Some(stamp_ns) {
-            self.checks.health.note(Issue::FrozenStamp, stamp_ns, index);
-        }
-        self.last_stamp = Some(stamp_ns);
-        self.range = Some(
-            self.range
-                .map_or(StampRange::new(stamp_ns), |r| r.widened(stamp_ns)),
+        self.stamps.next(
+            stamp_ns,
+            d.from_log_time,
+            headed,
+            index,
+            &mut self.checks.health,
         );
         if self.frame_id.is_none() && !d.frame_id.is_empty() {
             self.frame_id = Some(d.frame_id.clone());
@@ -155,26 +181,14 @@ impl TopicState {
     /// read, counted as a [`Issue::TypeChange`] after the messages read so far.
     pub(super) fn other_type(&mut self, type_name: &str, log_time_ns: i64) {
         let health = &mut self.checks.health;
-        if !health.other_types.iter().any(|t| t == type_name) {
-            health.other_types.push(type_name.to_owned());
-        }
-        health.note(Issue::TypeChange, log_time_ns, self.count);
+        health.other_type(type_name, log_time_ns, self.count);
     }
 
     /// `count` messages of another type (`type_name`, the first logged at `first_log_ns`)
     /// seen on this topic before it was known as a pose topic.
     pub(super) fn other_type_before(&mut self, type_name: String, count: u64, first_log_ns: i64) {
-        if count == 0 {
-            return;
-        }
         let health = &mut self.checks.health;
-        health.other_types.push(type_name);
-        let first = IssueCount {
-            count,
-            first_stamp_ns: first_log_ns,
-            first_index: 0,
-        };
-        health.add(Issue::TypeChange, first);
+        health.other_type_before(type_name, count, first_log_ns);
     }
 
     pub(super) fn into_plan(self, name: String) -> TopicSummary {
@@ -211,9 +225,9 @@ impl TopicState {
             frame_id: self.frame_id.unwrap_or_default(),
             child_frame_id: self.child_frame_id.unwrap_or_default(),
             count: self.count,
-            stamps_from_log_time: self.from_log,
-            stamps_out_of_order: self.out_of_order,
-            stamp_range: self.range,
+            stamps_from_log_time: self.stamps.from_log,
+            stamps_out_of_order: self.stamps.out_of_order,
+            stamp_range: self.stamps.range,
             health,
             group: if planar {
                 GroupKind::Se2
@@ -229,9 +243,9 @@ impl TopicState {
     }
 }
 
-/// Why a log has nothing to draw: the topics it has (type and count), its pose topics without
-/// messages, and the types posecov reads.
-pub(super) fn no_pose_topic(plan: &LogSummary) -> String {
+/// Why a log has nothing to check: the topics it has (type and count), its topics with a
+/// covariance but without messages, and the types posecov reads.
+pub(super) fn no_covariance_topic(plan: &LogSummary) -> String {
     const SHOWN: usize = 12;
     let mut has: Vec<String> = plan
         .skipped
@@ -242,10 +256,15 @@ pub(super) fn no_pose_topic(plan: &LogSummary) -> String {
     if plan.skipped.len() > SHOWN {
         has.push(format!("… and {} more topics", plan.skipped.len() - SHOWN));
     }
-    let empty: Vec<&str> = plan.topics.iter().map(|t| t.name.as_str()).collect();
+    let empty: Vec<&str> = plan
+        .topics
+        .iter()
+        .map(|t| t.name.as_str())
+        .chain(plan.sensors.iter().map(|t| t.name.as_str()))
+        .collect();
     if !empty.is_empty() {
         has.push(format!(
-            "pose topics without messages: {}",
+            "topics with a covariance but no messages: {}",
             empty.join(", ")
         ));
     }
@@ -254,12 +273,19 @@ pub(super) fn no_pose_topic(plan: &LogSummary) -> String {
     } else {
         has.join(", ")
     };
-    let reads: Vec<String> = PoseMessageKind::ALL
+    let names = PoseMessageKind::ALL
         .iter()
-        .map(|k| format!("{} (ROS 2: {})", k.ros1_name(), k.ros2_name()))
+        .map(|k| (k.ros1_name(), k.ros2_name()))
+        .chain(
+            SensorKind::ALL
+                .iter()
+                .map(|k| (k.ros1_name(), k.ros2_name())),
+        );
+    let reads: Vec<String> = names
+        .map(|(ros1, ros2)| format!("{ros1} (ROS 2: {ros2})"))
         .collect();
     format!(
-        "no pose-with-covariance topic to draw; the log has {has}; posecov reads {}",
+        "no topic with a covariance to check; the log has {has}; posecov reads {}",
         reads.join(", ")
     )
 }

@@ -253,6 +253,45 @@ impl Health {
         }
     }
 
+    /// A message of another type (`type_name`, logged at `log_time_ns`) on the topic, after
+    /// `index` messages of its own: not read, a [`Issue::TypeChange`].
+    ///
+    /// ```
+    /// use posecov::plan::log::{Health, Issue};
+    /// let mut h = Health::default();
+    /// h.other_type("sensor_msgs/msg/Image", 5, 3);
+    /// h.other_type("sensor_msgs/msg/Image", 6, 4);
+    /// assert_eq!((h.count(Issue::TypeChange), h.other_types.len()), (2, 1));
+    /// ```
+    pub fn other_type(&mut self, type_name: &str, log_time_ns: i64, index: u64) {
+        if !self.other_types.iter().any(|t| t == type_name) {
+            self.other_types.push(type_name.to_owned());
+        }
+        self.note(Issue::TypeChange, log_time_ns, index);
+    }
+
+    /// `count` messages of another type (`type_name`, the first logged at `first_log_ns`) seen
+    /// on the topic before its own type was known.
+    ///
+    /// ```
+    /// use posecov::plan::log::{Health, Issue};
+    /// let mut h = Health::default();
+    /// h.other_type_before("std_msgs/String".into(), 3, 7);
+    /// assert_eq!(h.first(Issue::TypeChange), Some(7));
+    /// ```
+    pub fn other_type_before(&mut self, type_name: String, count: u64, first_log_ns: i64) {
+        if count == 0 {
+            return;
+        }
+        self.other_types.push(type_name);
+        let first = IssueCount {
+            count,
+            first_stamp_ns: first_log_ns,
+            first_index: 0,
+        };
+        self.add(Issue::TypeChange, first);
+    }
+
     /// Messages with `issue`.
     pub fn count(&self, issue: Issue) -> u64 {
         self.issues.get(&issue).map_or(0, |c| c.count)

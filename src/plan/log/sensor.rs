@@ -1,0 +1,195 @@
+//! Covariance-carrying messages that are not poses (issue 32): a sensor's message carries one or
+//! more 3 × 3 covariance blocks, each of one quantity in one unit. Read (`input::log::sensor`)
+//! into a [`SensorTopicSummary`] per topic: its health per block, σ statistics per axis and a
+//! bounded σ series; evaluated and reported beside the pose topics.
+//!
+//! ```
+//! use posecov::plan::log::{SensorKind, Class, Issue};
+//! let imu = SensorKind::Imu;
+//! assert_eq!(imu.ros2_name(), "sensor_msgs/msg/Imu");
+//! assert_eq!(imu.blocks()[1].unit, "rad/s");
+//! // REP 145's −1 in element 0, "not provided", is a note on a sensor topic.
+//! assert_eq!(SensorKind::class(Issue::UnknownMarker), Class::Note);
+//! ```
+
+use serde::Serialize;
+
+use super::{AxisStats, Class, Health, Issue};
+
+/// The most blocks a sensor message carries.
+pub const MAX_BLOCKS: usize = 3;
+
+/// One 3 × 3 covariance block of a sensor message: which field it is, the unit of its σ and the
+/// names of its three axes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct BlockSpec {
+    /// The quantity (`orientation`, `angular_velocity`, `linear_acceleration`): the message's
+    /// field is this with `_covariance` after it.
+    pub name: &'static str,
+    /// The unit of σ = √Σᵢᵢ.
+    pub unit: &'static str,
+    /// The axes, in the block's row order.
+    pub axes: [&'static str; 3],
+}
+
+/// The message types posecov reads covariances from that are not poses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorKind {
+    /// `sensor_msgs/Imu` (REP 145): orientation, angular velocity and linear acceleration,
+    /// each with its 3 × 3 covariance in the message's `header.frame_id` axes.
+    Imu,
+}
+
+/// An IMU's three blocks, in the message's order.
+const IMU_BLOCKS: [BlockSpec; 3] = [
+    BlockSpec {
+        name: "orientation",
+        unit: "rad",
+        axes: ["x", "y", "z"],
+    },
+    BlockSpec {
+        name: "angular_velocity",
+        unit: "rad/s",
+        axes: ["x", "y", "z"],
+    },
+    BlockSpec {
+        name: "linear_acceleration",
+        unit: "m/s²",
+        axes: ["x", "y", "z"],
+    },
+];
+
+impl SensorKind {
+    /// Every sensor kind.
+    pub const ALL: [SensorKind; 1] = [SensorKind::Imu];
+
+    /// The ROS 1 type name (`sensor_msgs/Imu`).
+    ///
+    /// ```
+    /// assert_eq!(posecov::plan::log::SensorKind::Imu.ros1_name(), "sensor_msgs/Imu");
+    /// ```
+    pub fn ros1_name(self) -> &'static str {
+        match self {
+            SensorKind::Imu => "sensor_msgs/Imu",
+        }
+    }
+
+    /// The ROS 2 type name (`sensor_msgs/msg/Imu`).
+    ///
+    /// ```
+    /// assert_eq!(posecov::plan::log::SensorKind::Imu.ros2_name(), "sensor_msgs/msg/Imu");
+    /// ```
+    pub fn ros2_name(self) -> &'static str {
+        match self {
+            SensorKind::Imu => "sensor_msgs/msg/Imu",
+        }
+    }
+
+    /// Its covariance blocks, in the message's order.
+    ///
+    /// ```
+    /// let b = posecov::plan::log::SensorKind::Imu.blocks();
+    /// assert_eq!((b[0].name, b[0].unit, b[2].unit), ("orientation", "rad", "m/s²"));
+    /// ```
+    pub fn blocks(self) -> &'static [BlockSpec] {
+        match self {
+            SensorKind::Imu => &IMU_BLOCKS,
+        }
+    }
+
+    /// The class of `issue` on a sensor's block or topic. As on a pose topic
+    /// ([`Issue::class`] of a topic that is not dead-reckoned), except `unknown_marker`: REP 145
+    /// defines −1 in element 0 as "not provided", a note (the block is then not checked).
+    ///
+    /// ```
+    /// use posecov::plan::log::{Class, Issue, SensorKind};
+    /// assert_eq!(SensorKind::class(Issue::AllZero), Class::Defect);
+    /// assert_eq!(SensorKind::class(Issue::Constant), Class::Note);
+    /// ```
+    pub fn class(issue: Issue) -> Class {
+        match issue {
+            Issue::UnknownMarker => Class::Note,
+            other => other.class(false),
+        }
+    }
+}
+
+/// One point of a sensor topic's σ series: per block, σ of each axis where it is checked and
+/// estimated (`None`: not provided, unusable, or a placeholder).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorSeriesPoint {
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// √Σᵢᵢ per block and axis, in the block's unit.
+    pub sigma: [[Option<f64>; 3]; MAX_BLOCKS],
+}
+
+/// One block of a sensor topic, reduced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockSummary {
+    /// Which block.
+    pub spec: BlockSpec,
+    /// Its health: per issue the messages and the first (`unknown_marker`: the messages whose
+    /// block is "not provided").
+    pub health: Health,
+    /// σ statistics per axis over the messages whose block is usable and estimates the axis.
+    pub sigma_stats: [Option<AxisStats>; 3],
+}
+
+/// What a sensor topic's messages were, reduced to bounded data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SensorTopicSummary {
+    /// Topic name as in the log.
+    pub name: String,
+    /// Message type.
+    pub kind: SensorKind,
+    /// `header.frame_id` of the first message that has one.
+    pub frame_id: String,
+    /// Messages read.
+    pub count: u64,
+    /// Messages whose header stamp was zero (log time used).
+    pub stamps_from_log_time: u64,
+    /// Messages whose stamp is earlier than the one before.
+    pub stamps_out_of_order: u64,
+    /// Earliest and latest stamp (ns), if any message.
+    pub stamp_range: Option<super::StampRange>,
+    /// The topic's own findings: stamps, undecodable messages, other types.
+    pub health: Health,
+    /// Per covariance block, in the message's order.
+    pub blocks: Vec<BlockSummary>,
+    /// σ over the stamp (bounded, in stamp order).
+    pub series: Vec<SensorSeriesPoint>,
+}
+
+impl SensorTopicSummary {
+    /// Every finding of the topic and its blocks with the block it is on (`None`: the
+    /// topic's own), defects first, then in block order.
+    ///
+    /// ```
+    /// use posecov::input::log::{LogOptions, read_log};
+    /// use posecov::plan::log::{Class, Issue};
+    /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/robot_localization/test2.bag");
+    /// let plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+    /// let imu = &plan.sensors[0];
+    /// let found: Vec<_> = imu.findings().map(|(b, i, _, c)| (b, i, c)).collect();
+    /// assert!(found.contains(&(Some("orientation"), Issue::Constant, Class::Note)));
+    /// ```
+    pub fn findings(
+        &self,
+    ) -> impl Iterator<Item = (Option<&'static str>, Issue, super::IssueCount, Class)> + '_ {
+        let own = self.health.issues.iter().map(|(i, c)| (None, *i, *c));
+        let blocks = self.blocks.iter().flat_map(|b| {
+            b.health
+                .issues
+                .iter()
+                .map(move |(i, c)| (Some(b.spec.name), *i, *c))
+        });
+        let mut all: Vec<_> = own
+            .chain(blocks)
+            .map(|(b, i, c)| (b, i, c, SensorKind::class(i)))
+            .collect();
+        all.sort_by_key(|f| f.3);
+        all.into_iter()
+    }
+}
