@@ -10,7 +10,6 @@
 //! ```
 
 #[path = "../tests/common/graph.rs"]
-#[allow(dead_code, unused_imports)]
 mod graph_common;
 
 use std::path::PathBuf;

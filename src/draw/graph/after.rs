@@ -268,7 +268,7 @@ fn sparse<G: LieGroup<N>, const N: usize>(
     } else {
         drawn.len()
     };
-    let count = fits.clamp(MIN_ELLIPSES, drawn.len().max(1));
+    let count = fits.max(MIN_ELLIPSES).min(drawn.len());
     if count >= drawn.len() {
         return drawn.clone();
     }
