@@ -93,7 +93,8 @@ impl Ramp {
         }
     }
 
-    /// The legend: one line entry per colour, "after: position σ √tr Σ_ρρ 20–50 mm".
+    /// The legend: one line entry per colour, "after: position σ √tr Σ_ρρ 20–50 mm" (the
+    /// trajectory and the ellipses in that colour).
     pub(super) fn legend(&self, p: &mut Painter) {
         if self.edges[0].is_infinite() {
             let what = "after: optimised trajectory (no marginals, so no σ colours)";
@@ -102,10 +103,7 @@ impl Ramp {
         }
         for (k, color) in RAMP.iter().enumerate() {
             p.legend(
-                format!(
-                    "after, coloured by position σ √tr Σ_ρρ: {}",
-                    self.range_words(k)
-                ),
+                format!("after: position σ √tr Σ_ρρ {}", self.range_words(k)),
                 *color,
                 Swatch::Line,
             );
