@@ -12,7 +12,11 @@ use std::process::Command;
 use posecov::app::Overrides;
 use posecov::app::figure::scene_of;
 use posecov::scene::Scene;
+use posecov::scene::layout::text_width;
 use posecov::sink::figure::{FigureFormat, FigureOptions, Plane, Steps, render, svg};
+
+#[path = "common/graph.rs"]
+mod graph_common;
 
 const BIN: &str = env!("CARGO_BIN_EXE_posecov");
 
@@ -326,5 +330,83 @@ fn the_gallery_has_every_bundled_example_and_the_figures_page_shows_it() {
             page.contains(&link),
             "docs/guide/figures.md does not show {file}"
         );
+    }
+}
+
+/// A label's box in a figure: (left, top, right, bottom) of one `text.label` line, from its
+/// place and font size and the bundled font's advance widths ([`text_width`]).
+fn label_boxes(svg: &str) -> Vec<(String, [f64; 4])> {
+    let attr = |tag: &str, name: &str| -> f64 {
+        let at = tag.find(&format!(" {name}=\"")).expect("attribute") + name.len() + 3;
+        tag[at..at + tag[at..].find('"').expect("closes")]
+            .parse()
+            .expect("number")
+    };
+    svg.match_indices("<text class=\"label\"")
+        .map(|(start, _)| {
+            let open = &svg[start..start + svg[start..].find('>').expect("tag closes")];
+            let body = &svg[start + open.len() + 1..];
+            let words = body[..body.find("</text>").expect("closes")].to_owned();
+            let (x, y, f) = (attr(open, "x"), attr(open, "y"), attr(open, "font-size"));
+            let w = text_width(&words.replace("&lt;", "<").replace("&amp;", "&"), f);
+            (words, [x, y - 0.8 * f, x + w, y + 0.25 * f])
+        })
+        .collect()
+}
+
+/// The figure of a generated graph of benchmark size (g2o text in a temporary file).
+fn generated_figure(name: &str, g2o: &str) -> String {
+    let dir = std::env::temp_dir().join(format!("posecov-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(format!("{name}.g2o"));
+    std::fs::write(&path, g2o).expect("written");
+    let overrides = Overrides {
+        samples: Some(64),
+        ..Default::default()
+    };
+    let scene = scene_of(path.to_str().expect("utf-8"), &overrides).expect("scene");
+    svg(&scene, &FigureOptions::default())
+}
+
+#[test]
+fn labels_of_benchmark_size_generated_graphs_never_overlap() {
+    for (name, g2o) in [
+        (
+            "manhattan3500",
+            graph_common::to_g2o(&graph_common::manhattan_walk(3500, 11)),
+        ),
+        (
+            "sphere2500",
+            graph_common::to_g2o(&graph_common::sphere(50, 50, 11)),
+        ),
+    ] {
+        let text = generated_figure(name, &g2o);
+        let boxes = label_boxes(&text);
+        // The worst loop closure, the largest marginal, the first and last pose: in the after
+        // view and in the close-ups, and the before view's own.
+        let words: Vec<&str> = boxes.iter().map(|(w, _)| w.as_str()).collect();
+        assert!(
+            words.iter().any(|w| w.contains("worst"))
+                && words.iter().any(|w| w.contains("largest")),
+            "{name}: {words:?}"
+        );
+        // At most four labels a view (four views), each in at most three lines, besides the
+        // chain's step numbers.
+        let named = words.iter().filter(|w| w.parse::<u64>().is_err()).count();
+        assert!(
+            named <= 48,
+            "{name}: at most a few labels a panel: {words:?}"
+        );
+        for (i, (a, p)) in boxes.iter().enumerate() {
+            for (b, q) in &boxes[..i] {
+                let apart = p[2] <= q[0] || q[2] <= p[0] || p[3] <= q[1] || q[3] <= p[1];
+                assert!(apart, "{name}: {a:?} {p:?} overlaps {b:?} {q:?}");
+            }
+            // Inside the world panels: left of the legend column, below the title.
+            assert!(
+                p[2] <= 1280.0 * (1.0 - 0.34) && p[1] >= 0.0,
+                "{name}: {a:?} at {p:?}"
+            );
+        }
     }
 }

@@ -99,7 +99,10 @@ fn the_after_view_follows_the_steps_after_the_chain() {
             .collect()
     };
     // The chain has 10 steps: k = 0 from step 0, k = 1 at step 11, k = 2 at step 12.
-    assert_eq!(steps_of("world/optimized/marginals"), vec![0, 11, 12]);
+    assert_eq!(
+        steps_of("world/optimized/marginals/sigma_0"),
+        vec![0, 11, 12]
+    );
     assert_eq!(steps_of("world/optimized/closed"), vec![11, 12]);
     assert!(
         scene

@@ -42,10 +42,13 @@
 //!   like, filled with the run's numbers and their standard errors — the one way a number the run
 //!   computes reaches the author's words; a pose graph file's description from its facts,
 //!   `graph/about.rs`; a pose graph's findings and its paragraph — loop closures
-//!   before and after, joint marginals — in `graph/mod.rs`, its after picture — marginals following
-//!   the loop-closure timeline on the `step` timeline after the chain's steps, loop closures,
-//!   relative uncertainties, labels that do not collide — in `graph/after.rs`; the σ before and
-//!   after against pose index in `graph/sigma.rs`), the 3-D views —
+//!   before and after, joint marginals — in `graph/mod.rs`, its after picture — marginals true
+//!   to scale following the loop-closure timeline on the `step` timeline after the chain's
+//!   steps, loop closures, relative uncertainties, a few labels by importance, a legend entry
+//!   for every mark — in `graph/after.rs`, the σ colours of its trajectory and ellipses in
+//!   `graph/ramp.rs`, the close-ups of the largest marginal and the worst loop closure in
+//!   `graph/zoom.rs`; the σ before and after against pose index in `graph/sigma.rs`), the 3-D
+//!   views —
 //!   layout, hidden entities, each view's camera fitted to what it draws (`views.rs`);
 //! - `log.rs` (`draw_log`: a robot log's scene on the `stamp` timeline and its views: one whole-log
 //!   view per `frame_id`, never overlaid, and per topic a view at the robot's scale whose camera is
@@ -357,9 +360,10 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         extras::trajectories(&mut p, e);
     }
     extras::links(&mut p, e, &choices.links);
-    if let Some(g) = &e.graph {
-        graph::draw_optimized(&mut p, g);
-    }
+    let zooms = match &e.graph {
+        Some(g) => graph::draw_optimized(&mut p, g),
+        None => Vec::new(),
+    };
     for point in &e.points {
         p.origin = Some(Origin::Node(point.name.clone()));
         extras::draw_point(&mut p, point, choices.clouds);
@@ -380,7 +384,7 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         camera: choices.camera,
     };
     p.scene.views = if e.graph.is_some() {
-        views::before_after(&p.scene, &plan, &paths::optimized())
+        views::before_after(&p.scene, &plan, &paths::optimized(), &zooms)
     } else {
         views::views(&p.scene, &plan)
     };

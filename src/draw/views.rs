@@ -10,8 +10,9 @@
 //! eye tilted 2° towards −y so that orbiting turns about z); 3-D scenes look along the
 //! direction in which what is drawn is thinnest (the smallest principal axis of all drawn
 //! points, tilted 25° towards up so depth still reads; a scene lying flat, thin within 35° of
-//! up, from 30° off the vertical on the −y side, x to the right), rotations from the (+x, +y,
-//! +z) octant; `[draw] camera` overrides. The eye then stands at the distance at which every
+//! up, from 30° off the vertical on the −y side, x to the right; a scene with no thin
+//! direction, such as a sphere of poses, from 30° above the horizon on the −y side, turned 30°
+//! towards +x), rotations from the (+x, +y, +z) octant; `[draw] camera` overrides. The eye then stands at the distance at which every
 //! drawn point of the view fits the viewer's 55° field of view with a margin, in the shape
 //! the view really has at 1024 × 640 ([`crate::scene::layout::views_aspect`]: the left column
 //! over the legend view, shared among the views).
@@ -36,6 +37,12 @@ const OBLIQUE_TILT_DEG: f64 = 25.0;
 const FLAT_DEG: f64 = 35.0;
 /// ...and is seen from this far off the vertical, from −y.
 const FLAT_TILT_DEG: f64 = 30.0;
+/// A scene whose least spread (variance along its thinnest axis) is more than this share of
+/// its largest has no thin direction (a sphere of poses)...
+const ROUND: f64 = 0.4;
+/// ...and is seen from 30° above the horizon, 30° round from −y towards +x:
+/// (sin 30° cos 30°, −cos 30° cos 30°, sin 30°).
+const ROUND_EYE: [f64; 3] = [0.433, -0.75, 0.5];
 
 /// What a pose's regions were drawn from: the input's own Gaussian, or a method's estimate.
 /// Its entity-path segment is [`Estimate::segment`].
@@ -138,22 +145,33 @@ pub(super) fn views(scene: &Scene, plan: &ViewInputs) -> Vec<View3d> {
     views
 }
 
-/// A pose graph's two views side by side: "before" (the file's estimates and the odometry
-/// chain, everything but `after`) and "after" (the subtree `after`: optimised poses and
-/// marginals), each with its own camera.
-pub(super) fn before_after(scene: &Scene, plan: &ViewInputs, after: &str) -> Vec<View3d> {
+/// A pose graph's views: "before" (the file's estimates and the odometry chain, everything
+/// but `after` and the zooms) and "after" (the subtree `after`: optimised poses and
+/// marginals, true size), then one robot-scale view per zoom (its subtree), each with its own
+/// camera.
+pub(super) fn before_after(
+    scene: &Scene,
+    plan: &ViewInputs,
+    after: &str,
+    zooms: &[super::graph::Zoom],
+) -> Vec<View3d> {
     let mut views = vec![
         View3d {
             name: "before: file estimates, odometry chain".to_owned(),
-            exclude: vec![after.to_owned()],
+            exclude: vec![after.to_owned(), paths::zooms()],
             ..Default::default()
         },
         View3d {
-            name: "after: optimised, marginals".to_owned(),
+            name: "after: optimised, marginals true size".to_owned(),
             include: vec![after.to_owned()],
             ..Default::default()
         },
     ];
+    views.extend(zooms.iter().map(|z| View3d {
+        name: z.name.clone(),
+        include: vec![z.path.clone()],
+        ..Default::default()
+    }));
     let aspect = views_aspect(scene, views.len());
     // The after view opens on the final solution: fitted to its last state and what is
     // static, not to the dead-reckoning state it starts the timeline with.
@@ -372,6 +390,11 @@ fn oblique(points: &[Vector3<f64>], up: &Vector3<f64>) -> Vector3<f64> {
         .sum::<Matrix3<f64>>();
     let eigen = SymmetricEigen::new(spread);
     let k = eigen.eigenvalues.imin();
+    // No thin direction (a sphere, a ball of poses): its thinnest axis is chance, so the eye
+    // stands where a 3-D shape reads, above and to the side (x to the right, y away, z up).
+    if eigen.eigenvalues[k] > ROUND * eigen.eigenvalues.max() {
+        return Vector3::from(ROUND_EYE).normalize();
+    }
     let mut n = eigen.eigenvectors.column(k).into_owned();
     if n.dot(up) < 0.0 {
         n = -n;
@@ -484,6 +507,22 @@ mod tests {
         let sight = (Vector3::from(c.target) - Vector3::from(c.position)).normalize();
         let off = sight.dot(&Vector3::y()).abs().acos().to_degrees();
         assert!((off - OBLIQUE_TILT_DEG).abs() < 1.0, "{off}°");
+    }
+
+    #[test]
+    fn a_round_3d_scene_is_seen_from_above_and_aside() {
+        let poses = Vec::new();
+        // Points on a sphere: no thin direction.
+        let points: Vec<Vector3<f64>> = (0..400)
+            .map(|i| {
+                let (a, b) = (i as f64 * 0.61, (i as f64 / 400.0 * 2.0 - 1.0).acos());
+                10.0 * Vector3::new(b.sin() * a.cos(), b.sin() * a.sin(), b.cos())
+            })
+            .collect();
+        let c = camera(&points, &plan(&poses, false), ASPECT).unwrap();
+        let towards_eye = (Vector3::from(c.position) - Vector3::from(c.target)).normalize();
+        assert!((towards_eye - Vector3::from(ROUND_EYE).normalize()).norm() < 1e-9);
+        assert!(c.check("sphere").is_ok());
     }
 
     #[test]

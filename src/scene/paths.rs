@@ -141,6 +141,25 @@ pub fn optimized() -> String {
     format!("{WORLD}/optimized")
 }
 
+/// A pose graph's robot-scale view of `what` (the largest marginal, the worst loop closure):
+/// `world/zoom/<what>`, under [`zooms`].
+///
+/// ```
+/// assert_eq!(posecov::scene::paths::zoom("largest_marginal"), "world/zoom/largest_marginal");
+/// ```
+pub fn zoom(what: &str) -> String {
+    child(&zooms(), what)
+}
+
+/// The subtree of a pose graph's robot-scale views: `world/zoom`.
+///
+/// ```
+/// assert_eq!(posecov::scene::paths::zooms(), "world/zoom");
+/// ```
+pub fn zooms() -> String {
+    format!("{WORLD}/zoom")
+}
+
 /// A graph vertex's entity under `base` (its label or its banana): `base/v<id>`.
 ///
 /// ```

@@ -134,6 +134,44 @@ fn walk<G: LieGroup<N>, const N: usize>(
         let last = *truth.last().unwrap();
         truth.push(last.compose(&step));
     }
+    graph_of(&truth, &mut rng, sigma, |rng, _, _, d| {
+        distance(d) < 1.1 && rng.random_bool(0.5)
+    })
+}
+
+/// A seeded sphere of poses like the benchmark's sphere2500: `rings` × `per_ring` poses on a
+/// sphere of radius 50 m, ring after ring from the south pole's side, each heading along its
+/// ring; odometry between consecutive poses and a loop closure from each pose to the one
+/// below it in the ring before; σ = 0.05 (translation) and 0.02 (rotation).
+pub fn sphere(rings: usize, per_ring: usize, seed: u64) -> PoseGraph<Se3, 6> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let truth: Vec<Se3> = (0..rings * per_ring)
+        .map(|k| {
+            let (r, c) = (k / per_ring, k % per_ring);
+            let latitude = -FRAC_PI_2 + std::f64::consts::PI * (r + 1) as f64 / (rings + 1) as f64;
+            let longitude = std::f64::consts::TAU * c as f64 / per_ring as f64;
+            let at = [
+                50.0 * latitude.cos() * longitude.cos(),
+                50.0 * latitude.cos() * longitude.sin(),
+                50.0 * latitude.sin(),
+            ];
+            Se3::from_xyz_rpy(at, [0.0, 0.0, longitude + FRAC_PI_2])
+        })
+        .collect();
+    let sigma = [0.05, 0.05, 0.05, 0.02, 0.02, 0.02];
+    graph_of(&truth, &mut rng, sigma, |_, i, j, _| j - i == per_ring)
+}
+
+/// The graph of a true trajectory: odometry between consecutive poses, chained into the
+/// initial guess, and a loop closure i → j (j more than 5 after i) wherever `closes` says so
+/// (given the rng, i, j and the true relative pose), every measurement with noise σ.
+fn graph_of<G: LieGroup<N>, const N: usize>(
+    truth: &[G],
+    rng: &mut rand_chacha::ChaCha8Rng,
+    sigma: [f64; N],
+    mut closes: impl FnMut(&mut rand_chacha::ChaCha8Rng, usize, usize, &G) -> bool,
+) -> PoseGraph<G, N> {
+    let poses = truth.len();
     let info = SMatrix::<f64, N, N>::from_diagonal(&SVector::<f64, N>::from_fn(|k, _| {
         1.0 / (sigma[k] * sigma[k])
     }));
@@ -144,10 +182,10 @@ fn walk<G: LieGroup<N>, const N: usize>(
         z.rplus(&n)
     };
     let mut graph = PoseGraph::<G, N>::default();
-    let mut guess = G::identity();
+    let mut guess = truth.first().copied().unwrap_or_else(G::identity);
     for k in 0..poses {
         if k > 0 {
-            let z = noisy(&mut rng, truth[k - 1].between(&truth[k]));
+            let z = noisy(rng, truth[k - 1].between(&truth[k]));
             graph.edges.push(GraphEdge {
                 from: k - 1,
                 to: k,
@@ -166,8 +204,8 @@ fn walk<G: LieGroup<N>, const N: usize>(
     for j in 0..poses {
         for i in 0..j.saturating_sub(5) {
             let d = truth[i].between(&truth[j]);
-            if distance(&d) < 1.1 && rng.random_bool(0.5) {
-                let z = noisy(&mut rng, d);
+            if closes(rng, i, j, &d) {
+                let z = noisy(rng, d);
                 graph.edges.push(GraphEdge {
                     from: i,
                     to: j,
@@ -179,4 +217,50 @@ fn walk<G: LieGroup<N>, const N: usize>(
         }
     }
     graph
+}
+
+/// A pose graph as g2o text: `VERTEX_SE2` / `EDGE_SE2` for a planar group (x, y, θ), else
+/// `VERTEX_SE3:QUAT` / `EDGE_SE3:QUAT` (x, y, z, qx, qy, qz, qw), each edge with the upper
+/// triangle of its information matrix as stored (for SE(3) not converted to g2o's quaternion
+/// error: a picture's test, not a numbers' one).
+pub fn to_g2o<G: LieGroup<N>, const N: usize>(graph: &PoseGraph<G, N>) -> String {
+    let planar = G::KIND.is_planar();
+    let values = |x: &G| -> String {
+        let se3 = x.to_se3();
+        let t = se3.translation();
+        let q = se3.rotation().to_quaternion_xyzw();
+        let numbers: Vec<f64> = if planar {
+            vec![t.x, t.y, 2.0 * q[2].atan2(q[3])]
+        } else {
+            vec![t.x, t.y, t.z, q[0], q[1], q[2], q[3]]
+        };
+        numbers
+            .iter()
+            .map(|v| format!("{v:.9}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let (vertex, edge) = if planar {
+        ("VERTEX_SE2", "EDGE_SE2")
+    } else {
+        ("VERTEX_SE3:QUAT", "EDGE_SE3:QUAT")
+    };
+    let mut text = String::new();
+    for v in &graph.vertices {
+        text += &format!("{vertex} {} {}\n", v.id, values(&v.estimate));
+    }
+    for e in &graph.edges {
+        let info: Vec<String> = (0..N)
+            .flat_map(|r| (r..N).map(move |c| (r, c)))
+            .map(|(r, c)| format!("{}", e.information[(r, c)]))
+            .collect();
+        text += &format!(
+            "{edge} {} {} {} {}\n",
+            graph.vertices[e.from].id,
+            graph.vertices[e.to].id,
+            values(&e.measurement),
+            info.join(" ")
+        );
+    }
+    text
 }

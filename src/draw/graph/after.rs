@@ -1,22 +1,26 @@
-//! The "after" picture of a pose graph: the optimised trajectory and poses, every drawn
-//! pose's marginal ellipse at the confidence, a few marginal bananas, each loop closure with
-//! its residual, the relative uncertainty of the worst loop closures and of every `--joint`
-//! pair, and labels that do not collide.
+//! The "after" picture of a pose graph: the optimised trajectory and every drawn pose's
+//! marginal ellipse at the confidence, true to scale and coloured by the pose's σ
+//! ([`super::ramp`]), a few marginal bananas, each loop closure with its residual, the relative
+//! uncertainty of the worst loop closures and of every `--joint` pair, robot-scale views of
+//! the largest marginal and the worst loop closure ([`super::zoom`]), a legend entry for every
+//! colour and mark, and a few labels chosen by importance.
 
 use super::super::shapes;
-use super::super::{Painter, v3};
+use super::super::{Painter, legend, v3};
+use super::ramp::{self, Ramp};
+use super::zoom::{self, Zoom};
+use nalgebra::Vector3;
 use std::collections::BTreeSet;
 
-use crate::eval::graph::{ClosureStep, GraphEvaluation, LoopClosure};
+use crate::eval::graph::{ClosureStep, GraphEvaluation, LoopClosure, PoseSigma};
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::scene::{
-    self, Arrows, Color, Ellipsoids, FillMode, Frame, ItemKind, LineStrips, QuatXyzw, Timing,
-    Triads, Vec3, paths,
+    self, Arrows, Color, Frame, ItemKind, LineStrips, QuatXyzw, Swatch, Timing, Triads, Vec3, paths,
 };
 use crate::uncertain::{Side, UncertainPose};
 
-/// Most optimised poses drawn with their marginal ellipse (evenly chosen, plus the loop
-/// closures' ends).
+/// Most optimised poses drawn with their axes and marginal ellipse (evenly chosen, plus the
+/// loop closures' ends; fewer when the ellipses are large beside the map, [`sparse`]).
 const MAX_DRAWN_MARGINALS: usize = 600;
 /// Most poses drawn with their marginal banana: the largest marginal and the last pose.
 const MAX_BANANAS: usize = 2;
@@ -25,30 +29,41 @@ const MAX_BANANAS: usize = 2;
 const MAX_RELATIVE_LOOP_CLOSURES: usize = 2;
 /// Most `--joint` pairs drawn (all are in `report --json`).
 const MAX_DRAWN_JOINTS: usize = 12;
-/// Most labels in the after picture.
-const MAX_LABELS: usize = 24;
-/// Colour of the optimised poses and their marginals.
+/// Colour of the loop closures added so far on the timeline (drawn thick).
 pub(super) const OPTIMIZED: Color = Color::rgb(0, 158, 115);
 /// Colour of loop closures beyond their radius.
-const OUTLIER: Color = Color::rgb(213, 94, 0);
+pub(super) const OUTLIER: Color = Color::rgb(213, 94, 0);
 /// Colour of a relative pose's uncertainty (X_b as X_a sees it).
-const RELATIVE: Color = Color::rgb(204, 121, 167);
+pub(super) const RELATIVE: Color = Color::rgb(204, 121, 167);
+/// Colour of a marginal's Exp-mapped region (banana).
+pub(super) const BANANA: Color = Color::rgb(120, 94, 240);
 
-/// The "after" picture at `world/optimized/…`: the optimised trajectory and poses, every
-/// drawn pose's marginal position ellipse at the confidence, the marginal bananas of the
-/// largest marginal and the last pose, each loop closure as a line between its optimised ends
+/// The position σ √tr Σ_ρρ of a marginal (0 for a pose without one).
+pub(super) fn position_sigma<G: LieGroup<N>, const N: usize>(
+    cov: &Option<TangentMatrix<N>>,
+) -> f64 {
+    cov.as_ref()
+        .map_or(0.0, |c| PoseSigma::of::<G, N>(c).position)
+}
+
+/// The "after" picture at `world/optimized/…`: the optimised trajectory and every drawn
+/// pose's marginal position ellipse at the confidence, true to scale, both coloured by the
+/// pose's position σ on the [`Ramp`] fitted to the final solution (one entity per colour,
+/// `trajectory/sigma_<k>` and `marginals/sigma_<k>`); the marginal bananas of the largest
+/// marginal and the last pose, each loop closure as a line between its optimised ends
 /// (outliers in [`OUTLIER`]) with its residual as an arrow from the pose it predicts
-/// (X_i · Z) to X_j, relative uncertainties ([`relative`]) and labels only where they do not
-/// collide. With a loop-closure timeline, the trajectory, ellipses, poses and bananas follow
-/// it on the `step` timeline: the graph without loop closures from step 0 (while the chain's
-/// banana grows), then one step per value of k after the chain's last step, the loop
-/// closures added so far drawn thick; everything else is the final solution, static.
+/// (X_i · Z) to X_j, relative uncertainties ([`relative`]), the robot-scale views of the
+/// largest marginal and the worst loop closure ([`zoom`], returned for the views) and a few
+/// labels ([`labels`]); a legend entry for each colour and mark. With a loop-closure
+/// timeline, the trajectory, ellipses, poses and bananas follow it on the `step` timeline:
+/// the graph without loop closures from step 0 (while the chain's banana grows), then one
+/// step per value of k after the chain's last step, the loop closures added so far drawn
+/// thick; everything else is the final solution, static.
 pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
-) {
+) -> Vec<Zoom> {
     let s = &g.solution;
-    let position = |x: &G| x.to_se3().translation().to_owned();
     let radius = 0.003 * p.extent.max(0.25);
     // Which poses get an ellipse: evenly chosen, plus the worst loop closures' ends.
     let n = s.poses.len();
@@ -63,17 +78,24 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     for l in worst.iter().take(MAX_DRAWN_MARGINALS / 4) {
         drawn.extend([index_of[&l.from], index_of[&l.to]]);
     }
-    // Bananas: the largest marginal and the last pose (of the final solution).
-    let size = |k: usize| s.covariances[k].map_or(0.0, |c| c.trace());
-    let largest = (0..n).max_by(|&a, &b| size(a).total_cmp(&size(b)));
+    // The final solution's σ: the ramp, and the largest marginal.
+    let sigma: Vec<f64> = s.covariances.iter().map(position_sigma::<G, N>).collect();
+    let ellipses = sparse(p, g, &drawn);
+    let ramp = Ramp::fitted(sigma.iter().copied()).unwrap_or_else(Ramp::flat);
+    let largest = (0..n)
+        .filter(|&k| sigma[k] > 0.0)
+        .max_by(|&a, &b| sigma[a].total_cmp(&sigma[b]));
     let mut banana_poses: Vec<usize> = largest.into_iter().chain([n.saturating_sub(1)]).collect();
     banana_poses.dedup();
     banana_poses.truncate(MAX_BANANAS);
     let look = Look {
         radius,
-        drawn: &drawn,
+        ellipses: &ellipses,
         bananas: &banana_poses,
+        ramp: &ramp,
     };
+    // Under the trajectory: its colours stay on top.
+    loop_closure_lines(p, g, &index_of, radius);
     if g.timeline.steps.is_empty() {
         state(p, g, &s.poses, &s.covariances, None, &look);
     } else {
@@ -82,7 +104,8 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         for (i, step) in g.timeline.steps.iter().enumerate() {
             let at = if i == 0 { 0 } else { chain_end + i as u64 };
             state(p, g, &step.poses, &step.covariances, Some(at), &look);
-            closed_so_far(p, g, step, at, radius);
+            let last = i + 1 == g.timeline.steps.len();
+            closed_so_far(p, g, (step, last), at, radius);
             states.push(scene::State {
                 closures: step.closures as u64,
                 step: at as i64,
@@ -93,7 +116,49 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
             steps: states,
         });
     }
-    // Loop closures: lines between the optimised ends; residual arrows X_i·Z → X_j.
+    ramp.legend(p);
+    p.legend(
+        format!(
+            "after: marginal position ellipse at {}, true size, in its σ colour",
+            p.confidence()
+        ),
+        ramp::RAMP[2],
+        Swatch::Dashed,
+    );
+    p.scene.add_legend(legend::axes("optimised poses"));
+    if !banana_poses.is_empty() && s.covariances.iter().any(Option::is_some) {
+        p.legend(
+            format!(
+                "after: a marginal's Exp-mapped {} region (largest, last pose)",
+                p.confidence()
+            ),
+            BANANA,
+            Swatch::Region,
+        );
+    }
+    relative(p, g, &worst);
+    let mut zooms = Vec::new();
+    if let Some(k) = largest {
+        zooms.extend(zoom::largest_marginal(p, g, k, (&sigma, &ramp)));
+    }
+    if let Some(l) = worst.first() {
+        zooms.extend(zoom::worst_loop_closure(p, g, l, (&sigma, &ramp)));
+    }
+    labels(p, g, largest, true);
+    labels(p, g, largest, false);
+    zooms
+}
+
+/// Each loop closure as a line between its optimised ends (`loop_closures/inliers`, outliers
+/// in [`OUTLIER`]) and its residual as an arrow from X_i · Z to X_j (`…_residuals`).
+fn loop_closure_lines<G: LieGroup<N>, const N: usize>(
+    p: &mut Painter,
+    g: &GraphEvaluation<G, N>,
+    index_of: &std::collections::HashMap<u64, usize>,
+    radius: f64,
+) {
+    let s = &g.solution;
+    let position = |x: &G| x.to_se3().translation().to_owned();
     for (outliers, name, color) in [(false, "inliers", scene::LINK), (true, "outliers", OUTLIER)] {
         let chosen: Vec<&LoopClosure<N>> = g
             .loop_closures
@@ -141,21 +206,90 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
                 radius: radius * 0.8,
             }),
         );
+        let what = if outliers {
+            format!("beyond its {} radius (outlier)", g.confidence)
+        } else {
+            "within its radius".to_owned()
+        };
+        p.legend(
+            format!("after: loop closure i → j {what}, and its residual X_i·Z → X_j (arrow)"),
+            color,
+            Swatch::Line,
+        );
     }
-    relative(p, g, &worst);
-    labels(p, g, &worst, &banana_poses, true);
-    labels(p, g, &worst, &banana_poses, false);
+}
+
+/// Most of the map's area the drawn marginal ellipses may cover together.
+const ELLIPSE_COVER: f64 = 0.3;
+/// Fewest ellipses drawn (when that many poses are drawn).
+const MIN_ELLIPSES: usize = 12;
+
+/// The poses of `drawn` that get their marginal ellipse: all of them when their ellipses are
+/// small beside the map, else evenly chosen so that together (at their median area) they
+/// cover at most [`ELLIPSE_COVER`] of the map's bounding box (its two longest sides), at least
+/// [`MIN_ELLIPSES`]: metre-sized marginals on a map tens of metres wide would hide it. The
+/// trajectory's σ colours carry every pose.
+fn sparse<G: LieGroup<N>, const N: usize>(
+    p: &Painter,
+    g: &GraphEvaluation<G, N>,
+    drawn: &BTreeSet<usize>,
+) -> BTreeSet<usize> {
+    let s = &g.solution;
+    let mut areas: Vec<f64> = drawn
+        .iter()
+        .filter_map(|&k| {
+            let pose = UncertainPose::new_unchecked(s.poses[k], s.covariances[k]?, Side::Right);
+            let e = shapes::position_region(&pose, p.confidence())?;
+            let mut h = e.half_sizes;
+            h.sort_by(f64::total_cmp);
+            Some(std::f64::consts::PI * h[1] * h[2])
+        })
+        .collect();
+    if areas.is_empty() {
+        return BTreeSet::new();
+    }
+    areas.sort_by(f64::total_cmp);
+    let median = areas[areas.len() / 2];
+    let (lo, hi) = s.poses.iter().fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), x| {
+            let t = x.to_se3().translation().to_owned();
+            (lo.inf(&t), hi.sup(&t))
+        },
+    );
+    let mut sides: Vec<f64> = (hi - lo).iter().copied().collect();
+    sides.sort_by(f64::total_cmp);
+    let map = (sides[1] * sides[2]).max(median);
+    let fits = if median > 0.0 {
+        (ELLIPSE_COVER * map / median) as usize
+    } else {
+        drawn.len()
+    };
+    let count = fits.max(MIN_ELLIPSES).min(drawn.len());
+    if count >= drawn.len() {
+        return drawn.clone();
+    }
+    let list: Vec<usize> = drawn.iter().copied().collect();
+    (0..count)
+        .map(|i| list[i * (list.len() - 1) / (count - 1).max(1)])
+        .collect()
 }
 
 /// What every state of the after picture draws the same way.
 struct Look<'a> {
     radius: f64,
-    drawn: &'a BTreeSet<usize>,
+    /// The poses drawn as axes with their marginal ellipse ([`sparse`]).
+    ellipses: &'a BTreeSet<usize>,
     bananas: &'a [usize],
+    ramp: &'a Ramp,
 }
 
 /// One state of the optimised graph (the final one, static; or a timeline step): the
-/// trajectory, the drawn poses with their marginal ellipses, and the bananas.
+/// trajectory and the drawn poses' marginal ellipses in their σ colours, the drawn poses, and
+/// the bananas.
 fn state<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
@@ -165,54 +299,46 @@ fn state<G: LieGroup<N>, const N: usize>(
     look: &Look,
 ) {
     let position = |x: &G| x.to_se3().translation().to_owned();
-    p.push(
-        paths::child(&paths::optimized(), "trajectory"),
+    let points: Vec<Vec3> = poses.iter().map(|x| v3(&position(x))).collect();
+    let sigma: Vec<f64> = covariances.iter().map(position_sigma::<G, N>).collect();
+    ramp::trajectory(
+        p,
+        &paths::child(&paths::optimized(), "trajectory"),
         step,
-        ItemKind::LineStrips(LineStrips {
-            strips: vec![poses.iter().map(|x| v3(&position(x))).collect()],
-            color: OPTIMIZED,
-            radius: look.radius,
-        }),
+        (&points, &sigma),
+        0..points.len().saturating_sub(1),
+        (look.ramp, look.radius),
     );
-    let d = G::KIND.position_dims().max(1);
     let uncertain = |k: usize| {
         covariances[k].map(|cov| UncertainPose::new_unchecked(poses[k], cov, Side::Right))
     };
     let shapes: Vec<_> = look
-        .drawn
+        .ellipses
         .iter()
         .filter_map(|&k| {
-            let cov = uncertain(k)?.position_cov_in_world_3d()?;
-            Some(shapes::ellipsoid_of(
-                &position(&poses[k]),
-                &cov,
-                p.confidence().radius(d),
+            Some((
+                shapes::position_region(&uncertain(k)?, p.confidence())?,
+                sigma[k],
             ))
         })
         .collect();
-    if !shapes.is_empty() {
-        p.push(
-            paths::child(&paths::optimized(), "marginals"),
-            step,
-            ItemKind::Ellipsoids(Ellipsoids {
-                shapes,
-                color: OPTIMIZED,
-                fill: FillMode::MajorWireframe,
-                line_radius: look.radius * 0.6,
-                label: None,
-            }),
-        );
-    }
+    ramp::ellipses(
+        p,
+        &paths::child(&paths::optimized(), "marginals"),
+        step,
+        shapes,
+        (look.ramp, look.radius * 0.6),
+    );
     p.push(
         paths::child(&paths::optimized(), "poses"),
         step,
         ItemKind::Triads(Triads {
             translations: look
-                .drawn
+                .ellipses
                 .iter()
                 .map(|&k| v3(&position(&poses[k])))
                 .collect(),
-            rotations: look.drawn.iter().map(|&k| quat(&poses[k])).collect(),
+            rotations: look.ellipses.iter().map(|&k| quat(&poses[k])).collect(),
             axis_length: p.axis_length * 0.6,
             line_radius: look.radius * 0.5,
         }),
@@ -223,7 +349,7 @@ fn state<G: LieGroup<N>, const N: usize>(
                 &paths::vertex(&paths::child(&paths::optimized(), "bananas"), g.ids[k]),
                 step.map_or(Timing::Static, |k| Timing::Step(k as i64)),
                 &pose,
-                OPTIMIZED,
+                BANANA,
                 |x: &G| x.to_se3().translation().to_owned(),
             );
         }
@@ -231,21 +357,24 @@ fn state<G: LieGroup<N>, const N: usize>(
 }
 
 /// The loop closures in the graph at a timeline step, thick between the step's poses
-/// (`world/optimized/closed`; nothing at k = 0).
+/// (`world/optimized/closed`; nothing at k = 0). The last step (the final solution, every
+/// loop closure in) logs none: its thin lines ([`loop_closure_lines`]) leave the trajectory's
+/// colours visible.
 fn closed_so_far<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
-    step: &ClosureStep<G, N>,
+    (step, last): (&ClosureStep<G, N>, bool),
     at: u64,
     radius: f64,
 ) {
     let index_of = |id: u64| g.ids.binary_search(&id).ok();
     let position = |k: usize| v3(&step.poses[k].to_se3().translation().to_owned());
-    let strips: Vec<Vec<Vec3>> = g.loop_closures[..step.closures.min(g.loop_closures.len())]
+    let added = if last { 0 } else { step.closures };
+    let strips: Vec<Vec<Vec3>> = g.loop_closures[..added.min(g.loop_closures.len())]
         .iter()
         .filter_map(|l| Some(vec![position(index_of(l.from)?), position(index_of(l.to)?)]))
         .collect();
-    if !strips.is_empty() {
+    if step.closures > 0 {
         p.push(
             paths::child(&paths::optimized(), "closed"),
             Some(at),
@@ -254,6 +383,11 @@ fn closed_so_far<G: LieGroup<N>, const N: usize>(
                 color: OPTIMIZED,
                 radius: radius * 1.5,
             }),
+        );
+        p.legend(
+            "after, on the step timeline: the loop closures added so far (thick)".to_owned(),
+            OPTIMIZED,
+            Swatch::Line,
         );
     }
 }
@@ -296,6 +430,16 @@ fn relative<G: LieGroup<N>, const N: usize>(
             |x: &G| x.to_se3().translation().to_owned(),
         );
     }
+    if !drawn.is_empty() {
+        p.legend(
+            format!(
+                "relative uncertainty: X_j as X_i sees it, {} (worst loop closures, --joint)",
+                p.confidence()
+            ),
+            RELATIVE,
+            Swatch::Region,
+        );
+    }
 }
 
 /// A covariance with a banana to draw: finite and not all zero (two poses held fixed).
@@ -303,15 +447,16 @@ fn is_drawable<const N: usize>(cov: &TangentMatrix<N>) -> bool {
     cov.iter().all(|v| v.is_finite()) && cov.amax() > 0.0
 }
 
-/// Labels that do not collide: the first and last pose, the loop closures' ends (worst
-/// first), the largest marginal — each only if it is farther than 4 % of the drawing from
-/// every label already placed. `after`: at the optimised poses (with the residual's d),
-/// else at the file's estimates (`world/labels/…`).
+/// At most four labels, by importance: the worst loop closure (the largest residual d after
+/// the optimisation; before it, at the file's estimates), the largest marginal (after only),
+/// the first and the last pose. Labels of one pose, or of poses closer than 4 % of the
+/// drawing, are joined into one ("; "), so no two sit on each other. `after`: at the optimised
+/// poses (`world/optimized/labels/…`), else at the file's estimates (`world/labels/…`). A
+/// figure places each label's box where it overlaps no other (`sink::figure`).
 fn labels<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
-    worst: &[&LoopClosure<N>],
-    bananas: &[usize],
+    largest: Option<usize>,
     after: bool,
 ) {
     let (poses, prefix) = if after {
@@ -323,44 +468,72 @@ fn labels<G: LieGroup<N>, const N: usize>(
         (&g.initial, paths::initial_labels())
     };
     let n = poses.len();
-    let index_of = |id: u64| g.ids.iter().position(|&x| x == id);
+    if n == 0 {
+        return;
+    }
+    let index_of = |id: u64| g.ids.binary_search(&id).ok();
+    let d = |l: &LoopClosure<N>| {
+        if after {
+            l.mahalanobis
+        } else {
+            l.mahalanobis_before
+        }
+    };
+    let worst = g.loop_closures.iter().max_by(|a, b| d(a).total_cmp(&d(b)));
     let mut candidates: Vec<(usize, String)> = Vec::new();
-    if n > 0 {
-        candidates.push((0, format!("v{}", g.ids[0])));
-        candidates.push((n - 1, format!("v{}", g.ids[n - 1])));
+    if let Some(l) = worst
+        && let Some(j) = index_of(l.to)
+    {
+        let what = if after {
+            "worst loop closure"
+        } else {
+            "worst loop closure at the file's estimates"
+        };
+        candidates.push((
+            j,
+            format!("v{} ← v{}: {what}, d = {:.2}", l.to, l.from, d(l)),
+        ));
     }
-    if let (Some(&k), true) = (bananas.first(), after) {
-        candidates.push((k, format!("v{} (largest marginal)", g.ids[k])));
+    if let (Some(k), true) = (largest, after) {
+        let sigma = position_sigma::<G, N>(&g.solution.covariances[k]);
+        candidates.push((
+            k,
+            format!(
+                "v{}: largest marginal, σ {}",
+                g.ids[k],
+                ramp::length_words(sigma)
+            ),
+        ));
     }
-    for l in worst {
-        if let (Some(i), Some(j)) = (index_of(l.from), index_of(l.to)) {
-            let d = if after {
-                l.mahalanobis
-            } else {
-                l.mahalanobis_before
-            };
-            candidates.push((j, format!("v{} ← v{} d={d:.2}", l.to, l.from)));
-            candidates.push((i, format!("v{}", l.from)));
-        }
-    }
-    let min_distance = 0.04 * p.extent.max(1e-9);
-    let mut placed: Vec<nalgebra::Vector3<f64>> = Vec::new();
-    let mut placed_poses = std::collections::BTreeSet::new();
+    candidates.push((0, format!("v{}: first pose", g.ids[0])));
+    candidates.push((n - 1, format!("v{}: last pose", g.ids[n - 1])));
+    let position = |k: usize| poses[k].to_se3().translation().to_owned();
+    let near = 0.04 * p.extent.max(1e-9);
+    let mut placed: Vec<(usize, String)> = Vec::new();
     for (k, text) in candidates {
-        if placed.len() >= MAX_LABELS {
-            break;
+        match placed
+            .iter_mut()
+            .find(|(q, _)| *q == k || (position(*q) - position(k)).norm() < near)
+        {
+            Some((q, words)) => {
+                let pose = format!("v{}", g.ids[k]);
+                let text = if *q == k {
+                    text.trim_start_matches(&format!("{pose}: ")).to_owned()
+                } else {
+                    text
+                };
+                words.push_str("; ");
+                words.push_str(&text);
+            }
+            None => placed.push((k, text)),
         }
-        let at = poses[k].to_se3().translation().to_owned();
-        if placed_poses.contains(&k) || placed.iter().any(|q| (q - at).norm() < min_distance) {
-            continue;
-        }
-        placed.push(at);
-        placed_poses.insert(k);
+    }
+    for (k, text) in placed {
         p.push(
             paths::vertex(&prefix, g.ids[k]),
             None,
             ItemKind::Frame(Frame {
-                translation: v3(&at),
+                translation: v3(&position(k)),
                 rotation: quat(&poses[k]),
                 axis_length: p.axis_length * 0.6,
                 label: Some(text),
@@ -369,7 +542,7 @@ fn labels<G: LieGroup<N>, const N: usize>(
     }
 }
 
-fn quat<G: LieGroup<N>, const N: usize>(x: &G) -> QuatXyzw {
+pub(super) fn quat<G: LieGroup<N>, const N: usize>(x: &G) -> QuatXyzw {
     let q = x.to_se3().rotation().to_quaternion_xyzw();
     [q[0], q[1], q[2], q[3]]
 }

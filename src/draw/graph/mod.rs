@@ -1,7 +1,9 @@
 //! A pose graph's optimisation in words — the findings (outliers, parts, duplicated edges, a
 //! solve that did not converge) and the text panel's paragraph — and in pictures
-//! ([`after`]: the optimised poses, marginals, loop closures and relative uncertainties;
-//! [`sigma`]: each pose's σ before and after the loop closures, against its index).
+//! ([`after`]: the optimised poses, marginals, loop closures and relative uncertainties, in
+//! the σ colours of [`ramp`]; [`zoom`]: the robot-scale views of the largest marginal and the
+//! worst loop closure; [`sigma`]: each pose's σ before and after the loop closures, against
+//! its index).
 
 use std::fmt::Write;
 
@@ -11,11 +13,14 @@ use crate::lie::LieGroup;
 
 mod about;
 mod after;
+mod ramp;
 mod sigma;
+mod zoom;
 
 pub(super) use about::description as file_description;
 pub(super) use after::draw_optimized;
 pub(super) use sigma::sigma_plot;
+pub(super) use zoom::Zoom;
 
 /// The sentence of a graph finding (`None` for any other finding).
 pub(super) fn finding_text(f: &Finding) -> Option<String> {

@@ -154,10 +154,11 @@ pub fn scale_bar(svg: &mut Svg, area: Rect, metres: f64, scale: f64, pen: Pen) {
     let right = area.right() - 1.0 * f;
     let y = area.bottom() - 1.0 * f;
     let left = right - len;
+    let ground = scale_bar_box(area, metres, scale, pen);
     svg.open("class=\"scale-bar\"");
     svg.rect(
-        [left - 0.5 * f, y - 2.0 * f],
-        [len + f, 2.6 * f],
+        [ground.x, ground.y],
+        [ground.w, ground.h],
         "white",
         " fill-opacity=\"0.85\"",
     );
@@ -187,30 +188,54 @@ pub fn scale_bar(svg: &mut Svg, area: Rect, metres: f64, scale: f64, pen: Pen) {
     svg.close();
 }
 
+/// The white ground of the scale bar ([`scale_bar`]) in the panel `area`: what labels keep
+/// clear of.
+pub fn scale_bar_box(area: Rect, metres: f64, scale: f64, pen: Pen) -> Rect {
+    let (len, f) = (metres * scale, pen.font);
+    Rect {
+        x: area.right() - 1.0 * f - len - 0.5 * f,
+        y: area.bottom() - 3.0 * f,
+        w: len + f,
+        h: 2.6 * f,
+    }
+}
+
 /// Draws the legend in `area` (swatch, then the label wrapped to the width), an entry that
-/// reads, looks and is coloured like an earlier one once; returns the height used.
+/// reads, looks and is coloured like an earlier one once; returns the height used. Every
+/// entry is drawn: when they do not all fit, their details (what the run measured, which the
+/// report keeps) are left out and entries that then read alike are drawn once; when they still
+/// do not fit, the legend's text is made smaller until they do (down to half size, below which
+/// the last entries are left out).
 pub fn legend(svg: &mut Svg, area: Rect, entries: &[LegendEntry], pen: Pen) -> f64 {
-    let f = pen.font;
+    let with_details = distinct(entries, true);
+    let without = distinct(entries, false);
+    let mut chosen = (&with_details, pen.font);
+    if legend_height(&with_details, area, pen.font) > area.h {
+        chosen = (&without, pen.font);
+        let mut f = pen.font;
+        while legend_height(&without, area, f) > area.h && f > 0.5 * pen.font {
+            f *= 0.92;
+            chosen.1 = f;
+        }
+    }
+    let (list, f) = chosen;
     let swatch_w = 2.2 * f;
     let text_x = area.x + swatch_w + 0.6 * f;
     let mut y = area.y;
     svg.open("class=\"legend\"");
-    for (k, entry) in entries.iter().enumerate() {
-        let same = |e: &LegendEntry| {
-            e.label == entry.label
-                && e.detail == entry.detail
-                && e.swatch == entry.swatch
-                && e.color == entry.color
-        };
-        if entries[..k].iter().any(same) {
-            continue;
-        }
-        let lines = wrap(&entry.text(), f, area.right() - text_x);
+    for (entry, text) in list {
+        let lines = wrap(text, f, area.right() - text_x);
         let needed = 1.25 * f * lines.len() as f64 + 0.35 * f;
         if y + needed > area.bottom() {
             break;
         }
-        swatch(svg, [area.x, y + 0.15 * f], [swatch_w, 0.9 * f], entry, pen);
+        swatch(
+            svg,
+            [area.x, y + 0.15 * f],
+            [swatch_w, 0.9 * f],
+            entry,
+            Pen { font: f, ..pen },
+        );
         for (i, line) in lines.iter().enumerate() {
             svg.text(
                 [text_x, y + 0.9 * f + 1.25 * f * i as f64],
@@ -224,6 +249,34 @@ pub fn legend(svg: &mut Svg, area: Rect, entries: &[LegendEntry], pen: Pen) -> f
     }
     svg.close();
     y - area.y
+}
+
+/// The entries to draw, each with its words (with or without its detail), those that read,
+/// look and are coloured like an earlier one left out.
+fn distinct(entries: &[LegendEntry], details: bool) -> Vec<(&LegendEntry, String)> {
+    let mut out: Vec<(&LegendEntry, String)> = Vec::new();
+    for entry in entries {
+        let text = if details {
+            entry.text()
+        } else {
+            entry.label.clone()
+        };
+        let same = |(e, t): &(&LegendEntry, String)| {
+            *t == text && e.swatch == entry.swatch && e.color == entry.color
+        };
+        if !out.iter().any(same) {
+            out.push((entry, text));
+        }
+    }
+    out
+}
+
+/// The height the legend's entries take at font size `f` in `area`'s width.
+fn legend_height(list: &[(&LegendEntry, String)], area: Rect, f: f64) -> f64 {
+    let text_x = area.x + 2.2 * f + 0.6 * f;
+    list.iter()
+        .map(|(_, text)| 1.25 * f * wrap(text, f, area.right() - text_x).len() as f64 + 0.35 * f)
+        .sum()
 }
 
 /// One swatch: the same mark as what it names.

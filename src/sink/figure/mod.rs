@@ -47,7 +47,7 @@ pub use world::Plane;
 
 use chart::{Axes, PlotPanel, Rect};
 use layout::PAGE;
-use panel::{cells, panels, title_lines};
+use panel::{cells, fit_line, panels, title_lines};
 use svg::{Anchor, Svg};
 use world::{Mapping, Pen};
 
@@ -169,12 +169,13 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
     let mut out = Svg::new(options.size.0, options.size.1);
     let panels = panels(scene, options.steps);
     // Title and what the figure shows.
+    let line = w - 2.0 * PAGE.title_at[0] * f;
     out.text(
         [PAGE.title_at[0] * f, PAGE.title_at[1] * f],
         PAGE.title_size * f,
         Anchor::Start,
         "#000",
-        &scene.title,
+        &fit_line(&scene.title, PAGE.title_size * f, line),
     );
     let steps = scene.steps();
     let mut about = about_steps(scene, options, &steps);
@@ -208,7 +209,7 @@ pub fn svg(scene: &Scene, options: &FigureOptions) -> String {
         PAGE.about_size * f,
         Anchor::Start,
         "#444",
-        &about.join(" · "),
+        &fit_line(&about.join(" · "), PAGE.about_size * f, line),
     );
     if column > 0.0 {
         let col = Rect {
@@ -447,10 +448,10 @@ fn draw_world(
     world::draw_labels(
         out,
         items,
-        plane,
-        &m,
+        (plane, &m),
         pen,
-        (steps && options.steps == Steps::All, area.right()),
+        (steps && options.steps == Steps::All, area),
+        &[chart::scale_bar_box(area, step, scale, pen)],
     );
     out.close();
     axes.frame(out, pen);

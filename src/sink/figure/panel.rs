@@ -90,10 +90,53 @@ pub(super) fn title_lines(name: &str, size: f64, width: f64) -> Vec<String> {
     lines
 }
 
+/// `text` on one line no wider than `width` at font size `size`: whole when it fits, else a
+/// path in it shortened to its file name ("/a/b/c.g2o" → "…/c.g2o"), then words left off its
+/// end for " …". The figure's title and the line under it never run off the page (the
+/// viewer's text panel has the whole title).
+pub(super) fn fit_line(text: &str, size: f64, width: f64) -> String {
+    let fits = |t: &str| svg::text_width(t, size) <= width;
+    if fits(text) {
+        return text.to_owned();
+    }
+    let short: Vec<String> = text
+        .split(' ')
+        .map(|word| match word.rfind('/') {
+            Some(at) if word[..at].contains('/') => format!("…{}", &word[at..]),
+            _ => word.to_owned(),
+        })
+        .collect();
+    let mut words = short.join(" ");
+    while !fits(&words) {
+        let Some((head, _)) = words.trim_end_matches(" …").rsplit_once(' ') else {
+            break;
+        };
+        words = format!("{head} …");
+    }
+    words
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::View3d;
+
+    #[test]
+    fn a_long_title_is_shortened_to_fit_never_cut() {
+        let title = "Pose graph /work/shared/data/posegraphs/sphere2500.g2o: 2500 SE(3) poses, 2499 odometry edges, 2449 loop closures";
+        assert_eq!(fit_line(title, 10.0, 2000.0), title);
+        let short = fit_line(title, 10.0, 420.0);
+        assert!(
+            short.starts_with("Pose graph …/sphere2500.g2o: 2500 SE(3) poses"),
+            "{short}"
+        );
+        assert!(svg::text_width(&short, 10.0) <= 420.0);
+        let shorter = fit_line(title, 10.0, 250.0);
+        assert!(
+            shorter.ends_with(" …") && svg::text_width(&shorter, 10.0) <= 250.0,
+            "{shorter}"
+        );
+    }
 
     #[test]
     fn views_that_show_nothing_leave_one_empty_panel() {
