@@ -331,6 +331,10 @@ pub trait Family {
     fn case(&self, seed: u64, case: u64) -> (Vec<u8>, String);
     /// Runs and judges one input; `true` when the run was left stuck (the campaign stops).
     fn check(&self, input: &[u8], limits: &Limits) -> (Vec<Finding>, bool);
+    /// This family's cases in the CI smoke run, out of the run's `default` per family.
+    fn smoke_cases(&self, default: u64) -> u64 {
+        default
+    }
 }
 
 pub fn env_u64(k: &str) -> Option<u64> {

@@ -250,6 +250,11 @@ impl Family for LiveWs {
     fn extension(&self) -> &'static str {
         "script"
     }
+    /// A quarter of the others': each case is a whole session over a socket (about half a
+    /// second on 2 cores), not a file read.
+    fn smoke_cases(&self, default: u64) -> u64 {
+        default.div_ceil(4)
+    }
     fn case(&self, seed: u64, case: u64) -> (Vec<u8>, String) {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(case);
