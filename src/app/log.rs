@@ -313,12 +313,7 @@ pub fn report_json(name: &str, run: &LogRun) -> serde_json::Value {
                 "frame_id": t.frame_id,
                 "child_frame_id": t.child_frame_id,
                 "messages": t.count,
-                "stamps": {
-                    "first_s": t.stamp_range.map(|r| stamp_seconds(r.first_ns)),
-                    "last_s": t.stamp_range.map(|r| stamp_seconds(r.last_ns)),
-                    "from_log_time": t.stamps_from_log_time,
-                    "out_of_order": t.stamps_out_of_order,
-                },
+                "stamps": stamps_json(t.stamp_range, t.stamps_from_log_time, t.stamps_out_of_order),
                 "planar": t.group.is_planar(),
                 "position_dof": e.group.position_dims(),
                 "pose_dof": e.group.dof(),
@@ -577,4 +572,19 @@ mod tests {
         );
         assert!(e.starts_with(&expected), "{e}");
     }
+}
+
+/// A topic's `stamps` in `report --json`: first and last stamp (s), and how many messages had
+/// their log time used or came out of order. One shape for pose and sensor topics.
+pub(super) fn stamps_json(
+    range: Option<crate::plan::log::StampRange>,
+    from_log_time: u64,
+    out_of_order: u64,
+) -> serde_json::Value {
+    serde_json::json!({
+        "first_s": range.map(|r| stamp_seconds(r.first_ns)),
+        "last_s": range.map(|r| stamp_seconds(r.last_ns)),
+        "from_log_time": from_log_time,
+        "out_of_order": out_of_order,
+    })
 }

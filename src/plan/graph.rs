@@ -130,6 +130,21 @@ pub struct GraphPrior<G: LieGroup<N>, const N: usize> {
     pub line: usize,
 }
 
+/// A vertex the file holds fixed (g2o's `FIX id`): not optimised, its marginal zero.
+///
+/// ```
+/// use posecov::plan::graph::FixedVertex;
+/// let f = FixedVertex { index: 0, line: 2 };
+/// assert_eq!(f.line, 2);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FixedVertex {
+    /// Index of the vertex.
+    pub index: usize,
+    /// The `FIX` record's line.
+    pub line: usize,
+}
+
 /// A pose graph (see the [module docs](self)).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PoseGraph<G: LieGroup<N>, const N: usize> {
@@ -139,8 +154,8 @@ pub struct PoseGraph<G: LieGroup<N>, const N: usize> {
     pub edges: Vec<GraphEdge<G, N>>,
     /// Priors in file order.
     pub priors: Vec<GraphPrior<G, N>>,
-    /// Vertices (indices) the file holds fixed (g2o's `FIX id`), with the record's line.
-    pub fixed: Vec<(usize, usize)>,
+    /// Vertices the file holds fixed (g2o's `FIX id`).
+    pub fixed: Vec<FixedVertex>,
 }
 
 impl<G: LieGroup<N>, const N: usize> Default for PoseGraph<G, N> {

@@ -3,7 +3,7 @@
 
 use serde_json::{Map, Value, json};
 
-use super::stamp_seconds;
+use super::{stamp_seconds, stamps_json};
 use crate::draw::log::{issue_word, sensor_sentence};
 use crate::eval::log::sensor::SensorEvaluation;
 use crate::plan::log::{
@@ -72,12 +72,7 @@ pub(super) fn sensors_json(plan: &LogSummary, e: &[SensorEvaluation]) -> Value {
                 "kind": t.kind,
                 "frame_id": t.frame_id,
                 "messages": t.count,
-                "stamps": {
-                    "first_s": t.stamp_range.map(|r| stamp_seconds(r.first_ns)),
-                    "last_s": t.stamp_range.map(|r| stamp_seconds(r.last_ns)),
-                    "from_log_time": t.stamps_from_log_time,
-                    "out_of_order": t.stamps_out_of_order,
-                },
+                "stamps": stamps_json(t.stamp_range, t.stamps_from_log_time, t.stamps_out_of_order),
                 "health": health_json(&t.health, None, t),
                 "blocks": blocks,
             })

@@ -95,8 +95,8 @@ pub fn parts<G: LieGroup<N>, const N: usize>(graph: &PoseGraph<G, N>) -> Parts {
         touched[p.vertex] = true;
     }
     let mut fixed = vec![false; n];
-    for &(v, _) in &graph.fixed {
-        fixed[v] = true;
+    for f in &graph.fixed {
+        fixed[f.index] = true;
     }
     let roots: Vec<usize> = (0..n).map(|v| root(&mut parent, v)).collect();
     let mut members: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();

@@ -8,8 +8,8 @@ use nalgebra::SMatrix;
 use super::convention::{
     from_upper_triangle, se3_cov_from_g2o_error_cov, se3_information_from_g2o,
 };
-use super::parse::{Dimension, Kind, Record, Records, information_axes};
-use super::problem::{Edge, Prior, chain_initial_guess, pose_graph};
+use super::parse::{Dimension, IdAt, Kind, Record, Records, information_axes};
+use super::problem::{Edge, Fix, Prior, chain_initial_guess, pose_graph};
 use super::{InputError, Locator};
 use crate::input::{About, DrawChoices, FileSettings, Input};
 use crate::lie::{LieGroup, Se2, Se3, TangentMatrix};
@@ -80,7 +80,7 @@ pub(super) fn lower(locator: &Locator, records: &Records) -> Result<Lowered, Inp
 }
 
 fn label(r: &Record) -> String {
-    let ids: Vec<String> = r.ids.iter().map(|(id, _)| id.to_string()).collect();
+    let ids: Vec<String> = r.ids.iter().map(|i| i.id.to_string()).collect();
     format!("{} {}", r.tag.name, ids.join(" "))
 }
 
@@ -124,11 +124,14 @@ fn build<G: GraphGroup<N>, const N: usize>(
     let mut vertices: BTreeMap<u64, (G, usize)> = BTreeMap::new();
     let mut edges: Vec<Edge<G, N>> = Vec::new();
     let mut priors: Vec<Prior<G, N>> = Vec::new();
-    // (id, offset of the id, line) of every FIX record's ids.
-    let mut fixes: Vec<(u64, usize, usize)> = Vec::new();
+    // Every FIX record's ids.
+    let mut fixes: Vec<Fix> = Vec::new();
     for r in &records.records {
         if r.tag.kind == Kind::Fix {
-            fixes.extend(r.ids.iter().map(|&(id, at)| (id, at, r.line)));
+            fixes.extend(r.ids.iter().map(|&vertex| Fix {
+                vertex,
+                line: r.line,
+            }));
             continue;
         }
         let values: Vec<f64> = r.pose.iter().map(|v| v.value).collect();
@@ -138,7 +141,7 @@ fn build<G: GraphGroup<N>, const N: usize>(
         check_coordinates(locator, r)?;
         match r.tag.kind {
             Kind::Vertex => {
-                let (id, id_at) = r.ids[0];
+                let IdAt { id, at: id_at } = r.ids[0];
                 if let Some((_, first)) = vertices.get(&id) {
                     return Err(locator.error(
                         id_at..id_at,
@@ -149,7 +152,7 @@ fn build<G: GraphGroup<N>, const N: usize>(
                 vertices.insert(id, (pose, r.line));
             }
             Kind::Edge => {
-                let ((from, _), (to, to_at)) = (r.ids[0], r.ids[1]);
+                let (from, IdAt { id: to, at: to_at }) = (r.ids[0].id, r.ids[1]);
                 if from == to {
                     return Err(locator.error(
                         to_at..to_at,
@@ -208,10 +211,10 @@ fn build<G: GraphGroup<N>, const N: usize>(
         .filter(|r| r.tag.kind == Kind::Edge)
         .zip(&edges)
     {
-        for (id, at) in &r.ids {
-            if !vertices.contains_key(id) {
+        for &IdAt { id, at } in &r.ids {
+            if !vertices.contains_key(&id) {
                 return Err(locator.error(
-                    *at..*at,
+                    at..at,
                     &label(r),
                     format!(
                         "vertex {id} is not defined (no VERTEX line has id {id}); edge {} → {} cannot be drawn",
@@ -223,10 +226,17 @@ fn build<G: GraphGroup<N>, const N: usize>(
     }
     let undefined = priors
         .iter()
-        .map(|p| (p.vertex, p.line))
-        .chain(fixes.iter().map(|&(id, at, line)| ((id, at), line)))
-        .find(|((id, _), _)| !vertices.contains_key(id));
-    if let Some(((id, at), line)) = undefined {
+        .map(|p| Fix {
+            vertex: p.vertex,
+            line: p.line,
+        })
+        .chain(fixes.iter().copied())
+        .find(|f| !vertices.contains_key(&f.vertex.id));
+    if let Some(Fix {
+        vertex: IdAt { id, at },
+        line,
+    }) = undefined
+    {
         let tag = records
             .records
             .iter()

@@ -161,6 +161,23 @@ pub struct Value {
     pub at: usize,
 }
 
+/// A vertex id as a record writes it, with the byte offset of its token (where an error about
+/// that vertex points).
+///
+/// ```
+/// use posecov::input::Locator;
+/// use posecov::input::graph::parse::{IdAt, read_records};
+/// let r = read_records(&Locator::new("g.g2o", "VERTEX_SE2 7 0 0 0\n")).unwrap();
+/// assert_eq!(r.records[0].ids, [IdAt { id: 7, at: 11 }]);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IdAt {
+    /// The vertex id.
+    pub id: u64,
+    /// Byte offset of its token.
+    pub at: usize,
+}
+
 /// One record as read: tag, ids and numbers, located.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Record {
@@ -170,8 +187,8 @@ pub struct Record {
     pub line: usize,
     /// Byte offset of the tag.
     pub at: usize,
-    /// The vertex id, or the edge's (from, to) ids, with their offsets.
-    pub ids: Vec<(u64, usize)>,
+    /// The vertex id, or the edge's from and to ids, with their offsets.
+    pub ids: Vec<IdAt>,
     /// The pose or measurement values (3 for SE(2), 7 for SE(3)).
     pub pose: Vec<Value>,
     /// The information matrix's upper triangle, row by row, whatever the file's order (edges
@@ -393,10 +410,10 @@ fn record(
                 format!("{name} = `{token}` is not a vertex id (a whole number ≥ 0)"),
             )
         })?;
-        ids.push((id, token_at));
+        ids.push(IdAt { id, at: token_at });
     }
     let label = {
-        let ids: Vec<String> = ids.iter().map(|(id, _)| id.to_string()).collect();
+        let ids: Vec<String> = ids.iter().map(|i| i.id.to_string()).collect();
         format!("{} {}", tag.name, ids.join(" "))
     };
     let number = |(token, token_at): (&str, usize), name: &str| -> Result<Value, InputError> {
@@ -460,7 +477,7 @@ fn fix_record(
                 format!("id = `{token}` is not a vertex id (a whole number ≥ 0)"),
             )
         })?;
-        ids.push((id, token_at));
+        ids.push(IdAt { id, at: token_at });
     }
     Ok(Record {
         tag: FIX,

@@ -3,8 +3,9 @@
 
 use std::collections::BTreeMap;
 
+use super::parse::IdAt;
 use crate::lie::{LieGroup, TangentMatrix};
-use crate::plan::graph::{GraphEdge, GraphPrior, GraphVertex, PoseGraph};
+use crate::plan::graph::{FixedVertex, GraphEdge, GraphPrior, GraphVertex, PoseGraph};
 
 /// A checked edge.
 pub(super) struct Edge<G: LieGroup<N>, const N: usize> {
@@ -18,10 +19,17 @@ pub(super) struct Edge<G: LieGroup<N>, const N: usize> {
     pub information: TangentMatrix<N>,
 }
 
+/// A vertex a `FIX` record holds fixed, with the record's line.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Fix {
+    pub vertex: IdAt,
+    pub line: usize,
+}
+
 /// A checked prior.
 pub(super) struct Prior<G: LieGroup<N>, const N: usize> {
     /// The vertex id and its offset in the text.
-    pub vertex: (u64, usize),
+    pub vertex: IdAt,
     pub line: usize,
     pub measurement: G,
     /// Λ over [ρ; θ], g2o's reading.
@@ -78,7 +86,7 @@ pub(super) fn pose_graph<G: LieGroup<N>, const N: usize>(
     vertices: &BTreeMap<u64, (G, usize)>,
     edges: &[Edge<G, N>],
     priors: &[Prior<G, N>],
-    fixes: &[(u64, usize, usize)],
+    fixes: &[Fix],
 ) -> PoseGraph<G, N> {
     let index: BTreeMap<u64, usize> = vertices
         .keys()
@@ -103,7 +111,7 @@ pub(super) fn pose_graph<G: LieGroup<N>, const N: usize>(
         priors: priors
             .iter()
             .map(|p| GraphPrior {
-                vertex: index[&p.vertex.0],
+                vertex: index[&p.vertex.id],
                 measurement: p.measurement,
                 information: p.information,
                 line: p.line,
@@ -111,7 +119,10 @@ pub(super) fn pose_graph<G: LieGroup<N>, const N: usize>(
             .collect(),
         fixed: fixes
             .iter()
-            .map(|&(id, _, line)| (index[&id], line))
+            .map(|f| FixedVertex {
+                index: index[&f.vertex.id],
+                line: f.line,
+            })
             .collect(),
     }
 }

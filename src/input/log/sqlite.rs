@@ -18,10 +18,7 @@ use std::path::Path;
 
 use rusqlite::{Connection, OpenFlags};
 
-use super::decode::{ros1_kind, ros2_kind};
-use super::reference::{ros1_reference_type, ros2_reference_type};
 use super::rosbag2::{Compression, parse_metadata};
-use super::sensor::{ros1_sensor, ros2_sensor};
 use super::{Codec, Collector, RECORD_LIMIT, Stream};
 use crate::input::InputError;
 use crate::input::format::SQLITE_MAGIC;
@@ -294,36 +291,8 @@ fn topics(db: &Connection) -> rusqlite::Result<HashMap<i64, (Stream, Codec)>> {
     let mut out = HashMap::new();
     for row in rows {
         let (id, topic, type_name, serialization) = row?;
-        let (kind, reference, sensor, codec) = match serialization.as_str() {
-            "cdr" => (
-                ros2_kind(&type_name).map(Ok),
-                ros2_reference_type(&type_name).map(Ok),
-                ros2_sensor(&type_name).map(Ok),
-                Codec::Cdr,
-            ),
-            "ros1" => (
-                ros1_kind(&type_name, "*"),
-                ros1_reference_type(&type_name, "*"),
-                ros1_sensor(&type_name, "*"),
-                Codec::Ros1,
-            ),
-            other => {
-                let why = format!("{type_name} in {other} serialization; posecov reads cdr");
-                (
-                    ros2_kind(&type_name).map(|_| Err(why.clone())),
-                    ros2_reference_type(&type_name).map(|_| Err(why.clone())),
-                    ros2_sensor(&type_name).map(|_| Err(why)),
-                    Codec::Cdr,
-                )
-            }
-        };
-        let stream = Stream {
-            topic,
-            type_name,
-            kind,
-            reference,
-            sensor,
-        };
+        let why = format!("{type_name} in {serialization} serialization; posecov reads cdr");
+        let (stream, codec) = Stream::of_channel(topic, type_name, &serialization, || why.clone());
         out.insert(id, (stream, codec));
     }
     Ok(out)

@@ -420,9 +420,14 @@ fn draw_world(
         center,
         origin: [area.x + 0.5 * area.w, area.y + 0.5 * area.h],
     };
-    let step = chart::nice_step(area.w.max(area.h) / scale, 8);
     let bl = m.metres([area.x, area.bottom()]);
     let tr = m.metres([area.right(), area.y]);
+    let step = world_step(
+        chart::nice_step(area.w.max(area.h) / scale, 8),
+        scale,
+        [bl[0], tr[0]],
+        pen,
+    );
     let xs: Vec<(f64, f64)> = chart::ticks(bl[0], tr[0], step)
         .into_iter()
         .map(|v| (v, m.px([v, 0.0])[0]))
@@ -456,6 +461,24 @@ fn draw_world(
     out.close();
     axes.frame(out, pen);
     chart::scale_bar(out, area, step, scale, pen);
+    step
+}
+
+/// The world panel's grid step, `step` widened (1, 2, 5 × 10ᵏ up) until the x tick labels over
+/// `x_range` stand apart: each tick at least its widest label plus one font size from the
+/// next (a close-up's many-digit labels, "29.2 29.4 …", would otherwise run together). The
+/// same step serves both axes and the scale bar, so the grid stays square.
+fn world_step(mut step: f64, scale: f64, x_range: [f64; 2], pen: Pen) -> f64 {
+    for _ in 0..12 {
+        let widest = chart::ticks(x_range[0], x_range[1], step)
+            .into_iter()
+            .map(|v| svg::text_width(&chart::tick_label(v, step), pen.font))
+            .fold(0.0, f64::max);
+        if step * scale >= widest + pen.font {
+            break;
+        }
+        step = chart::nice_step(2.0 * step, 1);
+    }
     step
 }
 

@@ -503,9 +503,13 @@ pub struct LabelPlace {
 /// let lines = vec!["v12: first pose".to_owned()];
 /// let first = place_label([100.0, 100.0], &lines, 10.0, area, &[]).unwrap();
 /// assert!(!first.moved);
-/// // The same label at the same pose again: placed elsewhere, not on the first.
+/// // The same label at the same pose again: placed elsewhere, not on the first (still beside
+/// // the pose, so no leader line); with the places near it taken too, farther, with one.
 /// let second = place_label([100.0, 100.0], &lines, 10.0, area, &[first.rect]).unwrap();
-/// assert!(second.moved && !posecov::sink::figure::world::overlaps(&first.rect, &second.rect));
+/// assert!(!second.moved && !posecov::sink::figure::world::overlaps(&first.rect, &second.rect));
+/// let near = [first.rect, second.rect, Rect { x: 20.0, y: 60.0, w: 200.0, h: 80.0 }];
+/// let third = place_label([100.0, 100.0], &lines, 10.0, area, &near).unwrap();
+/// assert!(third.moved && near.iter().all(|r| !posecov::sink::figure::world::overlaps(r, &third.rect)));
 /// ```
 pub fn place_label(
     anchor: Px,
