@@ -525,6 +525,21 @@ pub fn check(run: &LogRun, name: &str, allow: &[Issue]) -> Checked {
     }
 }
 
+/// A topic's `stamps` in `report --json`: first and last stamp (s), and how many messages had
+/// their log time used or came out of order. One shape for pose and sensor topics.
+pub(super) fn stamps_json(
+    range: Option<crate::plan::log::StampRange>,
+    from_log_time: u64,
+    out_of_order: u64,
+) -> serde_json::Value {
+    serde_json::json!({
+        "first_s": range.map(|r| stamp_seconds(r.first_ns)),
+        "last_s": range.map(|r| stamp_seconds(r.last_ns)),
+        "from_log_time": from_log_time,
+        "out_of_order": out_of_order,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -572,19 +587,4 @@ mod tests {
         );
         assert!(e.starts_with(&expected), "{e}");
     }
-}
-
-/// A topic's `stamps` in `report --json`: first and last stamp (s), and how many messages had
-/// their log time used or came out of order. One shape for pose and sensor topics.
-pub(super) fn stamps_json(
-    range: Option<crate::plan::log::StampRange>,
-    from_log_time: u64,
-    out_of_order: u64,
-) -> serde_json::Value {
-    serde_json::json!({
-        "first_s": range.map(|r| stamp_seconds(r.first_ns)),
-        "last_s": range.map(|r| stamp_seconds(r.last_ns)),
-        "from_log_time": from_log_time,
-        "out_of_order": out_of_order,
-    })
 }

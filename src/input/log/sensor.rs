@@ -1,6 +1,6 @@
 //! Covariance-carrying messages that are not poses (`sensor_msgs/Imu`): their type names,
 //! their decoding from ROS 1 and CDR bytes ([`decode_sensor`]) and one topic's streaming state
-//! ([`SensorState`]: stamps, health per 3 × 3 block, σ statistics and a bounded σ series),
+//! (`SensorState`: stamps, health per 3 × 3 block, σ statistics and a bounded σ series),
 //! reduced to a [`SensorTopicSummary`].
 
 use serde::{Deserialize, Serialize};
