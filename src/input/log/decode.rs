@@ -41,9 +41,26 @@ pub struct DecodeError(pub String);
 /// assert_eq!(ros1_kind("sensor_msgs/Imu", "x"), None);
 /// ```
 pub fn ros1_kind(type_name: &str, md5: &str) -> Option<Result<PoseMessageKind, String>> {
-    let (kind, expected) = ROS1_MD5.iter().find(|(k, _)| k.ros1_name() == type_name)?;
-    Some(if md5 == *expected || md5 == "*" {
-        Ok(*kind)
+    by_ros1_definition(
+        ROS1_MD5.iter().map(|&(k, sum)| (k.ros1_name(), sum, k)),
+        type_name,
+        md5,
+    )
+}
+
+/// What a ROS 1 connection of `type_name` whose definition has MD5 sum `md5` is read as, from
+/// `table` (type name, the MD5 sum of the definition posecov reads, what it is read as):
+/// `None` for a type not in it, `Err` naming both sums for another definition of it; `md5`
+/// `*` takes the type by name (an MCAP channel converted from ROS 1 carries no sum). The one
+/// rule for pose, sensor and reference types.
+pub(super) fn by_ros1_definition<K>(
+    mut table: impl Iterator<Item = (&'static str, &'static str, K)>,
+    type_name: &str,
+    md5: &str,
+) -> Option<Result<K, String>> {
+    let (_, expected, kind) = table.find(|(name, ..)| *name == type_name)?;
+    Some(if md5 == expected || md5 == "*" {
+        Ok(kind)
     } else {
         Err(format!(
             "{type_name} with MD5 {md5} (posecov reads definition {expected})"

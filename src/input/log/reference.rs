@@ -72,14 +72,7 @@ pub fn ros1_reference_type(type_name: &str, md5: &str) -> Option<Result<Referenc
     if let Some(kind) = super::decode::ros1_kind(type_name, md5) {
         return Some(kind.map(ReferenceType::Pose));
     }
-    let (_, expected, kind) = ROS1.iter().find(|(name, ..)| *name == type_name)?;
-    Some(if md5 == *expected || md5 == "*" {
-        Ok(*kind)
-    } else {
-        Err(format!(
-            "{type_name} with MD5 {md5} (posecov reads definition {expected})"
-        ))
-    })
+    super::decode::by_ros1_definition(ROS1.iter().copied(), type_name, md5)
 }
 
 /// The reference type of an MCAP channel's schema name (the ROS 1 spelling accepted too).

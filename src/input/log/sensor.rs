@@ -29,14 +29,11 @@ pub const ROS1_MD5: [(SensorKind, &str); 1] =
 /// assert_eq!(ros1_sensor("nav_msgs/Odometry", "*"), None);
 /// ```
 pub fn ros1_sensor(type_name: &str, md5: &str) -> Option<Result<SensorKind, String>> {
-    let (kind, expected) = ROS1_MD5.iter().find(|(k, _)| k.ros1_name() == type_name)?;
-    Some(if md5 == *expected || md5 == "*" {
-        Ok(*kind)
-    } else {
-        Err(format!(
-            "{type_name} with MD5 {md5} (posecov reads definition {expected})"
-        ))
-    })
+    super::decode::by_ros1_definition(
+        ROS1_MD5.iter().map(|&(k, sum)| (k.ros1_name(), sum, k)),
+        type_name,
+        md5,
+    )
 }
 
 /// The sensor kind of a ROS 2 schema name (the ROS 1 spelling is accepted too).
