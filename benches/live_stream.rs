@@ -4,11 +4,13 @@
 //!
 //! 1. **Latency at 100 Hz × 4 topics** (`POSECOV_BENCH_SECONDS`, default 30 s, real time):
 //!    each message's header stamp is the wall clock when the server sends it; per message,
-//!    from leaving the server to (a) being read by the collector (the read's observer) and
-//!    (b) its items reaching the viewer's stream: the first picture of the growing view
-//!    taken after it was read, evaluated, drawn, re-streamed in place (`Restream`) and
-//!    encoded, as the app's growing view does. p50, p95, max; the client's CPU (the process's
-//!    less the server thread's, from /proc) as a share of one core.
+//!    from leaving the server to (a) being read by the collector (the read's observer), (b)
+//!    its own σ points logged to the viewer's stream (a message its series takes in, once a
+//!    picture is shown: `draw::log::message_points`, `sink::log_points`, as the app's live
+//!    view does) and (c) its items in the stream: its points, else the first picture of the
+//!    growing view taken after it was read (evaluated, drawn, re-streamed in place with
+//!    `Restream` and encoded on the read's thread that draws). p50, p95, max; the client's
+//!    CPU (the process's less the server thread's, from /proc) as a share of one core.
 //! 2. **Memory after a simulated minute and a simulated hour** at 100 Hz × 4 topics (the
 //!    server sends as fast as it can, stamps 10 ms apart): the heap the read held at its
 //!    peak and what the summary keeps at the end (a counting allocator), and messages
@@ -21,12 +23,12 @@ use std::net::TcpListener;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
-use posecov::draw::log::{LogDrawSettings, description, draw_log};
+use posecov::draw::log::{LogDrawSettings, description, draw_log, message_points};
 use posecov::eval::log::{LogEvalSettings, evaluate_log};
 use posecov::input::About;
 use posecov::input::log::{LogOptions, read_located_growing, ws::LiveOptions};
 use posecov::plan::log::{EstimateMessage, LogObserver, LogSummary, ReferenceSample};
-use posecov::sink::Restream;
+use posecov::sink::{Restream, log_points};
 use posecov::uncertain::Confidence;
 
 struct Counting;
@@ -177,14 +179,34 @@ fn server(messages: u64, rate_hz: Option<u64>) -> (u16, std::thread::JoinHandle<
     (port, thread)
 }
 
-/// Every message's send stamp and when the collector read it (ns since the epoch).
-#[derive(Default)]
-struct Arrivals(Vec<(u64, u64)>);
+/// The picture shown last: its lines (points left out) and generation, which each message's
+/// points extend until the next (as the app's live view does, `app/session.rs`).
+type Tail = std::sync::Mutex<Option<(posecov::scene::Scene, u64)>>;
 
-impl LogObserver for Arrivals {
+/// Every message's send stamp, when the collector read it and, for a message its series took
+/// in once a picture was shown, when its points were in the stream (ns since the epoch).
+struct Arrivals<'t> {
+    seen: Vec<(u64, u64, Option<u64>)>,
+    rec: &'t rerun::RecordingStream,
+    tail: &'t Tail,
+}
+
+impl LogObserver for Arrivals<'_> {
     fn reference(&mut self, _: &str, _: ReferenceSample) {}
     fn estimate(&mut self, m: &EstimateMessage<'_>) {
-        self.0.push((m.stamp_ns as u64, now_ns()));
+        let read = now_ns();
+        let mut streamed = None;
+        if let Some(point) = &m.series
+            && let Some((lines, generation)) = &*self.tail.lock().expect("tail")
+        {
+            let mut points = message_points(lines, m.topic, point);
+            for line in &mut points {
+                line.generation = Some(*generation);
+            }
+            log_points(self.rec, &points, lines.timeline).expect("points logged");
+            streamed = Some(now_ns());
+        }
+        self.seen.push((m.stamp_ns as u64, read, streamed));
     }
 }
 
@@ -218,6 +240,7 @@ fn latency(seconds: u64) {
         .expect("memory");
     let mut restream = Restream::new();
     let never = std::sync::atomic::AtomicBool::new(false);
+    let tail: Tail = std::sync::Mutex::new(None);
     // Per picture: when its summary was taken, when its items were in the stream.
     let mut pictures: Vec<(u64, u64, f64)> = Vec::new();
     let mut grow = |mut plan: LogSummary| {
@@ -235,12 +258,24 @@ fn latency(seconds: u64) {
         };
         let text = description(&plan, "Live stream", &e, Confidence::DEFAULT);
         let scene = draw_log(&e, &settings, &text);
+        let mut lines = posecov::scene::Scene::new("", "");
+        lines.timeline = scene.timeline;
+        lines.plots = scene.plots.clone();
+        lines.series = scene.series.clone();
+        for line in &mut lines.series {
+            line.points.clear();
+        }
         restream.log(&rec, scene, &never).expect("logged");
         let bytes = storage.drain_as_bytes().expect("encoded").len();
+        *tail.lock().expect("tail") = Some((lines, restream.generations() - 1));
         let done = now_ns();
         pictures.push((taken, done, bytes as f64));
     };
-    let mut arrivals = Arrivals::default();
+    let mut arrivals = Arrivals {
+        seen: Vec::new(),
+        rec: &rec,
+        tail: &tail,
+    };
     let cpu_before = cpu_seconds("/proc/self/stat");
     let wall = Instant::now();
     let plan = read_located_growing(
@@ -255,23 +290,22 @@ fn latency(seconds: u64) {
     let wall = wall.elapsed().as_secs_f64();
     let cpu = cpu_seconds("/proc/self/stat") - cpu_before;
     let server_cpu = server.join().expect("server");
-    let mut read_ms: Vec<f64> = arrivals
-        .0
+    let seen = arrivals.seen;
+    let mut read_ms: Vec<f64> = seen.iter().map(|(s, r, _)| (r - s) as f64 / 1e6).collect();
+    let mut points_ms: Vec<f64> = seen
         .iter()
-        .map(|(s, r)| (r - s) as f64 / 1e6)
+        .filter_map(|(s, _, p)| p.map(|p| (p - s) as f64 / 1e6))
         .collect();
-    let mut shown_ms: Vec<f64> = arrivals
-        .0
+    // Every message: its own points, else the first picture taken after it was read.
+    let mut shown_ms: Vec<f64> = seen
         .iter()
-        .filter_map(|(s, r)| {
-            pictures
-                .iter()
-                .find(|p| p.0 >= *r)
-                .map(|p| (p.1 - s) as f64 / 1e6)
+        .filter_map(|(s, r, p)| {
+            p.or_else(|| pictures.iter().find(|q| q.0 >= *r).map(|q| q.1))
+                .map(|at| (at - s) as f64 / 1e6)
         })
         .collect();
     let mut redraw_ms: Vec<f64> = pictures.iter().map(|p| (p.1 - p.0) as f64 / 1e6).collect();
-    for v in [&mut read_ms, &mut shown_ms, &mut redraw_ms] {
+    for v in [&mut read_ms, &mut points_ms, &mut shown_ms, &mut redraw_ms] {
         v.sort_by(f64::total_cmp);
     }
     let line = |what: &str, v: &[f64]| {
@@ -284,15 +318,20 @@ fn latency(seconds: u64) {
         );
     };
     println!(
-        "\n## latency, {seconds} s at 100 Hz x 4 topics ({} messages read, thinned {})",
+        "\n## latency, {seconds} s at 100 Hz x 4 topics ({} messages read, thinned {}, pictures skipped {})",
         plan.topics.iter().map(|t| t.count).sum::<u64>(),
-        plan.stream.as_ref().map_or(0, |s| s.thinned)
+        plan.stream.as_ref().map_or(0, |s| s.thinned),
+        plan.stream.as_ref().map_or(0, |s| s.pictures_skipped)
     );
     println!(
         "| from leaving the server to | n | p50 ms | p95 ms | max ms |\n|---|---|---|---|---|"
     );
     line("read by the collector", &read_ms);
-    line("its items in the viewer's stream", &shown_ms);
+    line("its own points in the viewer's stream", &points_ms);
+    line(
+        "its items in the viewer's stream (its points, else the next picture)",
+        &shown_ms,
+    );
     line(
         "(one picture: evaluate, draw, re-stream, encode)",
         &redraw_ms,

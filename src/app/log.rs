@@ -11,8 +11,11 @@
 //! ```
 
 mod frames;
+mod growing;
 mod nees;
 mod sensors;
+
+pub(crate) use growing::Growing;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -55,7 +58,7 @@ pub(super) fn run(
     located: &Located,
     settings: &LogSettings,
     options: &RunOptions,
-    mut growing: Option<&mut dyn FnMut(&Scene)>,
+    growing: Option<&dyn Growing>,
 ) -> Result<LogRun, AppError> {
     let (cancel, bar, drawn) = (options.cancel.as_deref(), options.progress, options.draw);
     let file = located.origin();
@@ -77,10 +80,13 @@ pub(super) fn run(
         None => None,
     };
     let mut options = settings.read.clone();
-    options.reference = reference.as_ref().and_then(|r| r.borrow().in_log.clone());
-    // The read hands every message to the observer; the growing view reads its NEES so far.
-    let mut forward = reference.as_ref().map(nees::Forward);
-    let observer = forward.as_mut().map(|f| f as &mut dyn LogObserver);
+    options.reference = reference.as_ref().and_then(nees::in_log);
+    let growing = growing.filter(|_| drawn);
+    // Every message to NEES (the growing view reads its NEES so far) and the growing view.
+    let nees = reference.as_ref().map(nees::Forward);
+    let watched = nees.is_some() || growing.is_some();
+    let mut observed = growing::Observer { nees, growing };
+    let observer = watched.then_some(&mut observed as &mut dyn LogObserver);
     let title = match &located.place {
         Place::Bundled(e) => bundled::find(e.name).map_or(e.name, |l| l.title).to_owned(),
         Place::File(_) | Place::Live(_) => file.clone(),
@@ -94,11 +100,11 @@ pub(super) fn run(
         confidence: settings.confidence,
         axis_length: None,
     };
-    let growing_wanted = drawn && growing.is_some();
     // What the stream has given so far, evaluated and drawn as the end's summary is, with the
-    // NEES of the estimates matched so far; an undrawable one is left out.
+    // NEES of the estimates matched so far; an undrawable one is left out. It runs on the
+    // read's thread that draws (reading never waits for it).
     let mut grow = |mut plan: LogSummary| {
-        if let Some(show) = growing.as_mut() {
+        if let Some(growing) = growing {
             let mut evaluation = evaluate_log(&mut plan, &settings.eval);
             if let Some(reference) = &reference {
                 evaluation = evaluation.with_consistency(nees::so_far(reference, &plan));
@@ -106,15 +112,17 @@ pub(super) fn run(
             let summary = describe(located, &plan, &evaluation, settings.confidence);
             let scene = draw_log(&evaluation, &draw, &summary);
             if scene.validate().is_ok() {
-                show(&scene);
+                growing.picture(&scene);
             }
         }
     };
-    let grow = growing_wanted.then_some(&mut grow as &mut dyn FnMut(LogSummary));
+    let grow = growing
+        .is_some()
+        .then_some(&mut grow as &mut (dyn FnMut(LogSummary) + Send));
     let mut plan = read(located, &options, cancel, bar, observer, grow)?;
     let mut evaluation = evaluate_log(&mut plan, &settings.eval);
     if let Some(reference) = reference {
-        let results = nees::finish(reference.into_inner(), &plan, &file)?;
+        let results = nees::finish(nees::into_prepared(reference), &plan, &file)?;
         evaluation = evaluation.with_consistency(results);
     }
     let summary = describe(located, &plan, &evaluation, settings.confidence);
@@ -190,7 +198,7 @@ fn read(
     cancel: Option<&std::sync::atomic::AtomicBool>,
     shown: bool,
     observer: Option<&mut dyn LogObserver>,
-    grow: Option<&mut dyn FnMut(LogSummary)>,
+    grow: Option<&mut (dyn FnMut(LogSummary) + Send)>,
 ) -> Result<LogSummary, AppError> {
     let file = located.origin();
     let bar = if shown {

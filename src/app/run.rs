@@ -229,8 +229,9 @@ impl Run {
 
     /// [`Run::start`], and for a live stream that is drawn each scene of what has arrived so
     /// far handed to `growing` while it is read (at most once per
-    /// [`growth_interval`](crate::input::log::growth_interval)); the run's own scene is the
-    /// end's.
+    /// [`growth_interval`](crate::input::log::growth_interval), on a thread of the read's
+    /// own), and between those each message's point of its σ series as it arrives; the run's
+    /// own scene is the end's.
     ///
     /// # Errors
     /// As [`Run::start`].
@@ -238,7 +239,7 @@ impl Run {
         opened: Opened,
         overrides: &Overrides,
         options: RunOptions,
-        growing: Option<&mut dyn FnMut(&Scene)>,
+        growing: Option<&dyn log::Growing>,
     ) -> Result<Run, AppError> {
         match opened {
             Opened::Plan(loaded) => {

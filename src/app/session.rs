@@ -4,20 +4,25 @@
 //! streams [`PlanRun::log_blocks`] too). Where its picture goes is [`super::sinks`].
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
+use super::log::Growing;
 use super::run::{Opened, PlanRun, Run, RunOptions, open};
 use super::sinks::{
     EXIT_INTERRUPTED, ViewOptions, choose_sink, finish, flush, render_with, scenario_name, serve,
     watch_file,
 };
 use super::{AppError, Overrides, RobotLog, resolve};
+use crate::draw::log::message_points;
 use crate::input::Place;
+use crate::plan::log::SeriesPoint;
 use crate::scene::Scene;
-use crate::sink::{self, LogOutcome, RecordingIds, Restream, Sink, SinkGuard, open_stream};
+use crate::sink::{
+    self, LogOutcome, RecordingIds, Restream, Sink, SinkError, SinkGuard, log_points, open_stream,
+};
 
 impl Run {
     /// Logs the scene, then the clouds of any later Monte Carlo blocks one block at a time
@@ -154,7 +159,9 @@ pub(crate) fn show(
 /// A live stream shown as it grows: the sink opens with the first scene of what has arrived,
 /// each later one (at most once per [`growth_interval`](crate::input::log::growth_interval))
 /// and at last the run's own scene replace it in place ([`Restream`]: the viewer keeps its
-/// camera, a recording holds one generation per scene). Returns the exit code.
+/// camera, a recording holds one generation per scene); between pictures each message's σ
+/// points extend the lines of the picture shown last as it arrives ([`LiveView`]). Returns
+/// the exit code.
 ///
 /// # Errors
 /// The input's error; the sink's (the first one stops the drawing, the read goes on to its
@@ -165,16 +172,78 @@ fn show_growing(
     cancel: &Arc<AtomicBool>,
 ) -> Result<u8, AppError> {
     let seed = resolve(RobotLog, &options.overrides, None)?.eval.seed;
-    let ids = RecordingIds::for_scenario(&scenario_name(&options.scenario), seed);
-    let sink = choose_sink(options)?;
-    let mut shown: Option<(rerun::RecordingStream, SinkGuard, Restream)> = None;
-    let mut failed: Option<AppError> = None;
-    let never = AtomicBool::new(false);
-    let mut show = |scene: &Scene, cancel: &AtomicBool| -> Result<LogOutcome, AppError> {
-        let (rec, _, restream) = match &mut shown {
+    let view = LiveView {
+        ids: RecordingIds::for_scenario(&scenario_name(&options.scenario), seed),
+        sink: choose_sink(options)?,
+        shown: Mutex::new(None),
+        tail: Mutex::new(None),
+        failed: Mutex::new(None),
+    };
+    let run = Run::start_growing(
+        opened,
+        &options.overrides,
+        RunOptions::shown().cancelled_by(Arc::clone(cancel)),
+        Some(&view),
+    );
+    let LiveView {
+        ids,
+        sink,
+        shown,
+        failed,
+        ..
+    } = view;
+    if let Some(e) = failed.into_inner().unwrap_or_else(PoisonError::into_inner) {
+        return Err(e);
+    }
+    let run = run?;
+    let mut shown = shown.into_inner().unwrap_or_else(PoisonError::into_inner);
+    let outcome = LiveView::show(&sink, &mut shown, &ids, run.scene(), cancel)?;
+    report_interrupted(outcome);
+    let Some((rec, guard, _)) = shown else {
+        unreachable!("the run's scene was shown, so the sink is open");
+    };
+    if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
+        serve(&options.serve, &guard, cancel)?;
+    }
+    finish(guard, rec, &sink, outcome).map(|code| run.exit_code(code))
+}
+
+/// The viewer's side of a growing live view: the pictures (the sink opened at the first,
+/// each re-streamed in place), and the lines of the picture shown last, which each message's
+/// points extend until the next (their paths are that picture's generation's, so the next
+/// picture hides them with its own lines: nothing is drawn twice).
+struct LiveView {
+    ids: RecordingIds,
+    sink: Sink,
+    /// The open sink and its re-streaming state (the thread that draws only).
+    shown: Mutex<Option<(rerun::RecordingStream, SinkGuard, Restream)>>,
+    /// Where the newest messages go: the recording, the generation shown last and its lines.
+    tail: Mutex<Option<Tail>>,
+    /// The first error of the sink: it stops the drawing.
+    failed: Mutex<Option<AppError>>,
+}
+
+/// The picture shown last, as messages extend it.
+struct Tail {
+    rec: rerun::RecordingStream,
+    generation: u64,
+    /// Its plots and lines (their points left out).
+    lines: Scene,
+}
+
+impl LiveView {
+    /// Shows `scene` in place of the one before on the sink, opened with it if not yet.
+    fn show(
+        sink: &Sink,
+        shown: &mut Option<(rerun::RecordingStream, SinkGuard, Restream)>,
+        ids: &RecordingIds,
+        scene: &Scene,
+        cancel: &AtomicBool,
+    ) -> Result<LogOutcome, AppError> {
+        let (rec, _, restream) = match shown {
             Some(open) => open,
             None => {
-                let (rec, guard) = open_stream(&sink, &ids, scene)?;
+                let (rec, guard) = open_stream(sink, ids, scene)?;
                 if let Some(url) = guard.viewer_url() {
                     println!("Web viewer: {url}");
                 }
@@ -184,33 +253,71 @@ fn show_growing(
         let outcome = restream.log(rec, scene.clone(), cancel)?;
         flush(rec)?;
         Ok(outcome)
-    };
-    let mut grown = |scene: &Scene| {
-        if failed.is_none()
-            && let Err(e) = show(scene, &never)
-        {
-            failed = Some(e);
+    }
+
+    /// Keeps the first error; later ones follow from it.
+    fn fail(&self, e: AppError) {
+        let mut failed = self.failed.lock().unwrap_or_else(PoisonError::into_inner);
+        failed.get_or_insert(e);
+    }
+
+    fn failed(&self) -> bool {
+        self.failed
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .is_some()
+    }
+}
+
+impl Growing for LiveView {
+    fn picture(&self, scene: &Scene) {
+        if self.failed() {
+            return;
         }
-    };
-    let run = Run::start_growing(
-        opened,
-        &options.overrides,
-        RunOptions::shown().cancelled_by(Arc::clone(cancel)),
-        Some(&mut grown),
-    );
-    if let Some(e) = failed {
-        return Err(e);
+        let mut shown = self.shown.lock().unwrap_or_else(PoisonError::into_inner);
+        let never = AtomicBool::new(false);
+        match Self::show(&self.sink, &mut shown, &self.ids, scene, &never) {
+            Err(e) => self.fail(e),
+            Ok(_) => {
+                if let Some((rec, _, restream)) = shown.as_ref() {
+                    let mut lines = Scene::new(String::new(), String::new());
+                    lines.timeline = scene.timeline;
+                    lines.plots = scene.plots.clone();
+                    lines.series = scene.series.clone();
+                    for line in &mut lines.series {
+                        line.points = Vec::new();
+                    }
+                    let tail = Tail {
+                        rec: rec.clone(),
+                        generation: restream.generations().saturating_sub(1),
+                        lines,
+                    };
+                    *self.tail.lock().unwrap_or_else(PoisonError::into_inner) = Some(tail);
+                }
+            }
+        }
     }
-    let run = run?;
-    let outcome = show(run.scene(), cancel)?;
-    report_interrupted(outcome);
-    let Some((rec, guard, _)) = shown else {
-        unreachable!("the run's scene was shown, so the sink is open");
-    };
-    if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
-        serve(&options.serve, &guard, cancel)?;
+
+    fn message(&self, topic: &str, point: &SeriesPoint) {
+        let mut tail = self.tail.lock().unwrap_or_else(PoisonError::into_inner);
+        let Some(shown) = tail.as_ref() else {
+            // Before the first picture: that picture will have it.
+            return;
+        };
+        let mut points = message_points(&shown.lines, topic, point);
+        for line in &mut points {
+            line.generation = Some(shown.generation);
+        }
+        match log_points(&shown.rec, &points, shown.lines.timeline) {
+            // A value the viewer cannot hold: left out here, located by the end's picture.
+            Ok(()) | Err(SinkError::Scene(_)) => {}
+            Err(e) => {
+                // Not streamed again: the pictures go on and the error is said at the end.
+                *tail = None;
+                self.fail(e.into());
+            }
+        }
     }
-    finish(guard, rec, &sink, outcome).map(|code| run.exit_code(code))
 }
 
 /// `--watch --save FILE.rrd`: the recording is written whole again on every change of the

@@ -47,6 +47,7 @@ mod text;
 
 pub use frames::frame_problem_sentence;
 pub use nees::verdict_word;
+pub use plots::message_points;
 pub use sensor::sensor_sentence;
 pub use text::{description, issue_sentence, issue_word};
 

@@ -71,7 +71,7 @@ use std::path::PathBuf;
 pub use self::blueprint::send_layout;
 #[cfg(feature = "viewer")]
 pub use self::rerun::{
-    LogOutcome, STEP_TIMELINE, log_part_cancellable, log_scene, log_scene_cancellable,
+    LogOutcome, STEP_TIMELINE, log_part_cancellable, log_points, log_scene, log_scene_cancellable,
 };
 #[cfg(feature = "viewer")]
 pub use self::restream::Restream;

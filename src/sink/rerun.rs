@@ -345,9 +345,54 @@ fn log_series(
             .with_widths([f(series.width)]);
         send(rec, path.as_str(), rr::TimePoint::default(), &[&style])?;
     }
+    log_samples(rec, series, timeline)
+}
+
+/// Points added to lines already logged (their style with them): each series' samples only,
+/// at its path (its generation's). A live view streams a message's points so, between whole
+/// pictures ([`crate::draw::log::message_points`]).
+///
+/// # Errors
+/// [`SinkError::Scene`] for a value beyond `f32` or not finite (nothing is logged then), or
+/// an SDK error.
+///
+/// ```
+/// use posecov::scene::{Color, PlotId, ScalarSeries, Scene, Timeline};
+/// use posecov::sink::{RecordingIds, Sink, log_points, open_stream};
+/// let (rec, guard) = open_stream(&Sink::Memory, &RecordingIds::for_scenario("doc", 0), &Scene::new("t", ""))?;
+/// let point = ScalarSeries::new(PlotId::new("sigma_position"), "odom/x", "σx", Color::rgb(0, 0, 0), 1.5, vec![(5, 1.0)]);
+/// log_points(&rec, &[point.clone()], Timeline::Stamp)?;
+/// let mut bad = point;
+/// bad.points[0].1 = f64::NAN;
+/// assert!(log_points(&rec, &[bad], Timeline::Stamp).is_err());
+/// # guard.finish(rec)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn log_points(
+    rec: &rr::RecordingStream,
+    series: &[ScalarSeries],
+    timeline: scene::Timeline,
+) -> Result<(), SinkError> {
+    let mut part = Scene::new(String::new(), String::new());
+    part.timeline = timeline;
+    part.series = series.to_vec();
+    part.validate()?;
+    for s in series {
+        log_samples(rec, s, timeline)?;
+    }
+    Ok(())
+}
+
+/// A series' samples, one column chunk (its style is logged apart).
+fn log_samples(
+    rec: &rr::RecordingStream,
+    series: &ScalarSeries,
+    timeline: scene::Timeline,
+) -> Result<(), SinkError> {
     if series.points.is_empty() {
         return Ok(());
     }
+    let path = series.path();
     let times = series.points.iter().map(|p| p.0);
     let steps = match timeline {
         scene::Timeline::Step => rr::TimeColumn::new_sequence(STEP_TIMELINE, times),

@@ -99,18 +99,38 @@ pub(super) fn prepare(
 }
 
 /// The observer of a run whose view grows: the read hands it every message (through
-/// [`Forward`]), the growing view reads the NEES so far between messages ([`so_far`]).
-pub(super) type SharedPrepared = std::cell::RefCell<Prepared>;
+/// [`Forward`]), the growing view reads the NEES so far ([`so_far`]) on the thread that
+/// draws, between messages.
+pub(super) type SharedPrepared = std::sync::Mutex<Prepared>;
+
+/// The shared observer, locked (a panic elsewhere leaves it whole: each change is one call).
+fn locked(prepared: &SharedPrepared) -> std::sync::MutexGuard<'_, Prepared> {
+    prepared
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// The prepared reference once the read is over.
+pub(super) fn into_prepared(prepared: SharedPrepared) -> Prepared {
+    prepared
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// Where the reference is read from in the log, if it is.
+pub(super) fn in_log(prepared: &SharedPrepared) -> Option<ReferenceInLog> {
+    locked(prepared).in_log.clone()
+}
 
 /// Hands every message of the read to a shared reference's observer.
 pub(super) struct Forward<'c>(pub(super) &'c SharedPrepared);
 
 impl LogObserver for Forward<'_> {
     fn reference(&mut self, frame_id: &str, sample: ReferenceSample) {
-        self.0.borrow_mut().observer.reference(frame_id, sample);
+        locked(self.0).observer.reference(frame_id, sample);
     }
     fn estimate(&mut self, message: &EstimateMessage<'_>) {
-        self.0.borrow_mut().observer.estimate(message);
+        locked(self.0).observer.estimate(message);
     }
 }
 
@@ -120,7 +140,7 @@ pub(super) fn so_far(
     prepared: &SharedPrepared,
     plan: &LogSummary,
 ) -> BTreeMap<String, TopicConsistency> {
-    prepared.borrow().observer.so_far(&strides(plan))
+    locked(prepared).observer.so_far(&strides(plan))
 }
 
 /// Each topic's drawn stride (the NEES series is kept at the drawn messages).

@@ -35,7 +35,7 @@
 //! // Truth at t = 150 is x = 1.5; the estimate says 1.6 with σx = 0.1: NEES = 1.
 //! nees.estimate(&EstimateMessage { topic: "/ekf", frame_id: "map", index: 0, stamp_ns: 150,
 //!     position: [1.6, 0.0, 0.0], orientation_xyzw: [0.0, 0.0, 0.0, 1.0], covariance: &cov,
-//!     usable: true, unestimated: [false; 6] });
+//!     usable: true, unestimated: [false; 6], series: None });
 //! let topics = nees.finish(&[("/ekf".to_owned(), 1)].into());
 //! let c = &topics["/ekf"];
 //! assert_eq!((c.dof, c.messages), (6, 1));
@@ -212,7 +212,7 @@ impl NeesObserver {
     /// for i in 0..6 { cov[i * 7] = 0.01; }
     /// nees.estimate(&EstimateMessage { topic: "/ekf", frame_id: "map", index: 0, stamp_ns: 150,
     ///     position: [0.1, 0.0, 0.0], orientation_xyzw: q, covariance: &cov,
-    ///     usable: true, unestimated: [false; 6] });
+    ///     usable: true, unestimated: [false; 6], series: None });
     /// let drawn = [("/ekf".to_owned(), 1)].into();
     /// let so_far = nees.so_far(&drawn);
     /// assert_eq!(so_far["/ekf"].messages, 1);

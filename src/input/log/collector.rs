@@ -54,9 +54,9 @@ pub(super) struct Collector<'a, 'o> {
     /// Where a read without an index stopped before the file's end.
     pub(super) cut: Option<LogCut>,
     tf: tf::TfCollector,
-    /// Where the summary so far goes while a live stream is read, when the read began and
-    /// when the next summary is due.
-    growth: Option<Growth<'o>>,
+    /// While a live stream is read and drawn: when the read began and when the next summary
+    /// so far is due.
+    growth: Option<Growth>,
 }
 
 /// Points kept per topic for the trajectory and each series in a summary handed to the
@@ -65,15 +65,14 @@ pub(super) struct Collector<'a, 'o> {
 /// of a growing run, holds at most this many points per line and picture.
 pub const GROWN_SERIES: usize = 1000;
 
-/// A growing read ([`Collector::growing`]): where its summaries go, when it began, when the
-/// next summary is due (`None`: at the first pose message).
-struct Growth<'o> {
-    show: &'o mut dyn FnMut(LogSummary),
+/// A growing read ([`Collector::growing`]): when it began, when the next summary is due
+/// (`None`: at the first pose message).
+struct Growth {
     started: Instant,
     next_due: Option<Instant>,
 }
 
-/// How long after the last summary was shown (the collector's `grow`) the next one is due,
+/// How long after the last summary was handed on (the collector's `grow`) the next one is due,
 /// `elapsed` into the read: every second, and once the read is past 100 s every hundredth of
 /// its age (an hour: every 36 s), so a long run hands on about 100 · (1 + ln(age / 100 s))
 /// summaries, each bounded as the summary is: what drawing them costs does not grow with the
@@ -112,28 +111,28 @@ impl<'a, 'o> Collector<'a, 'o> {
         }
     }
 
-    /// The same collector, handing the summary so far to `show` when [`Self::grow`] finds one
-    /// due.
-    pub(super) fn growing(mut self, show: Option<&'o mut dyn FnMut(LogSummary)>) -> Self {
-        self.growth = show.map(|show| Growth {
-            show,
+    /// The same collector, its summary so far handed on by [`Self::grow`] when `drawn`.
+    pub(super) fn growing(mut self, drawn: bool) -> Self {
+        self.growth = drawn.then(|| Growth {
             started: Instant::now(),
             next_due: None,
         });
         self
     }
 
-    /// Hands the summary read so far (with the stream's `notes` so far) to the `show` of
-    /// [`Self::growing`] when one is due and a pose message has arrived: a copy of the bounded
-    /// state, the collector goes on unchanged. The next is due [`growth_interval`] after this
-    /// one was shown, or four times what showing it took if longer (redraws take at most a
-    /// fifth of the time, whatever the machine).
-    pub(super) fn grow(&mut self, notes: &dyn Fn() -> StreamNotes) {
-        let Some(growth) = &self.growth else {
-            return;
-        };
+    /// The summary read so far (with the stream's `notes` so far) when one is due and a pose
+    /// message has arrived, for a [`Self::growing`] collector: a copy of the bounded state, the
+    /// collector goes on unchanged. The next is due [`growth_interval`] after this one, or four
+    /// times `cost` (what drawing the last one took, on the thread that draws) if longer:
+    /// drawing takes at most a fifth of the time, whatever the machine.
+    pub(super) fn grow(
+        &mut self,
+        notes: &dyn Fn() -> StreamNotes,
+        cost: Duration,
+    ) -> Option<LogSummary> {
+        let growth = self.growth.as_ref()?;
         if growth.next_due.is_some_and(|at| Instant::now() < at) {
-            return;
+            return None;
         }
         let mut plan = assemble(
             self.topics.clone(),
@@ -147,7 +146,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             self.tf.clone().finish(),
         );
         if plan.topics.iter().all(|t| t.count == 0) && plan.sensors.iter().all(|t| t.count == 0) {
-            return;
+            return None;
         }
         // A picture of the run so far: its series thinner than the end's (every one stays in
         // the viewer's recording).
@@ -158,13 +157,10 @@ impl<'a, 'o> Collector<'a, 'o> {
         }
         plan.stream = Some(notes());
         if let Some(growth) = &mut self.growth {
-            let before = Instant::now();
-            (growth.show)(plan);
-            // The reading gets at least four fifths of the time, however long a redraw takes.
-            let cost = before.elapsed();
             growth.next_due =
                 Some(Instant::now() + growth_interval(growth.started.elapsed()).max(4 * cost));
         }
+        Some(plan)
     }
 
     /// Whether `topic` carries the reference asked for (its topic, or `/tf` for `tf:CHILD`).
@@ -457,6 +453,7 @@ impl<'a, 'o> Collector<'a, 'o> {
                     covariance: &m.covariance,
                     usable: a.usable,
                     unestimated: a.unestimated,
+                    series: a.series,
                 });
             }
         });

@@ -59,8 +59,11 @@ pub const RECORD_LIMIT: usize = 1 << 30;
 pub const MAX_CHUNK_RATIO: u64 = 1024;
 
 pub use crate::plan::log::{DEFAULT_MAX_DRAWN, MAX_DRAWN_LIMIT};
-/// Points kept per topic for the trajectory and the time series (density halves beyond).
-pub const MAX_SERIES: usize = 20_000;
+/// Points kept per topic for the trajectory and the time series (density halves beyond):
+/// 2 048 to 4 096 points a line, more than a plot is pixels wide. Small on purpose: a topic at
+/// 100 Hz fills it in 41 s, and from then on what a read keeps is the same whatever its
+/// length (an hour keeps what a minute keeps; `benches/live_stream.rs`).
+pub const MAX_SERIES: usize = 4096;
 
 /// What to read and how much to keep.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -156,7 +159,9 @@ pub fn read_located_observed(
 
 /// [`read_located_observed`], and for a live stream the summary read so far handed to
 /// `grow` as messages arrive, at most once per [`growth_interval`] (a file is read whole:
-/// `grow` is not called). Each is a bounded copy (the drawn set and statistics as the end's
+/// `grow` is not called). `grow` runs on a thread of its own, so that reading never waits for
+/// drawing: a summary that comes while `grow` is still busy with the one before waits in a
+/// one-slot mailbox, where a newer one replaces it (skipped, counted in the stream's notes). Each is a bounded copy (the drawn set and statistics as the end's
 /// summary keeps them, the trajectory and series thinned to [`GROWN_SERIES`] points), `stream`
 /// with the stream's notes so far; what the observer saw is not in it.
 ///
@@ -174,17 +179,16 @@ pub fn read_located_growing(
     progress: &mut dyn FnMut(u64, u64),
     cancel: Option<&AtomicBool>,
     observer: Option<&mut dyn LogObserver>,
-    grow: Option<&mut dyn FnMut(LogSummary)>,
+    grow: Option<&mut (dyn FnMut(LogSummary) + Send)>,
 ) -> Result<LogSummary, InputError> {
     let origin = located.origin();
     let example = match &located.place {
         // A running robot: its topics until a limit, Ctrl-C or the stream's end.
         Place::Live(url) => {
-            // Each hook's borrow shortened to the read's (`&mut dyn` is invariant).
+            // The observer's borrow shortened to the read's (`&mut dyn` is invariant).
             let observer = observer.map(|o| o as &mut dyn LogObserver);
-            let grow = grow.map(|g| g as &mut dyn FnMut(LogSummary));
-            let mut collector = Collector::new(options, cancel, observer).growing(grow);
-            let notes = ws::read(url, options, &mut collector, progress)?;
+            let mut collector = Collector::new(options, cancel, observer).growing(grow.is_some());
+            let notes = ws::read(url, options, &mut collector, grow, progress)?;
             let mut plan = summary(collector, ws::origin(url))?;
             plan.stream = Some(notes);
             return Ok(plan);

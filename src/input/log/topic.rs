@@ -19,6 +19,14 @@ pub(super) struct Added {
     pub(super) index: u64,
     pub(super) usable: bool,
     pub(super) unestimated: [bool; 6],
+    /// Its series point (σ), when the series took it in.
+    pub(super) series: Option<SeriesPoint>,
+}
+
+/// A series point as kept (each axis's variance) made what a summary shows (its σ).
+fn with_sigma(mut p: SeriesPoint) -> SeriesPoint {
+    p.sigma = p.sigma.map(|v| v.map(f64::sqrt));
+    p
 }
 
 /// A topic's stamps, streamed: the one place their findings are made (`stamp_fallback`,
@@ -149,18 +157,18 @@ impl TopicState {
                 },
             );
         }
-        self.series.push(
-            index,
-            SeriesPoint {
-                stamp_ns,
-                sigma: variance,
-                position_trace: h.position_trace,
-            },
-        );
+        let point = SeriesPoint {
+            stamp_ns,
+            sigma: variance,
+            position_trace: h.position_trace,
+        };
+        let in_series = self.series.wants(index);
+        self.series.push(index, point);
         let added = Added {
             index,
             usable,
             unestimated: h.unestimated,
+            series: in_series.then(|| with_sigma(point)),
         };
         observe(&added, &d);
         if self.drawn.wants(index) {
@@ -195,10 +203,12 @@ impl TopicState {
         let stride = self.drawn.stride();
         let mut trajectory = self.trajectory.into_items();
         trajectory.sort_by_key(|p| p.stamp_ns);
-        let mut series = self.series.into_items();
-        for p in &mut series {
-            p.sigma = p.sigma.map(|v| v.map(f64::sqrt));
-        }
+        let mut series: Vec<SeriesPoint> = self
+            .series
+            .into_items()
+            .into_iter()
+            .map(with_sigma)
+            .collect();
         series.sort_by_key(|p| p.stamp_ns);
         let checks = self.checks;
         let sigma_stats = checks.sigma_stats();

@@ -7,7 +7,8 @@
 //! series at the same messages).
 
 /// Keeps items at indices that are multiples of `stride`; when more than `cap` are kept, the
-/// stride doubles and every other one is dropped. Memory stays bounded by `cap`.
+/// stride doubles and every other one is dropped. Memory stays bounded by `cap`: once full it
+/// holds one allocation of `cap + 1` items, the same after any length.
 ///
 /// ```
 /// use posecov::plan::log::Decimator;
@@ -48,6 +49,13 @@ impl<T> Decimator<T> {
     pub fn push(&mut self, index: u64, item: T) {
         if !self.wants(index) {
             return;
+        }
+        if self.items.len() == self.items.capacity() {
+            // Grown by doubling, but to `cap + 1` at most: a decimator that was ever full
+            // holds one allocation of its bound, whatever the length after (flat memory).
+            let wanted = (2 * self.items.len()).clamp(4, self.cap + 1);
+            self.items
+                .reserve_exact(wanted.saturating_sub(self.items.len()).max(1));
         }
         self.items.push((index, item));
         while self.items.len() > self.cap {
@@ -91,6 +99,8 @@ mod tests {
         for i in 0..100_000u64 {
             d.push(i, i);
         }
+        // Full once, its allocation is its bound: the same after a short and a long run.
+        assert_eq!(d.items.capacity(), 201);
         let kept = d.into_items();
         assert!(kept.len() <= 200 && kept.len() > 100, "{}", kept.len());
         let stride = kept[1] - kept[0];

@@ -120,6 +120,11 @@ pub struct EstimateMessage<'a> {
     pub usable: bool,
     /// Per ROS axis: a placeholder (≥ 1e6) or zero variance, "not estimated".
     pub unestimated: [bool; 6],
+    /// Its point of the topic's σ series (σ per axis, the position trace) as a summary's
+    /// [`TopicSummary::series`](super::TopicSummary::series) holds it, when the series takes
+    /// the message in as it arrives (`None`: thinned, the series' density halved already):
+    /// what a live view streams of each message between its whole pictures.
+    pub series: Option<super::SeriesPoint>,
 }
 
 /// Receives, in file order, every reference sample and every estimate message of a log while

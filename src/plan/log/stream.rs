@@ -1,7 +1,7 @@
 //! What a live stream (`ws://…`) did besides carrying messages ([`StreamNotes`]): frames
 //! posecov could not read and skipped (the run went on), messages thinned because they came
-//! faster than posecov read them, and connections lost and made again. Bounded: counts, and
-//! the first few of each in words.
+//! faster than posecov read them, connections lost and made again, and pictures of the
+//! growing view skipped. Bounded: counts, and the first few of each in words.
 
 use serde::Serialize;
 
@@ -16,7 +16,9 @@ pub const MAX_NOTED: usize = 8;
 /// let mut notes = StreamNotes::new("ws://127.0.0.1:8765");
 /// notes.damaged("malformed JSON (EOF while parsing)".into());
 /// notes.lost("closed by the server".into(), 1.5);
+/// notes.pictures_skipped = 2;
 /// let lines = notes.sentences();
+/// assert!(lines[2].contains("skipped 2 picture(s) of the growing view"), "{lines:?}");
 /// assert!(lines[0].starts_with("ws://127.0.0.1:8765: skipped 1 damaged frame(s)"), "{lines:?}");
 /// assert!(lines[1].contains("lost 1 time(s)"), "{lines:?}");
 /// ```
@@ -40,6 +42,16 @@ pub struct StreamNotes {
     /// Why the stream ended for good without a limit asked (`--duration`, `--messages`):
     /// the server went and did not come back.
     pub ended: Option<String>,
+    /// Pictures of the growing view not drawn: a newer summary replaced each while the one
+    /// before was still being drawn (reading never waits for drawing). Absent from the JSON
+    /// when none (a run that is not drawn, `report`, never skips one).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub pictures_skipped: u64,
+}
+
+/// Whether a count is zero (a key left out of the JSON).
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 impl StreamNotes {
@@ -134,6 +146,12 @@ impl StreamNotes {
         }
         if let Some(why) = &self.ended {
             lines.push(format!("{}: the stream ended: {why}", self.url));
+        }
+        if self.pictures_skipped > 0 {
+            lines.push(format!(
+                "{}: skipped {} picture(s) of the growing view, each replaced by a newer one while the one before was drawn (every message was read)",
+                self.url, self.pictures_skipped
+            ));
         }
         lines
     }

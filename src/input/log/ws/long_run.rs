@@ -1,7 +1,7 @@
 //! Long runs stay bounded (issue 31 item 3), proven without a clock: a simulated hour of a
 //! robot at 100 Hz on four topics goes through the queue and the collector exactly as a live
-//! stream's messages do (`take` feeding `Collector::message_on`, the growing view's hook
-//! called as it is due), and what is kept — the drawn messages, series, trajectories, health
+//! stream's messages do (`take` feeding `Collector::message_on`, the summaries due handed to
+//! the growing view's thread through its mailbox), and what is kept — the drawn messages, series, trajectories, health
 //! and every summary handed to the growing view — stays under a bound that does not depend on
 //! the number of messages: after an hour it is what it was after half an hour.
 
@@ -11,9 +11,10 @@ use std::sync::atomic::Ordering;
 use tungstenite::Bytes;
 
 use super::super::{Codec, Collector, GROWN_SERIES, LogOptions, MAX_SERIES, Stream};
+use super::mailbox::Mailbox;
 use super::queue::{self, Arrived};
 use super::session::Shared;
-use super::{LiveOptions, take};
+use super::{LiveOptions, draw, take};
 use crate::plan::log::{DEFAULT_MAX_DRAWN, LogSummary};
 
 const TOPICS: [&str; 4] = ["/odom", "/ekf", "/amcl_pose", "/gnss"];
@@ -84,9 +85,10 @@ fn simulate(seconds: u64) -> (LogSummary, usize, u64) {
         largest_grown = largest_grown.max(kept(&plan));
         grown += 1;
     };
-    let mut collector = Collector::new(&options, None, None).growing(Some(&mut show));
+    let mut collector = Collector::new(&options, None, None).growing(true);
     let shared = Shared::new("ws://127.0.0.1:8765");
     let (sender, taker) = queue::bounded(&shared.queued);
+    let mailbox = Mailbox::new();
     let streams: Vec<Arc<(Stream, Codec)>> = TOPICS
         .iter()
         .map(|topic| {
@@ -129,7 +131,18 @@ fn simulate(seconds: u64) -> (LogSummary, usize, u64) {
             }
             drop(sender);
         });
-        take(taker, &live, &shared, &mut collector, &mut |_, _| {}).expect("read");
+        let drawer = scope.spawn(|| draw(&mailbox, &mut show));
+        let taken = take(
+            taker,
+            &live,
+            &shared,
+            &mut collector,
+            Some(&mailbox),
+            &mut |_, _| {},
+        );
+        mailbox.close(true);
+        drawer.join().expect("the thread that draws ends");
+        taken.expect("read");
     });
     let plan = collector
         .finish(std::path::Path::new("ws://127.0.0.1:8765"))

@@ -10,7 +10,9 @@
 //!   message data; `subscribe`, `unsubscribe`);
 //! - `record.rs`: `--record run.mcap`, every received message written as it arrives;
 //! - `session.rs`: the thread that reads the socket, across its connections;
-//! - `queue.rs`: the bounded hand-off from that thread to the collector.
+//! - `queue.rs`: the bounded hand-off from that thread to the collector;
+//! - `mailbox.rs`: the one-slot hand-off from the collector to the thread that draws the
+//!   growing view (the newest summary wins).
 //!
 //! The read subscribes to the channels posecov reads (the pose-with-covariance topics chosen,
 //! the reference, `/tf` and `/tf_static`), declares every other advertised channel (listed as
@@ -23,8 +25,10 @@
 //! unsubscribes and closes on exit.
 //!
 //! No async runtime: one thread reads frames as they come and hands them to the thread that
-//! collects and draws through a queue of at most [`QUEUE_MESSAGES`] messages and
-//! [`QUEUE_BYTES`] bytes. A server that sends faster than posecov reads and draws fills it;
+//! collects through a queue of at most [`QUEUE_MESSAGES`] messages and [`QUEUE_BYTES`] bytes;
+//! a third draws the growing view, taking the newest summary from a one-slot mailbox, so a
+//! slow redraw costs pictures (skipped, counted), never messages. A server that sends faster
+//! than posecov reads fills the queue;
 //! what arrives then is thinned (recorded by `--record`, not read) and counted
 //! ([`StreamNotes::thinned`], said in the panel and in `report --json`'s `meta.stream`):
 //! nothing queues without bound, and the socket is always read, so the server never holds
@@ -46,12 +50,14 @@ use crate::input::InputError;
 pub mod client;
 #[cfg(test)]
 mod long_run;
+mod mailbox;
 pub mod protocol;
 mod queue;
 mod record;
 mod session;
 
-use crate::plan::log::StreamNotes;
+use crate::plan::log::{LogSummary, StreamNotes};
+use mailbox::Mailbox;
 use queue::{Event, Next};
 pub use queue::{QUEUE_BYTES, QUEUE_MESSAGES};
 use session::{Session, Shared};
@@ -114,12 +120,15 @@ pub const RECONNECT_BACKOFF: [Duration; 4] = [
 /// Reads the stream at `url` into `collector` until a limit of `options.live`, Ctrl-C or the
 /// end of the stream; a lost connection is made again (after [`RECONNECT_BACKOFF`]). A thread
 /// reads the socket (`session.rs`) and hands on through the bounded queue (`queue.rs`); this
-/// one feeds the collector and shows the growing view. Returns what the stream did besides
-/// carrying messages. `progress(done, total)`: messages or ms.
+/// one feeds the collector; when `grow` is given, a third draws the growing view: the
+/// collector hands it the newest summary through a one-slot mailbox (`mailbox.rs`), so that
+/// reading never waits for drawing. Returns what the stream did besides carrying messages.
+/// `progress(done, total)`: messages or ms.
 pub(super) fn read(
     url: &str,
     options: &LogOptions,
     collector: &mut Collector<'_, '_>,
+    grow: Option<&mut (dyn FnMut(LogSummary) + Send)>,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<StreamNotes, InputError> {
     let fail = |reason: String| InputError::Read {
@@ -134,33 +143,81 @@ pub(super) fn read(
     let connection = client::connect(&parsed).map_err(fail)?;
     let shared = Shared::new(url);
     let (sender, taker) = queue::bounded(&shared.queued);
+    let mailbox = Mailbox::new();
     let outcome = std::thread::scope(|scope| {
         let session = Session::new(&parsed, options, &shared, sender, recorder);
         let reader = std::thread::Builder::new()
             .name("posecov-ws".to_owned())
             .spawn_scoped(scope, move || session.serve(connection))
-            .map_err(|e| format!("cannot start the thread that reads the stream ({e})"))?;
-        let taken = take(taker, &options.live, &shared, collector, progress);
+            .map_err(|e| format!("cannot start the thread that reads the stream ({e})"));
+        let drawing = &mailbox;
+        let drawer = grow.map(|grow| {
+            std::thread::Builder::new()
+                .name("posecov-draw".to_owned())
+                .spawn_scoped(scope, move || draw(drawing, grow))
+        });
+        let taken = match (&reader, &drawer) {
+            (Err(e), _) => Err(e.clone()),
+            (_, Some(Err(e))) => Err(format!("cannot start the thread that draws ({e})")),
+            _ => take(
+                taker,
+                &options.live,
+                &shared,
+                collector,
+                Some(&mailbox),
+                progress,
+            ),
+        };
+        // The end (a limit, Ctrl-C, an error): both threads stop, neither waits for the other.
         shared.stop.store(true, Ordering::Release);
-        let served = reader
-            .join()
-            .unwrap_or_else(|_| Err("the thread that reads the stream failed".to_owned()));
-        served.and(taken)
+        mailbox.close(taken.is_ok() && !collector.stop());
+        let served = match reader {
+            Ok(reader) => reader
+                .join()
+                .unwrap_or_else(|_| Err("the thread that reads the stream failed".to_owned())),
+            Err(e) => Err(e),
+        };
+        let drawn = match drawer {
+            Some(Ok(drawer)) => drawer
+                .join()
+                .map_err(|_| "the thread that draws the growing view failed".to_owned()),
+            _ => Ok(()),
+        };
+        served.and(taken).and(drawn)
     });
     outcome.map_err(fail)?;
-    Ok(shared.into_notes())
+    let skipped = mailbox.skipped();
+    let mut notes = shared.into_notes();
+    notes.pictures_skipped = skipped;
+    Ok(notes)
+}
+
+/// The thread that draws: hands each summary `mailbox` gives to `grow` until it is closed,
+/// noting what each took.
+fn draw(mailbox: &Mailbox<LogSummary>, grow: &mut (dyn FnMut(LogSummary) + Send)) {
+    while let Some(plan) = mailbox.take() {
+        let started = Instant::now();
+        grow(plan);
+        mailbox.handled(started.elapsed());
+    }
 }
 
 /// Feeds the collector what the reading thread hands on until it ends (Ctrl-C stops it),
-/// calling `progress` and showing the growing view as it goes.
+/// calling `progress` and putting each summary due in `mailbox` for the thread that draws.
 fn take(
     taker: queue::Taker<'_>,
     live: &LiveOptions,
     shared: &Shared,
     collector: &mut Collector<'_, '_>,
+    mailbox: Option<&Mailbox<LogSummary>>,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<(), String> {
     let mut last_progress = Instant::now();
+    let notes = || {
+        let mut notes = shared.notes();
+        notes.pictures_skipped = mailbox.map_or(0, Mailbox::skipped);
+        notes
+    };
     loop {
         if collector.stop() {
             shared.stop.store(true, Ordering::Release);
@@ -177,7 +234,11 @@ fn take(
             }
             last_progress = Instant::now();
         }
-        collector.grow(&|| shared.notes());
+        if let Some(mailbox) = mailbox
+            && let Some(plan) = collector.grow(&notes, mailbox.cost())
+        {
+            mailbox.put(plan);
+        }
         match taker.next(client::POLL) {
             Next::Event(Event::Declare(stream)) => collector.declare_stream(&stream.0),
             Next::Event(Event::Message(m)) => collector.message_on(
