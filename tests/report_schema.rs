@@ -313,7 +313,7 @@ fn a_log_report_has_sigma_per_axis_in_si_units_and_clean_stamps() {
     for axis in ["z", "roll", "pitch"] {
         assert!(odom["sigma"].get(axis).is_none(), "{axis}");
     }
-    // The position trace as plotted: x + y variances, every message (3060 < 20 000 kept).
+    // The position trace as plotted: x + y variances, every message (3060 < 4 096 kept).
     let trace = &odom["position_trace"];
     assert_eq!(trace["stamps_s"].as_array().unwrap().len(), 3060);
     assert!(
