@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::run::{Run, RunOptions, open};
+use super::run::{Run, RunOptions, open, with_spinner};
 use super::{AppError, Overrides};
 use crate::eval::graph::StepMarginals;
 use crate::scene::Scene;
@@ -63,7 +63,10 @@ pub fn figure(
         ..RunOptions::shown()
     };
     let scene = scene_with(name_or_path, overrides, run)?;
-    Ok(figure::write(&scene, options, out)?)
+    let what = format!("writing {}", out.display());
+    Ok(with_spinner(&what, |_, _| {
+        figure::write(&scene, options, out)
+    })?)
 }
 
 /// Writes `NAME.png` for every bundled example into `dir` (created if missing), with the

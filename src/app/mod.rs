@@ -305,21 +305,31 @@ pub fn pipeline(
         cancel,
         ..run::RunOptions::shown()
     };
-    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, &options, None)?;
+    let (_, evaluation, scene) = evaluate_and_draw(loaded, overrides, &options, Hooks::default())?;
     Ok((evaluation, scene))
 }
 
+/// Where an evaluation reports its progress: a pose graph's solves, and the Monte Carlo's
+/// steps (none by default).
+#[derive(Default)]
+struct Hooks {
+    graph: Option<crate::eval::graph::ProgressHook>,
+    monte_carlo: Option<crate::eval::StepProgress>,
+}
+
 /// Resolves, evaluates, draws and validates: the one plan path ([`pipeline`],
-/// [`run::Run::start`]) with `options`' cancel, graph step marginals and drawing; undrawn
-/// when [`run::RunOptions::draw`] is false (the scene keeps the title and description).
+/// [`run::Run::start`]) with `options`' cancel, graph step marginals and drawing, reporting
+/// to `hooks`; undrawn when [`run::RunOptions::draw`] is false (the scene keeps the title and
+/// description).
 fn evaluate_and_draw(
     loaded: &Loaded,
     overrides: &Overrides,
     options: &run::RunOptions,
-    progress: Option<crate::eval::graph::ProgressHook>,
+    hooks: Hooks,
 ) -> Result<(Settings, AnyEvaluation, Scene), AppError> {
     let mut settings = resolve(&loaded.input, overrides, options.cancel.clone())?;
-    settings.eval.graph_progress = progress;
+    settings.eval.graph_progress = hooks.graph;
+    settings.eval.monte_carlo_progress = hooks.monte_carlo;
     settings.eval.graph.step_marginals = options.step_marginals;
     let evaluation = evaluate(loaded, &settings.eval)?;
     if !options.draw {

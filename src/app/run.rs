@@ -17,11 +17,12 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 
 use super::log::{self, LogRun};
 use super::{AppError, Loaded, Overrides, RobotLog, Settings, resolve};
 use crate::draw;
+use crate::eval::StepProgress;
 use crate::eval::graph::{Iteration, ProgressHook, Stage, StepMarginals};
 use crate::eval::{self, AnyEvaluation};
 use crate::input::{self, InputKind, Located};
@@ -150,20 +151,20 @@ impl PlanRun {
             cancel,
             ..RunOptions::shown()
         };
-        Self::run(loaded, overrides, &options, None)
+        Self::run(loaded, overrides, &options, super::Hooks::default())
     }
 
-    /// Resolves and evaluates a loaded plan, a pose graph's solves reporting their steps to
-    /// `progress`, and draws it when [`RunOptions::draw`] (else the scene holds the title and
-    /// description).
+    /// Resolves and evaluates a loaded plan, a pose graph's solves and the Monte Carlo
+    /// reporting their steps to `hooks`, and draws it when [`RunOptions::draw`] (else the scene
+    /// holds the title and description).
     fn run(
         loaded: Loaded,
         overrides: &Overrides,
         options: &RunOptions,
-        progress: Option<ProgressHook>,
+        hooks: super::Hooks,
     ) -> Result<Self, AppError> {
         let (settings, evaluation, scene) =
-            super::evaluate_and_draw(&loaded, overrides, options, progress)?;
+            super::evaluate_and_draw(&loaded, overrides, options, hooks)?;
         Ok(Self {
             loaded,
             settings,
@@ -244,12 +245,15 @@ impl Run {
         match opened {
             Opened::Plan(loaded) => {
                 let what = format!("evaluating {}", loaded.input.about.title);
-                let work = |spinner: Option<&ProgressBar>| {
-                    let hook = spinner.map(|s| graph_progress(s.clone(), what.clone()));
-                    PlanRun::run(*loaded, overrides, &options, hook)
+                let work = |bars: Option<(&ProgressBar, &MultiProgress)>| {
+                    let hooks = super::Hooks {
+                        graph: bars.map(|(s, _)| graph_progress(s.clone(), what.clone())),
+                        monte_carlo: bars.map(|(_, m)| monte_carlo_progress(m.clone())),
+                    };
+                    PlanRun::run(*loaded, overrides, &options, hooks)
                 };
                 let run = if options.progress {
-                    with_spinner(&what, |spinner| work(Some(spinner)))
+                    with_spinner(&what, |spinner, multi| work(Some((spinner, multi))))
                 } else {
                     work(None)
                 };
@@ -339,10 +343,34 @@ fn graph_progress(spinner: ProgressBar, what: String) -> ProgressHook {
     }))
 }
 
-/// Runs `work`, showing a spinner on a terminal when it takes more than 0.3 s; `work` may
-/// change its message.
-fn with_spinner<T>(message: &str, work: impl FnOnce(&ProgressBar) -> T) -> T {
-    let spinner = ProgressBar::new_spinner().with_message(message.to_owned());
+/// The Monte Carlo's steps on a bar of their own under the spinner (added at its first report,
+/// cleared with the spinner): "Monte Carlo, 2000 samples [####    ] 800/1727 steps".
+fn monte_carlo_progress(multi: MultiProgress) -> StepProgress {
+    let bar = std::sync::OnceLock::<ProgressBar>::new();
+    StepProgress(Arc::new(move |k, of, samples| {
+        let bar = bar.get_or_init(|| {
+            let bar = ProgressBar::new(of as u64)
+                .with_message(format!("Monte Carlo, {samples} samples"))
+                .with_style(
+                    ProgressStyle::with_template("  {msg} [{bar:24}] {pos}/{len} steps")
+                        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+                );
+            multi.add(bar)
+        });
+        bar.set_length(of as u64);
+        bar.set_position(k as u64);
+    }))
+}
+
+/// Runs `work`, showing a spinner on a terminal (stderr; nothing when it is not one) when it
+/// takes more than 0.3 s; `work` may change its message and add bars under it to the
+/// [`MultiProgress`] it is given.
+pub(crate) fn with_spinner<T>(
+    message: &str,
+    work: impl FnOnce(&ProgressBar, &MultiProgress) -> T,
+) -> T {
+    let multi = MultiProgress::new();
+    let spinner = multi.add(ProgressBar::new_spinner().with_message(message.to_owned()));
     spinner.set_style(
         ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
             .unwrap_or_else(|_| ProgressStyle::default_spinner()),
@@ -359,11 +387,12 @@ fn with_spinner<T>(message: &str, work: impl FnOnce(&ProgressBar) -> T) -> T {
                 std::thread::park_timeout(Duration::from_millis(80));
             }
         });
-        let result = work(&spinner);
+        let result = work(&spinner, &multi);
         done.store(true, Ordering::Release);
         ticker.thread().unpark();
         result
     });
     spinner.finish_and_clear();
+    let _ = multi.clear();
     result
 }

@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::log::Growing;
-use super::run::{Opened, PlanRun, Run, RunOptions, open};
+use super::run::{Opened, PlanRun, Run, RunOptions, open, with_spinner};
 use super::sinks::{
     EXIT_INTERRUPTED, ViewOptions, choose_sink, finish, flush, render_with, scenario_name, serve,
     watch_file,
@@ -149,7 +149,8 @@ pub(crate) fn show(
     if let Some(url) = guard.viewer_url() {
         println!("Web viewer: {url}");
     }
-    let outcome = run.log(&rec, cancel)?;
+    // Logging and encoding a large scene (a pose graph's) takes seconds: a spinner says so.
+    let outcome = with_spinner("logging the recording", |_, _| run.log(&rec, cancel))?;
     if guard.viewer_url().is_some() && outcome == LogOutcome::Complete {
         serve(&options.serve, &guard, cancel)?;
     }

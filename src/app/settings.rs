@@ -453,6 +453,7 @@ fn plan_settings(
                 step_marginals: Default::default(),
             },
             graph_progress: None,
+            monte_carlo_progress: None,
         },
         draw: DrawSettings {
             about: input.about.clone(),

@@ -49,7 +49,9 @@
 //!   `graph/ramp.rs`, the close-ups of the largest marginal and the worst loop closure in
 //!   `graph/zoom.rs`; the σ before and after against pose index in `graph/sigma.rs`), the 3-D
 //!   views —
-//!   layout, hidden entities, each view's camera fitted to what it draws (`views.rs`);
+//!   layout, hidden entities, each view's camera fitted to what it draws (`views.rs`); the
+//!   viewer's labels fitted to the views they open in, a label that would cover a more
+//!   important one left out of the viewer and said in the text panel (`tags.rs`);
 //! - `log.rs` (`draw_log`: a robot log's scene on the `stamp` timeline and its views: one whole-log
 //!   view per `frame_id`, never overlaid, and per topic a view at the robot's scale whose camera is
 //!   fitted to its last message) with `log/message.rs` (one drawn message wherever it is placed —
@@ -89,6 +91,7 @@ use node::{draw_node, draw_particles};
 use painter::{Painter, at_step, detailed};
 mod plots;
 mod shapes;
+mod tags;
 mod text;
 mod views;
 mod words;
@@ -383,11 +386,12 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
         layout: p.layout,
         camera: choices.camera,
     };
-    p.scene.views = if e.graph.is_some() {
-        views::before_after(&p.scene, &plan, &paths::optimized(), &zooms)
+    if e.graph.is_some() {
+        p.scene.views = views::before_after(&p.scene, &plan, &paths::optimized(), &zooms);
+        tags::fit_tags(&mut p.scene, views::FOV_Y);
     } else {
-        views::views(&p.scene, &plan)
-    };
+        p.scene.views = views::views(&p.scene, &plan);
+    }
     if let Some(note) = views::note(&p.scene.views) {
         p.scene.description_markdown.push_str(&note);
     }

@@ -81,6 +81,7 @@ fn nominal_frame<G: LieGroup<N>, const N: usize>(p: &mut Painter, node: &Node<G,
             rotation: pose3.rotation().to_quaternion_xyzw(),
             axis_length: p.axis_length,
             label: labels.then(|| node.name.clone()),
+            tag: None,
         }),
     );
 }

@@ -26,7 +26,7 @@ use crate::scene::{Camera, ItemKind, Scene, SceneItem, Vec3, View3d, rotate};
 use crate::uncertain::Method;
 
 /// Rerun's default vertical field of view of a 3-D view (55°).
-const FOV_Y: f64 = 55.0 * std::f64::consts::PI / 180.0;
+pub(super) const FOV_Y: f64 = 55.0 * std::f64::consts::PI / 180.0;
 /// Room left around what is drawn.
 const MARGIN: f64 = 1.2;
 /// Tilt of the top view off the vertical, so that orbiting still turns about z.

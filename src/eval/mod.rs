@@ -149,6 +149,30 @@ pub struct EvalSettings {
     pub graph: graph::GraphSettings,
     /// Where a pose graph's solves report their steps (a progress bar), if anywhere.
     pub graph_progress: Option<graph::ProgressHook>,
+    /// Where a Monte Carlo propagation reports the steps its particles have taken (a progress
+    /// bar), if anywhere.
+    pub monte_carlo_progress: Option<StepProgress>,
+}
+
+/// What a Monte Carlo propagation calls each time its particles reach one of the steps its
+/// statistics are taken at: with (k, n), step k of the propagation's n, and the samples.
+///
+/// ```
+/// use std::sync::{Arc, Mutex};
+/// use posecov::eval::StepProgress;
+/// let seen = Arc::new(Mutex::new(Vec::new()));
+/// let into = seen.clone();
+/// let hook = StepProgress(Arc::new(move |k, n, _samples| into.lock().unwrap().push((k, n))));
+/// (hook.0)(3, 10, 2000);
+/// assert_eq!(*seen.lock().unwrap(), [(3, 10)]);
+/// ```
+#[derive(Clone)]
+pub struct StepProgress(pub Arc<dyn Fn(usize, usize, usize) + Send + Sync>);
+
+impl std::fmt::Debug for StepProgress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("StepProgress")
+    }
 }
 
 impl Default for EvalSettings {
@@ -164,6 +188,7 @@ impl Default for EvalSettings {
             cancel: None,
             graph: Default::default(),
             graph_progress: None,
+            monte_carlo_progress: None,
         }
     }
 }

@@ -135,6 +135,11 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
                     }
                 });
             }
+            if let (Some(particles), Some(hook)) =
+                (current.as_ref(), &self.settings.monte_carlo_progress)
+            {
+                (hook.0)(next, controls.len(), particles.len());
+            }
             for k in (done + 1..next).filter(|&k| recorded(k)) {
                 self.push_step(&name, k as u64, last, step_estimates(k), None)?;
             }

@@ -6,8 +6,9 @@
 //!
 //! Sizes are in UI points (one point per pixel at 1024 × 640). The window's top bar and the
 //! collapsed time panel leave [`DESIGN_HEIGHT`]; the left column (three fifths) holds the 3-D
-//! views over the legend view ([`legend_share`]), the right one the text panel over the
-//! plots.
+//! views over the legend view of tiles ([`legend_share`]) when it takes little of the column,
+//! the right one the text panel over the plots (and between them a legend too large for tiles,
+//! as a list in words: [`LegendPane`]).
 //!
 //! ```
 //! use posecov::scene::{Scene, layout::{DESIGN_WIDTH, views_aspect}};
@@ -52,32 +53,101 @@ const ROW_GAP: f64 = 8.0;
 /// Space between tiles, and the words' inner padding.
 const PAD: f64 = 8.0;
 
-/// The most of the left column the legend view takes: the 3-D views keep the rest.
-pub const LEGEND_MOST: f64 = 0.6;
+/// The most of the left column a legend of tiles takes, shared by the rows of 3-D views (a
+/// 2 × 2 grid leaves it half of this): a larger legend is a list in words ([`LegendPane::Text`]).
+pub const LEGEND_MOST: f64 = 0.45;
 
 /// The legend view's height in the left column, tab included, for tiles `height` high
-/// ([`Tiles::height`]); 0 without tiles. At most [`LEGEND_MOST`] of the column, so the 3-D
-/// views keep the rest; tiles taller than that are scaled down to fit and their words
-/// (which keep their size) can overlap, which no bundled scenario's legend needs.
+/// ([`Tiles::height`]); 0 without tiles. The tiles are laid out only when this is at most
+/// their share of the column ([`legend_pane`]), so they are never scaled down.
 ///
 /// ```
-/// use posecov::scene::layout::{DESIGN_HEIGHT, LEGEND_MOST, legend_share};
+/// use posecov::scene::layout::legend_share;
 /// assert_eq!(legend_share(0.0), 0.0);
 /// assert_eq!(legend_share(100.0), 130.0);
-/// assert_eq!(legend_share(1000.0), LEGEND_MOST * DESIGN_HEIGHT);
 /// ```
 pub fn legend_share(height: f64) -> f64 {
     if height <= 0.0 {
         0.0
     } else {
-        (height + VIEW_CHROME).min(LEGEND_MOST * DESIGN_HEIGHT)
+        height + VIEW_CHROME
     }
 }
 
-/// Whether the layout has a legend view: a scene with a legend whose plots are not laid out
-/// under its views (a robot log's views and plots fill the window).
+/// How the viewer shows a scene's legend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LegendPane {
+    /// None: no legend, or a robot log's layout (its views and plots fill the window).
+    None,
+    /// Tiles (a bar in each entry's colour and mark over its words, [`tiles`]) in a 2-D view
+    /// under the 3-D views, as tall as they need.
+    Tiles,
+    /// A list in words ([`legend_markdown`]: each entry's colour and mark named) in a text
+    /// view of the right column, between the text panel and the plots: the tiles would take
+    /// more than [`LEGEND_MOST`] of the column (a pose graph's sixteen entries under four
+    /// views), so the 3-D views keep the whole left column.
+    Text,
+}
+
+/// The legend pane of `scene` with `views` 3-D views ([`LegendPane`]).
+///
+/// ```
+/// use posecov::scene::{Color, LegendEntry, Scene, Swatch};
+/// use posecov::scene::layout::{LegendPane, legend_pane};
+/// let mut scene = Scene::new("t", "d");
+/// assert_eq!(legend_pane(&scene, 1), LegendPane::None);
+/// let entry = |k: usize| LegendEntry { label: format!("what colour {k} marks, in a few words"),
+///     detail: String::new(), color: Color::rgb(0, 114, 178), swatch: Swatch::Line };
+/// scene.legend = (0..3).map(entry).collect();
+/// assert_eq!(legend_pane(&scene, 1), LegendPane::Tiles);
+/// scene.legend = (0..16).map(entry).collect();
+/// assert_eq!(legend_pane(&scene, 4), LegendPane::Text);
+/// ```
+pub fn legend_pane(scene: &Scene, views: usize) -> LegendPane {
+    if scene.plots_below || scene.legend.is_empty() {
+        return LegendPane::None;
+    }
+    let rows = views.max(1).div_ceil(grid_columns(views));
+    if legend_share(tiles(&scene.legend).height) <= LEGEND_MOST * DESIGN_HEIGHT / rows as f64 {
+        LegendPane::Tiles
+    } else {
+        LegendPane::Text
+    }
+}
+
+/// The legend as a Markdown list for the viewer's text view ([`LegendPane::Text`]): per
+/// distinct entry (grouped as [`tiles`] groups them), its colour in bold, its mark and its
+/// words ("- **sky blue** region: first order: Exp-mapped 95 % region").
+///
+/// ```
+/// use posecov::scene::{Color, LegendEntry, Swatch, layout::legend_markdown};
+/// let e = LegendEntry { label: "nominal path".into(), detail: String::new(),
+///     color: Color::rgb(0, 114, 178), swatch: Swatch::Line };
+/// assert_eq!(legend_markdown(&[e]), "- **blue** line: nominal path\n");
+/// ```
+pub fn legend_markdown(entries: &[LegendEntry]) -> String {
+    grouped(entries)
+        .into_iter()
+        .map(|(e, label)| {
+            let mark = match e.swatch {
+                Swatch::Region => "region",
+                Swatch::Line => "line",
+                Swatch::Dashed => "dashed line",
+                Swatch::Dots => "dots",
+                Swatch::Axes => "axes",
+            };
+            match (e.swatch, color_name(e.color)) {
+                (Swatch::Axes, _) | (_, None) => format!("- {mark}: {label}\n"),
+                (_, Some(name)) => format!("- **{name}** {mark}: {label}\n"),
+            }
+        })
+        .collect()
+}
+
+/// Whether the layout has a legend view of tiles under the 3-D views ([`LegendPane::Tiles`]
+/// with the scene's views, one when it has none).
 pub fn has_legend_view(scene: &Scene) -> bool {
-    !scene.plots_below && !scene.legend.is_empty()
+    legend_pane(scene, scene.views.len()) == LegendPane::Tiles
 }
 
 /// The most plots side by side in one row under a log's views ([`Scene::plots_below`]).
@@ -99,8 +169,8 @@ pub fn views_over_plots(rows: usize) -> Vec<f32> {
 }
 
 /// Width over height of each of `count` 3-D views of `scene` (a grid of them,
-/// [`grid_columns`]) at 1024 × 640: above its legend view, if it has one
-/// ([`has_legend_view`]), or, for a log ([`Scene::plots_below`]), above its rows of plots
+/// [`grid_columns`]) at 1024 × 640: above its legend of tiles, if it has one
+/// ([`legend_pane`]), or, for a log ([`Scene::plots_below`]), above its rows of plots
 /// ([`views_over_plots`]).
 pub fn views_aspect(scene: &Scene, count: usize) -> f64 {
     let columns = grid_columns(count);
@@ -108,7 +178,7 @@ pub fn views_aspect(scene: &Scene, count: usize) -> f64 {
     let height = if scene.plots_below && !scene.plots.is_empty() {
         let shares = views_over_plots(scene.plots.len().div_ceil(PLOTS_PER_ROW));
         DESIGN_HEIGHT * f64::from(shares[0]) / f64::from(shares.iter().sum::<f32>())
-    } else if has_legend_view(scene) {
+    } else if legend_pane(scene, count) == LegendPane::Tiles {
         DESIGN_HEIGHT - legend_share(tiles(&scene.legend).height)
     } else {
         DESIGN_HEIGHT
@@ -164,6 +234,17 @@ fn lines(text: &str, width: f64) -> usize {
     wrap(text, LABEL_SIZE * VIEWER_WIDER, width - 2.0 * PAD)
         .len()
         .max(1)
+}
+
+/// How wide the viewer writes `text` as a label, in points: [`text_width`] at its 13-point
+/// size, widened for its font (measured in a screenshot).
+///
+/// ```
+/// use posecov::scene::layout::{text_width, viewer_text_width};
+/// assert!(viewer_text_width("v12 first") > text_width("v12 first", 13.0));
+/// ```
+pub fn viewer_text_width(text: &str) -> f64 {
+    text_width(text, LABEL_SIZE) * VIEWER_WIDER
 }
 
 /// Advance widths of the printable ASCII characters, `' '` to `'~'`, in Liberation Sans (the
@@ -238,8 +319,8 @@ pub fn wrap(text: &str, size: f64, width: f64) -> Vec<String> {
     lines
 }
 
-/// The entries as tiles' words: an entry whose words, mark and colour equal an earlier one's
-/// is left out (entries that differ only in their detail, the share of samples held by each
+/// The entries' labels as the viewer's legend shows them: an entry whose words, mark and
+/// colour equal an earlier one's is left out (entries that differ only in their detail, the share of samples held by each
 /// of two outputs, read the same here), and entries that differ only in the method before
 /// their label's first ": " share one tile naming the methods (each view's title names the
 /// method it draws). Axes entries, whose labels name what carries the axes, are never joined.
@@ -283,8 +364,7 @@ fn grouped(entries: &[LegendEntry]) -> Vec<(&LegendEntry, String)> {
             } else {
                 format!("{}: {rest}", methods.join(", "))
             };
-            let joined = LegendEntry { label, ..e.clone() };
-            (e, tile_words(&joined))
+            (e, label)
         })
         .collect()
 }
@@ -307,7 +387,13 @@ fn grouped(entries: &[LegendEntry]) -> Vec<(&LegendEntry, String)> {
 /// assert_eq!(tiles(&[]).height, 0.0);
 /// ```
 pub fn tiles(entries: &[LegendEntry]) -> Tiles<'_> {
-    let grouped = grouped(entries);
+    let grouped: Vec<(&LegendEntry, String)> = grouped(entries)
+        .into_iter()
+        .map(|(e, label)| {
+            let joined = LegendEntry { label, ..e.clone() };
+            (e, tile_words(&joined))
+        })
+        .collect();
     let lay = |columns: usize| {
         let width = DESIGN_WIDTH / columns as f64;
         let mut tiles = Vec::new();

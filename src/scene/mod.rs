@@ -189,8 +189,33 @@ pub struct Frame {
     pub rotation: QuatXyzw,
     /// Length of each axis, metres.
     pub axis_length: f64,
-    /// Text drawn at the origin (e.g. `"T_MC"`), if any.
+    /// Text drawn at the origin (e.g. `"T_MC"`), if any: a figure places it whole.
     pub label: Option<String>,
+    /// What the viewer writes there instead, when it differs from `label`: a short tag (the
+    /// viewer draws labels at a fixed size, so long words would cover a small view), or an
+    /// empty one for none (it would sit on a more important label as the view opens,
+    /// `draw::tags`). `None`: the label.
+    pub tag: Option<String>,
+}
+
+impl Frame {
+    /// The words the viewer draws at the frame: its tag, else its label; `None` for an empty
+    /// tag.
+    ///
+    /// ```
+    /// use posecov::scene::Frame;
+    /// let f = Frame { translation: [0.0; 3], rotation: [0.0, 0.0, 0.0, 1.0], axis_length: 1.0,
+    ///     label: Some("v9: worst loop closure, d = 2.1".into()), tag: Some("v9 worst".into()) };
+    /// assert_eq!(f.viewer_label(), Some("v9 worst"));
+    /// assert_eq!(Frame { tag: Some(String::new()), ..f.clone() }.viewer_label(), None);
+    /// assert_eq!(Frame { tag: None, ..f }.viewer_label(), Some("v9: worst loop closure, d = 2.1"));
+    /// ```
+    pub fn viewer_label(&self) -> Option<&str> {
+        match &self.tag {
+            Some(tag) => Some(tag.as_str()).filter(|t| !t.is_empty()),
+            None => self.label.as_deref(),
+        }
+    }
 }
 
 /// Many small RGB axis triads on one entity (e.g. a subsample of Monte-Carlo poses).

@@ -244,6 +244,7 @@ fn check_kind(path: &str, kind: &ItemKind) -> Result<(), SceneError> {
             rotation,
             axis_length,
             label: _,
+            tag: _,
         }) => {
             vecs(path, "translation", [translation])?;
             quats(path, "rotation", [rotation])?;
@@ -434,6 +435,7 @@ mod tests {
             rotation,
             axis_length: 1.0,
             label: None,
+            tag: None,
         })
     }
 

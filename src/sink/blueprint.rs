@@ -37,12 +37,12 @@ use rr::external::re_sdk_types::blueprint::components::{
 use rr::external::re_sdk_types::datatypes::{self, Range1D, Range2D, TimeInt, TimeRangeBoundary};
 use rr::external::re_sdk_types::datatypes::{Float32, UInt32, Uuid};
 
-use super::legend::LEGEND;
+use super::legend::{LEGEND, LEGEND_TEXT};
 use super::rerun::{STAMP_TIMELINE, STEP_TIMELINE};
 use super::{APPLICATION_ID, SinkError};
 use crate::scene::layout::{
-    DESIGN_HEIGHT, DESIGN_WIDTH, LEFT_SHARE, RIGHT_SHARE, has_legend_view, legend_share, tiles,
-    views_over_plots,
+    DESIGN_HEIGHT, DESIGN_WIDTH, LEFT_SHARE, LegendPane, RIGHT_SHARE, legend_pane, legend_share,
+    tiles, views_over_plots,
 };
 use crate::scene::{self, Camera, Corner, Scene, View3d};
 
@@ -54,7 +54,8 @@ pub use crate::scene::layout::PLOTS_PER_ROW;
 /// ([`super::legend`], as tall as its tiles), on the right the description above one
 /// time-series view per [`Plot`](crate::scene::Plot) (its title and unit as the view's name,
 /// its value range when the scene fits one, its legend in the plot's corner; several plots are
-/// tabs of one pane); with [`Scene::plots_below`], the plots in rows of at most
+/// tabs of one pane); a legend too large for tiles ([`LegendPane::Text`]) is a list in words
+/// between the description and the plots, the 3-D views keeping the whole left column; with [`Scene::plots_below`], the plots in rows of at most
 /// [`PLOTS_PER_ROW`] under the views (a log with `--reference` adds its NEES plots, which a
 /// single row would squeeze to a fifth of the width each) and the description the whole
 /// right column (two fifths), no legend view. Panels collapsed; the time
@@ -95,8 +96,18 @@ fn layout_messages(
         "Description",
         scene::DESCRIPTION,
     )?;
+    let legend = match legend_pane(scene, scene.views.len()) {
+        LegendPane::Text => Some(log_view(
+            &bp,
+            &mut ids,
+            "TextDocument",
+            &legend_title(scene),
+            LEGEND_TEXT,
+        )?),
+        LegendPane::Tiles | LegendPane::None => None,
+    };
     let plots = plot_views(&bp, &mut ids, scene)?;
-    let root = root_container(&bp, &mut ids, scene, left, description, &plots)?;
+    let root = root_container(&bp, &mut ids, scene, left, (description, legend), &plots)?;
     bp.log(
         "viewport",
         &ViewportBlueprint::new()
@@ -145,7 +156,7 @@ fn views_and_legend(
             grid
         }
     };
-    if !has_legend_view(scene) {
+    if legend_pane(scene, views.len()) != LegendPane::Tiles {
         return Ok(left);
     }
     let height = tiles(&scene.legend).height;
@@ -202,13 +213,13 @@ fn plot_views(
 /// The root container: with `plots_below`, the views above rows of plots on the left and the
 /// text panel the whole right column; otherwise the views on the left and the text panel over
 /// the plots on the right (several plots are tabs of one pane, so the one shown is tall enough
-/// for its legend to sit beside its lines).
+/// for its legend to sit beside its lines), a legend in words between them.
 fn root_container(
     bp: &rr::RecordingStream,
     ids: &mut Ids,
     scene: &Scene,
     left: String,
-    description: String,
+    (description, legend): (String, Option<String>),
     plots: &[String],
 ) -> Result<Id, SinkError> {
     let (left, right) = if scene.plots_below && !plots.is_empty() {
@@ -221,25 +232,20 @@ fn root_container(
         let left = log_container(bp, ids, ContainerKind::Vertical, &column, &shares)?;
         (left, description)
     } else {
-        let right = match plots {
-            [] => description,
-            [one] => log_container(
-                bp,
-                ids,
-                ContainerKind::Vertical,
-                &[description, one.clone()],
-                &[3.0, 2.0],
-            )?,
-            _ => {
-                let tabs = log_container(bp, ids, ContainerKind::Tabs, plots, &[])?;
-                log_container(
-                    bp,
-                    ids,
-                    ContainerKind::Vertical,
-                    &[description, tabs],
-                    &[3.0, 2.0],
-                )?
-            }
+        let plots = match plots {
+            [] => None,
+            [one] => Some(one.clone()),
+            _ => Some(log_container(bp, ids, ContainerKind::Tabs, plots, &[])?),
+        };
+        let (panes, shares): (Vec<String>, &[f32]) = match (legend, plots) {
+            (None, None) => (vec![description], &[]),
+            (Some(legend), None) => (vec![description, legend], &[3.0, 2.0]),
+            (None, Some(plots)) => (vec![description, plots], &[3.0, 2.0]),
+            (Some(legend), Some(plots)) => (vec![description, legend, plots], &[2.0, 2.0, 2.5]),
+        };
+        let right = match panes.as_slice() {
+            [one] => one.clone(),
+            _ => log_container(bp, ids, ContainerKind::Vertical, &panes, shares)?,
         };
         (left, right)
     };

@@ -15,19 +15,30 @@ use ::rerun as rr;
 
 use super::SinkError;
 use super::rerun::send;
-use crate::scene::layout::{AXES_WORDS, tiles};
-use crate::scene::{AXIS_COLORS, Color, LegendEntry, Swatch};
+use crate::scene::layout::{AXES_WORDS, LegendPane, legend_markdown, legend_pane, tiles};
+use crate::scene::{AXIS_COLORS, Color, LegendEntry, Scene, Swatch};
 
 /// Entity of the legend's tiles (static; shown by the legend view only).
 pub const LEGEND: &str = "legend";
 
-/// Logs the legend's tiles (static, always all three entities, so a new scene replaces the
-/// last one's legend whole): `legend/bars` (one box per entry, carrying its words),
-/// `legend/dots` (a cloud's mark) and `legend/axes` (an axes entry's red, green and blue).
+/// Entity of the legend as a list in words ([`LegendPane::Text`]; its text view's origin).
+pub const LEGEND_TEXT: &str = "legend_text";
+
+/// Logs the scene's legend (static): its tiles, always all three entities so that a new scene
+/// replaces the last one's legend whole — `legend/bars` (one box per entry, carrying its
+/// words), `legend/dots` (a cloud's mark) and `legend/axes` (an axes entry's red, green and
+/// blue), none when the legend is a list in words — and that list at [`LEGEND_TEXT`] when it
+/// is one ([`LegendPane::Text`]; only its own text view shows it).
 ///
 /// # Errors
 /// An SDK error.
-pub fn log_legend(rec: &rr::RecordingStream, entries: &[LegendEntry]) -> Result<(), SinkError> {
+pub fn log_legend(rec: &rr::RecordingStream, scene: &Scene) -> Result<(), SinkError> {
+    let text = legend_pane(scene, scene.views.len()) == LegendPane::Text;
+    let entries: &[LegendEntry] = if text { &[] } else { &scene.legend };
+    if text {
+        let list = rr::TextDocument::from_markdown(legend_markdown(&scene.legend));
+        send(rec, LEGEND_TEXT, rr::TimePoint::default(), &[&list])?;
+    }
     let laid = tiles(entries);
     let mut bars = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut dots = (Vec::new(), Vec::new());

@@ -87,7 +87,7 @@ pub fn log_scene_cancellable(
     )?;
     if !scene.plots_below {
         // Every time, even empty: a new scene's legend replaces the last one's whole.
-        super::legend::log_legend(rec, &scene.legend)?;
+        super::legend::log_legend(rec, scene)?;
     }
     // A robot log's plots (on the stamp timeline) are small and what a reader looks at
     // first: they go before its items, so a viewer still loading the recording shows them.
@@ -217,8 +217,8 @@ fn log_item(
     }
 }
 
-/// A frame is a transform of its own entity plus its axes; the label is a tiny point at the
-/// frame's origin (in the frame's coordinates, hence `[0, 0, 0]`).
+/// A frame is a transform of its own entity plus its axes; its viewer label
+/// ([`Frame::viewer_label`]) is a tiny point at the frame's origin (in the frame's coordinates, hence `[0, 0, 0]`).
 fn log_frame(
     rec: &rr::RecordingStream,
     path: &str,
@@ -228,13 +228,13 @@ fn log_frame(
     let transform =
         rr::Transform3D::from_translation_rotation(v3(&frame.translation), quat(&frame.rotation));
     let axes = rr::TransformAxes3D::new(f(frame.axis_length));
-    match &frame.label {
+    match frame.viewer_label() {
         None => send(rec, path, at, &[&transform, &axes]),
         Some(label) => {
             let marker = rr::Points3D::new([[0.0f32; 3]])
                 .with_radii([f(0.04 * frame.axis_length)])
                 .with_colors([color(Color::rgb(128, 128, 128))])
-                .with_labels([label.as_str()])
+                .with_labels([label])
                 .with_show_labels(true);
             send(rec, path, at, &[&transform, &axes, &marker])
         }

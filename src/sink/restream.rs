@@ -228,7 +228,7 @@ impl Restream {
                     let was = self.frames.get(&(path.clone(), t));
                     match (was, shown(t).map(|i| &i.kind)) {
                         (Some(&labelled), Some(ItemKind::Frame(frame))) => {
-                            if labelled && frame.label.is_none() {
+                            if labelled && frame.viewer_label().is_none() {
                                 unlabel.push((path.as_str(), t));
                             }
                             false
@@ -267,7 +267,7 @@ impl Restream {
         for item in &scene.items {
             let key = (item.path.clone(), item.timing);
             match &item.kind {
-                ItemKind::Frame(frame) => self.frames.insert(key, frame.label.is_some()),
+                ItemKind::Frame(frame) => self.frames.insert(key, frame.viewer_label().is_some()),
                 _ => self.frames.remove(&key),
             };
             self.touched
@@ -333,9 +333,9 @@ pub fn layout_key(scene: &Scene) -> String {
         .map(|v| (&v.name, &v.include, &v.exclude, &v.hidden))
         .collect();
     format!(
-        "{views:?} {:?} {:?} legend view {}",
+        "{views:?} {:?} {:?} legend {:?}",
         scene.plots,
         scene.timeline,
-        crate::scene::layout::has_legend_view(scene)
+        crate::scene::layout::legend_pane(scene, scene.views.len())
     )
 }

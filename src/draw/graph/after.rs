@@ -452,7 +452,10 @@ fn is_drawable<const N: usize>(cov: &TangentMatrix<N>) -> bool {
 /// the first and the last pose. Labels of one pose, or of poses closer than 4 % of the
 /// drawing, are joined into one ("; "), so no two sit on each other. `after`: at the optimised
 /// poses (`world/optimized/labels/…`), else at the file's estimates (`world/labels/…`). A
-/// figure places each label's box where it overlaps no other (`sink::figure`).
+/// figure places each label's box where it overlaps no other (`sink::figure`); the viewer
+/// writes a short tag ("v9 ← v5 worst", "v7 largest σ", "v0 first"), the whole words going to
+/// the text panel, and leaves out a tag that would cover a more important one
+/// ([`crate::draw::tags`]).
 fn labels<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
@@ -480,7 +483,8 @@ fn labels<G: LieGroup<N>, const N: usize>(
         }
     };
     let worst = g.loop_closures.iter().max_by(|a, b| d(a).total_cmp(&d(b)));
-    let mut candidates: Vec<(usize, String)> = Vec::new();
+    // (pose index, who: "v9 ← v5", what in words, what in a tag)
+    let mut candidates: Vec<(usize, String, String, &str)> = Vec::new();
     if let Some(l) = worst
         && let Some(j) = index_of(l.to)
     {
@@ -491,44 +495,45 @@ fn labels<G: LieGroup<N>, const N: usize>(
         };
         candidates.push((
             j,
-            format!("v{} ← v{}: {what}, d = {:.2}", l.to, l.from, d(l)),
+            format!("v{} ← v{}", l.to, l.from),
+            format!("{what}, d = {:.2}", d(l)),
+            "worst",
         ));
     }
     if let (Some(k), true) = (largest, after) {
         let sigma = position_sigma::<G, N>(&g.solution.covariances[k]);
         candidates.push((
             k,
-            format!(
-                "v{}: largest marginal, σ {}",
-                g.ids[k],
-                ramp::length_words(sigma)
-            ),
+            format!("v{}", g.ids[k]),
+            format!("largest marginal, σ {}", ramp::length_words(sigma)),
+            "largest σ",
         ));
     }
-    candidates.push((0, format!("v{}: first pose", g.ids[0])));
-    candidates.push((n - 1, format!("v{}: last pose", g.ids[n - 1])));
+    let pose = |k: usize| format!("v{}", g.ids[k]);
+    candidates.push((0, pose(0), "first pose".to_owned(), "first"));
+    candidates.push((n - 1, pose(n - 1), "last pose".to_owned(), "last"));
     let position = |k: usize| poses[k].to_se3().translation().to_owned();
     let near = 0.04 * p.extent.max(1e-9);
-    let mut placed: Vec<(usize, String)> = Vec::new();
-    for (k, text) in candidates {
+    // (pose index, words, tag)
+    let mut placed: Vec<(usize, String, String)> = Vec::new();
+    for (k, who, what, short) in candidates {
         match placed
             .iter_mut()
-            .find(|(q, _)| *q == k || (position(*q) - position(k)).norm() < near)
+            .find(|(q, ..)| *q == k || (position(*q) - position(k)).norm() < near)
         {
-            Some((q, words)) => {
-                let pose = format!("v{}", g.ids[k]);
-                let text = if *q == k {
-                    text.trim_start_matches(&format!("{pose}: ")).to_owned()
-                } else {
-                    text
-                };
-                words.push_str("; ");
-                words.push_str(&text);
+            // The same pose: its name once ("v9 ← v5: worst …; last pose").
+            Some((q, words, tag)) if *q == k => {
+                words.push_str(&format!("; {what}"));
+                tag.push_str(&format!(", {short}"));
             }
-            None => placed.push((k, text)),
+            Some((_, words, tag)) => {
+                words.push_str(&format!("; {who}: {what}"));
+                tag.push_str(&format!("; {who} {short}"));
+            }
+            None => placed.push((k, format!("{who}: {what}"), format!("{who} {short}"))),
         }
     }
-    for (k, text) in placed {
+    for (k, text, tag) in placed {
         p.push(
             paths::vertex(&prefix, g.ids[k]),
             None,
@@ -537,6 +542,7 @@ fn labels<G: LieGroup<N>, const N: usize>(
                 rotation: quat(&poses[k]),
                 axis_length: p.axis_length * 0.6,
                 label: Some(text),
+                tag: Some(tag),
             }),
         );
     }

@@ -114,13 +114,13 @@ fn surroundings<G: LieGroup<N>, const N: usize>(
     );
 }
 
-/// A labelled pose of a zoom (`base/v<id>`).
+/// A labelled pose of a zoom (`base/v<id>`): its words, and the viewer's tag when shorter.
 fn labelled<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
     base: &str,
     k: usize,
-    (label, size): (String, f64),
+    (label, tag, size): (String, String, f64),
 ) {
     let x = &g.solution.poses[k];
     p.push(
@@ -130,6 +130,7 @@ fn labelled<G: LieGroup<N>, const N: usize>(
             translation: v3(x.to_se3().translation()),
             rotation: quat(x),
             axis_length: (0.15 * size).min(p.axis_length),
+            tag: (tag != label).then_some(tag),
             label: Some(label),
         }),
     );
@@ -173,7 +174,8 @@ pub(super) fn largest_marginal<G: LieGroup<N>, const N: usize>(
         g.ids[k],
         ramp::length_words(sigma[k])
     );
-    labelled(p, g, &base, k, (label, reach));
+    let tag = format!("v{} largest σ", g.ids[k]);
+    labelled(p, g, &base, k, (label, tag, reach));
     Some(Zoom {
         name: format!("close-up: largest marginal, v{}", g.ids[k]),
         path: base,
@@ -257,9 +259,11 @@ pub(super) fn worst_loop_closure<G: LieGroup<N>, const N: usize>(
         "v{} ← v{}: worst loop closure, d = {:.2}",
         l.to, l.from, l.mahalanobis
     );
-    labelled(p, g, &base, j, (label, reach));
+    let tag = format!("v{} ← v{} worst", l.to, l.from);
+    labelled(p, g, &base, j, (label, tag, reach));
     if i != j && (pi - pj).norm() > 0.1 * reach {
-        labelled(p, g, &base, i, (format!("v{}", l.from), reach));
+        let from = format!("v{}", l.from);
+        labelled(p, g, &base, i, (from.clone(), from, reach));
     }
     Some(Zoom {
         name: format!("close-up: worst loop closure, v{} ← v{}", l.to, l.from),

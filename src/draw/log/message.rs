@@ -92,6 +92,7 @@ pub(super) fn message(
             ],
             axis_length: p.axis_length,
             label,
+            tag: None,
         }),
     );
     let shift = place.shift;
