@@ -29,6 +29,7 @@ use super::format::{self, Format};
 use super::{InputError, Located, Place};
 
 pub mod bundled;
+mod cdr_pose;
 mod collector;
 pub mod decode;
 pub mod health;
