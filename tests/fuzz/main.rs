@@ -58,6 +58,7 @@
 
 mod graph;
 mod harness;
+mod imu_hour;
 #[cfg(feature = "viewer")]
 mod live_api;
 mod live_ws;
@@ -126,6 +127,28 @@ fn long() {
     let total: u64 = summaries.iter().map(|s| s.cases).sum();
     println!("fuzz total: {total} cases");
     assert_clean(&summaries);
+}
+
+/// An IMU at 400 Hz for an hour (1.44 M messages, issue 32) is read in bounded memory: the
+/// read's peak heap is that of a tenth of the log (within 10 %, and under 64 MiB). No timing.
+#[test]
+fn imu_hour_is_read_in_bounded_memory() {
+    let _guard = harness::RUN_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    let [(n_tenth, tenth), (n_hour, hour)] = imu_hour::logs();
+    imu_hour::write_imu_mcap(&tenth, n_tenth);
+    imu_hour::write_imu_mcap(&hour, n_hour);
+    let (peak_tenth, read_tenth) = imu_hour::peak_of_read(&tenth);
+    let (peak_hour, read_hour) = imu_hour::peak_of_read(&hour);
+    let _ = (std::fs::remove_file(&tenth), std::fs::remove_file(&hour));
+    assert_eq!((read_tenth, read_hour), (n_tenth, n_hour));
+    println!(
+        "IMU at 400 Hz: peak heap {peak_tenth} bytes reading {n_tenth} messages, {peak_hour} \
+         bytes reading {n_hour}"
+    );
+    assert!(
+        peak_hour as f64 <= 1.1 * peak_tenth as f64 && peak_hour < 64 << 20,
+        "the hour's read peaks at {peak_hour} bytes, a tenth of it at {peak_tenth}"
+    );
 }
 
 /// The extra scenario seeds are valid scenarios (so their mutants start from something that
