@@ -6,9 +6,7 @@ use serde_json::{Map, Value, json};
 use super::{stamp_seconds, stamps_json};
 use crate::draw::log::{issue_word, sensor_sentence};
 use crate::eval::log::sensor::SensorEvaluation;
-use crate::plan::log::{
-    BlockSummary, Class, Health, Issue, LogSummary, SensorKind, SensorTopicSummary,
-};
+use crate::plan::log::{BlockSummary, Class, Health, Issue, LogSummary, SensorTopicSummary};
 
 /// A health map as the pose topics' (`health` in json-report.md): per finding its class, count,
 /// first stamp and message, word and sentence.
@@ -20,7 +18,7 @@ fn health_json(health: &Health, block: Option<&BlockSummary>, t: &SensorTopicSum
             (
                 issue.name().to_owned(),
                 json!({
-                    "class": SensorKind::class(*issue),
+                    "class": t.kind.class_of(*issue),
                     "count": c.count,
                     "first_stamp_s": stamp_seconds(c.first_stamp_ns),
                     "first_message": c.first_index,

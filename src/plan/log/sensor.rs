@@ -202,6 +202,23 @@ impl SensorKind {
             other => other.class(false),
         }
     }
+
+    /// The class of `issue` on a block or topic of this kind: [`SensorKind::class`], except
+    /// `all_zero` on an Odometry's twist, a note: many odometry publishers leave the twist
+    /// covariance unset, and a consumer of the pose never reads it (on a
+    /// `TwistWithCovarianceStamped`, published to be fused, it stays a defect).
+    ///
+    /// ```
+    /// use posecov::plan::log::{Class, Issue, SensorKind};
+    /// assert_eq!(SensorKind::OdometryTwist.class_of(Issue::AllZero), Class::Note);
+    /// assert_eq!(SensorKind::Twist.class_of(Issue::AllZero), Class::Defect);
+    /// ```
+    pub fn class_of(self, issue: Issue) -> Class {
+        match (self, issue) {
+            (SensorKind::OdometryTwist, Issue::AllZero) => Class::Note,
+            _ => Self::class(issue),
+        }
+    }
 }
 
 /// One point of a sensor topic's σ series: per block, σ of each axis where it is checked and
@@ -276,7 +293,7 @@ impl SensorTopicSummary {
         });
         let mut all: Vec<_> = own
             .chain(blocks)
-            .map(|(b, i, c)| (b, i, c, SensorKind::class(i)))
+            .map(|(b, i, c)| (b, i, c, self.kind.class_of(i)))
             .collect();
         all.sort_by_key(|f| f.3);
         all.into_iter()
