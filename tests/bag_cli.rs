@@ -30,11 +30,12 @@ fn scratch(name: &str) -> PathBuf {
 
 #[test]
 fn check_and_list_know_both_log_formats() {
-    // The Jackal's odometry covariance never grows over 84 m: a defect, so `check` fails.
+    // The Jackal's odometry covariance never grows over 84 m: a defect, so `check` fails. The
+    // sensor topics: the IMU and the odometry's twist (its placeholders and constancy notes).
     let (code, out, err) = run(&["check", TEST2]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
-        out.contains(": defects on 1 of 1 pose topic(s) and 0 of 1 sensor topic(s) (6121 messages"),
+        out.contains(": defects on 1 of 1 pose topic(s) and 0 of 2 sensor topic(s) (6121 messages"),
         "{out}"
     );
     assert!(
@@ -46,7 +47,7 @@ fn check_and_list_know_both_log_formats() {
     let (code, out, err) = run(&["check", TEST2, "--allow", "constant"]);
     assert_eq!(code, Some(0), "{err}");
     assert!(
-        out.contains(": ok (1 pose topic(s), 1 sensor topic(s), 6121 messages"),
+        out.contains(": ok (1 pose topic(s), 2 sensor topic(s), 6121 messages"),
         "{out}"
     );
     let (code, out, _) = run(&["list"]);
@@ -58,7 +59,9 @@ fn check_and_list_know_both_log_formats() {
     let (code, out, err) = run(&["check", "covariance_health"]);
     assert_eq!(code, Some(1), "{err}");
     assert!(
-        out.starts_with("covariance_health: defects on 1 of 3 pose topic(s) (70 messages"),
+        out.starts_with(
+            "covariance_health: defects on 1 of 3 pose topic(s) and 0 of 1 sensor topic(s) (70 messages"
+        ),
         "{out}"
     );
 }
@@ -147,15 +150,15 @@ fn save_writes_a_recording_and_every_thins_it() {
         .filter(|c| c.entity_path().to_string().ends_with("/TimeAxis"))
         .count();
     assert_eq!(
-        ranges, 6,
-        "σ of position, σ of rotation, trace; the IMU's σ orientation, angular velocity, linear acceleration"
+        ranges, 7,
+        "σ of position, σ of rotation, trace; the IMU's σ orientation, angular velocity (with the odometry twist's), linear acceleration; the twist's σ linear velocity"
     );
     // And each plot's value axis is fitted to the data (a flat σ is not lost in ±1).
     let values = rrd::store_chunks(&bytes, rerun::StoreKind::Blueprint)
         .iter()
         .filter(|c| c.entity_path().to_string().ends_with("/ScalarAxis"))
         .count();
-    assert_eq!(values, 6);
+    assert_eq!(values, 7);
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -100,7 +100,7 @@ fn check_and_several_bags_at_once_work_as_for_mcap() {
     let (code, out, err) = run(&["check", &data("arc_humble")]);
     assert_eq!(code, Some(0), "{err}");
     assert!(
-        out.contains("ok (2 pose topic(s), 1 sensor topic(s), 245 messages"),
+        out.contains("ok (2 pose topic(s), 2 sensor topic(s), 245 messages"),
         "{out}"
     );
     let (mcap_code, ..) = run(&["check", &data("arc.mcap")]);

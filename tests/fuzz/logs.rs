@@ -30,7 +30,8 @@ pub enum LogKind {
     Ros1,
     Mcap,
     Db3,
-    /// ROS 1 bags of `sensor_msgs/Imu` (tests/data/imu): mutations reach the IMU messages.
+    /// ROS 1 bags of sensor messages: `sensor_msgs/Imu` (tests/data/imu), twists,
+    /// accelerations and an Odometry's twist (tests/data/twist): mutations reach their messages.
     Imu,
 }
 
@@ -50,7 +51,7 @@ impl Logs {
             LogKind::Ros1 => bundled.chain([small_bag()]).collect(),
             LogKind::Mcap => bundled.collect(),
             LogKind::Db3 => DB3_SEEDS.iter().map(|s| s.to_vec()).collect(),
-            LogKind::Imu => vec![IMU_SEED.to_vec()],
+            LogKind::Imu => vec![IMU_SEED.to_vec(), TWIST_SEED.to_vec()],
         };
         Self { kind, seeds }
     }
@@ -66,16 +67,23 @@ impl LogKind {
     }
 }
 
-/// The `.db3` seeds: a version 9 bag, Humble's layout, zstd-compressed messages.
-pub const DB3_SEEDS: [&[u8]; 3] = [
+/// The `.db3` seeds: a version 9 bag, Humble's layout, zstd-compressed messages, and the CDR
+/// twists, accelerations and Odometry of tests/data/twist.
+pub const DB3_SEEDS: [&[u8]; 4] = [
     include_bytes!("../data/ros2/arc_v9/arc_v9.db3"),
     include_bytes!("../data/ros2/arc_humble/arc_humble_0.db3"),
     include_bytes!("../data/ros2/arc_zstd_message/arc_zstd_message.db3"),
+    include_bytes!("../data/twist/twist_db3/twist_db3.db3"),
 ];
 
 /// The `imu` seed: an uncompressed ROS 1 bag of two IMU topics (−1 "not provided", all zero),
 /// written by PyPI `rosbags` (tests/data/imu/make_imu.py).
 pub const IMU_SEED: &[u8] = include_bytes!("../data/imu/imu_rep145.bag");
+
+/// The `imu` family's second seed: an uncompressed ROS 1 bag of `TwistWithCovarianceStamped`,
+/// `AccelWithCovarianceStamped` and `nav_msgs/Odometry` (a PSD defect, all zero, −1, placeholders),
+/// written by PyPI `rosbags` (tests/data/twist/make_twist.py).
+pub const TWIST_SEED: &[u8] = include_bytes!("../data/twist/twist.bag");
 
 /// Strings the mutator inserts: record field names and values of both formats.
 const TOKENS: &[&str] = &[
@@ -101,6 +109,8 @@ const TOKENS: &[&str] = &[
     "geometry_msgs/msg/PoseWithCovarianceStamped",
     "type=sensor_msgs/Imu",
     "sensor_msgs/msg/Imu",
+    "type=geometry_msgs/TwistWithCovarianceStamped",
+    "geometry_msgs/msg/AccelWithCovarianceStamped",
 ];
 
 impl Family for Logs {

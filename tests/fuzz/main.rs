@@ -10,8 +10,8 @@
 //! | `graph` | the g2o / GTSAM / TORO graphs, mutated by token, line and byte | read → lower → evaluate (16 samples) → draw → validate → `report --json` |
 //! | `ros1` | the bundled bz2 bag and a small uncompressed bag written here, mutated by byte (lengths and counts set to edge values) | read → evaluate → draw → validate → `report --json` |
 //! | `mcap` | the bundled MCAP, mutated by byte | the same |
-//! | `imu` | a ROS 1 bag of `sensor_msgs/Imu` (tests/data/imu: −1 "not provided", all-zero covariances), mutated by byte | the same |
-//! | `db3` | three ROS 2 SQLite bags of tests/data/ros2 (version 9, Humble's 5, zstd messages), mutated by byte | the same |
+//! | `imu` | ROS 1 bags of sensor messages: `sensor_msgs/Imu` (tests/data/imu: −1 "not provided", all-zero covariances), twists, accelerations and an Odometry's twist (tests/data/twist), mutated by byte | the same |
+//! | `db3` | four ROS 2 SQLite bags: three of tests/data/ros2 (version 9, Humble's 5, zstd messages) and tests/data/twist's CDR twists, accelerations and Odometry, mutated by byte | the same |
 //! | `ov_eval` | the OpenVINS text trajectories of tests/data/ov_eval (cut) and one mixing 8- and 20-column lines, mutated by token, line and byte | read as an estimate → evaluate → draw → validate → `report --json`; read as a NEES reference (the TUM reader) |
 //! | `live_ws` | a scripted Foxglove WebSocket server on 127.0.0.1, each session a good one (a ROS 2 and a ROS 1 pose topic) damaged: frames' JSON and bytes mutated, bad frames of the issue's list inserted, frames dropped, repeated, swapped | `report --json` of `ws://127.0.0.1:PORT` (read → evaluate → report), Ctrl-C once the server is done |
 //! | `live_api` | raw HTTP requests to the live page's server: methods, paths, `Host`, `Origin`, content types, edits of every control to edge values | a real server on loopback |
@@ -58,6 +58,7 @@
 
 mod graph;
 mod harness;
+mod imu_hour;
 #[cfg(feature = "viewer")]
 mod live_api;
 mod live_ws;
@@ -128,6 +129,28 @@ fn long() {
     assert_clean(&summaries);
 }
 
+/// An IMU at 400 Hz for an hour (1.44 M messages, issue 32) is read in bounded memory: the
+/// read's peak heap is that of a tenth of the log (within 10 %, and under 64 MiB). No timing.
+#[test]
+fn imu_hour_is_read_in_bounded_memory() {
+    let _guard = harness::RUN_LOCK.lock().unwrap_or_else(|e| e.into_inner());
+    let [(n_tenth, tenth), (n_hour, hour)] = imu_hour::logs();
+    imu_hour::write_imu_mcap(&tenth, n_tenth);
+    imu_hour::write_imu_mcap(&hour, n_hour);
+    let (peak_tenth, read_tenth) = imu_hour::peak_of_read(&tenth);
+    let (peak_hour, read_hour) = imu_hour::peak_of_read(&hour);
+    let _ = (std::fs::remove_file(&tenth), std::fs::remove_file(&hour));
+    assert_eq!((read_tenth, read_hour), (n_tenth, n_hour));
+    println!(
+        "IMU at 400 Hz: peak heap {peak_tenth} bytes reading {n_tenth} messages, {peak_hour} \
+         bytes reading {n_hour}"
+    );
+    assert!(
+        peak_hour as f64 <= 1.1 * peak_tenth as f64 && peak_hour < 64 << 20,
+        "the hour's read peaks at {peak_hour} bytes, a tenth of it at {peak_tenth}"
+    );
+}
+
 /// The extra scenario seeds are valid scenarios (so their mutants start from something that
 /// works), and the small bag written here reads.
 #[test]
@@ -155,8 +178,10 @@ fn seeds_are_valid() {
         assert!(found.iter().all(|f| f.class == "ok"), "db3 seed: {found:?}");
     }
     let imu = logs::Logs::new(logs::LogKind::Imu);
-    let (found, _) = imu.check(logs::IMU_SEED, &limits);
-    assert!(found.iter().all(|f| f.class == "ok"), "imu seed: {found:?}");
+    for seed in [logs::IMU_SEED, logs::TWIST_SEED] {
+        let (found, _) = imu.check(seed, &limits);
+        assert!(found.iter().all(|f| f.class == "ok"), "imu seed: {found:?}");
+    }
     let ov_eval = ov_eval::OvEval::new();
     for seed in ov_eval.seeds() {
         let (found, _) = ov_eval.check(seed.as_bytes(), &limits);

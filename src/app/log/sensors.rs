@@ -1,4 +1,4 @@
-//! A log's sensor topics (`sensor_msgs/Imu`) in `report --json` (`sensors`) and `check`: per
+//! A log's sensor topics (`sensor_msgs/Imu`, twists, accelerations, an Odometry's twist) in `report --json` (`sensors`) and `check`: per
 //! topic its findings and per covariance block its findings and σ per axis with its unit.
 
 use serde_json::{Map, Value, json};
@@ -6,9 +6,7 @@ use serde_json::{Map, Value, json};
 use super::{stamp_seconds, stamps_json};
 use crate::draw::log::{issue_word, sensor_sentence};
 use crate::eval::log::sensor::SensorEvaluation;
-use crate::plan::log::{
-    BlockSummary, Class, Health, Issue, LogSummary, SensorKind, SensorTopicSummary,
-};
+use crate::plan::log::{BlockSummary, Class, Health, Issue, LogSummary, SensorTopicSummary};
 
 /// A health map as the pose topics' (`health` in json-report.md): per finding its class, count,
 /// first stamp and message, word and sentence.
@@ -20,7 +18,7 @@ fn health_json(health: &Health, block: Option<&BlockSummary>, t: &SensorTopicSum
             (
                 issue.name().to_owned(),
                 json!({
-                    "class": SensorKind::class(*issue),
+                    "class": t.kind.class_of(*issue),
                     "count": c.count,
                     "first_stamp_s": stamp_seconds(c.first_stamp_ns),
                     "first_message": c.first_index,
@@ -71,6 +69,7 @@ pub(super) fn sensors_json(plan: &LogSummary, e: &[SensorEvaluation]) -> Value {
                 "type": t.kind.ros1_name(),
                 "kind": t.kind,
                 "frame_id": t.frame_id,
+                "frame_field": t.kind.frame_field(),
                 "messages": t.count,
                 "stamps": stamps_json(t.stamp_range, t.stamps_from_log_time, t.stamps_out_of_order),
                 "health": health_json(&t.health, None, t),
@@ -126,7 +125,7 @@ pub(super) fn sensor_defects(
             c.first_index,
             stamp_seconds(c.first_stamp_ns),
             issue.name(),
-            block.map_or_else(String::new, |b| format!(" on {b}_covariance")),
+            b.map_or_else(String::new, |b| format!(" on {}", t.kind.field(&b.spec))),
             sensor_sentence(*issue, b, t),
             c.count,
             issue.name(),

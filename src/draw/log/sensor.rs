@@ -1,6 +1,8 @@
-//! A log's sensor topics (`sensor_msgs/Imu`) in words and plots: each finding's sentence
+//! A log's sensor topics (`sensor_msgs/Imu`, twists and accelerations with covariance, an
+//! Odometry's twist) in words and plots: each finding's sentence
 //! ([`sensor_sentence`]), a paragraph per topic in the text panel, and one σ plot per kind of
-//! block (`σ orientation`, `σ angular velocity`, `σ linear acceleration`) over the stamp, one
+//! block (`σ orientation`, `σ angular velocity`, `σ linear acceleration`, `σ linear velocity`,
+//! `σ angular acceleration`) over the stamp, one
 //! line per topic and axis, in a unit fitted to the values. Velocities and accelerations are
 //! σ plots only: there is nothing in the world view to put them on.
 
@@ -9,7 +11,9 @@ use std::fmt::Write;
 use super::super::shapes::AXIS_COLORS;
 use super::text::issue_word;
 use crate::eval::log::LogEvaluation;
-use crate::plan::log::{BlockSummary, Class, Issue, LogSummary, SensorKind, SensorTopicSummary};
+use crate::plan::log::{
+    BlockSpec, BlockSummary, Class, Issue, LogSummary, SensorKind, SensorTopicSummary,
+};
 use crate::scene::paths::{self, topic_segments};
 use crate::scene::{Corner, Plot, PlotId, ScalarSeries, Scene};
 
@@ -31,10 +35,7 @@ pub fn sensor_sentence(
     block: Option<&BlockSummary>,
     t: &SensorTopicSummary,
 ) -> String {
-    let field = block.map_or_else(
-        || "the covariance".to_owned(),
-        |b| format!("{}_covariance", b.spec.name),
-    );
+    let field = block.map_or_else(|| "the covariance".to_owned(), |b| t.kind.field(&b.spec));
     match issue {
         Issue::UnknownMarker => format!(
             "{field}[0] = −1: REP 145's \"not provided\"; the block is not checked and its σ \
@@ -84,10 +85,10 @@ pub fn sensor_sentence(
 /// σ's range per block and axis, and each finding with its class, count and first message.
 pub(super) fn sensor_paragraph(plan: &LogSummary, s: &mut String) {
     for t in &plan.sensors {
-        let frame = if t.frame_id.is_empty() {
-            "no frame_id".to_owned()
-        } else {
-            format!("frame `{}`", t.frame_id)
+        let frame = match (t.frame_id.as_str(), t.kind.frame_field()) {
+            ("", field) => format!("no {field}"),
+            (id, "header.frame_id") => format!("frame `{id}`"),
+            (id, field) => format!("frame `{id}` ({field})"),
         };
         let _ = writeln!(
             s,
@@ -143,6 +144,8 @@ fn unit_for(si: &'static str, max: f64) -> (&'static str, f64) {
         "rad" => ("°", 180.0 / std::f64::consts::PI),
         "rad/s" if max < 0.1 => ("mrad/s", 1e3),
         "m/s²" if max < 0.1 => ("mm/s²", 1e3),
+        "m/s" if max < 0.1 => ("mm/s", 1e3),
+        "rad/s²" if max < 0.1 => ("mrad/s²", 1e3),
         other => (other, 1.0),
     }
 }
@@ -151,7 +154,14 @@ fn unit_for(si: &'static str, max: f64) -> (&'static str, f64) {
 /// topic and axis, ranged from 0 with room above.
 pub(super) fn sensor_plots(scene: &mut Scene, e: &LogEvaluation) {
     let several = e.sensors.len() > 1;
+    // A quantity's one plot, whichever kinds carry it (an IMU's and a twist's angular velocity).
+    let mut specs: Vec<&BlockSpec> = Vec::new();
     for spec in SensorKind::ALL.iter().flat_map(|k| k.blocks()) {
+        if !specs.contains(&spec) {
+            specs.push(spec);
+        }
+    }
+    for spec in specs {
         type Line = (String, String, usize, Vec<(i64, f64)>);
         let mut lines: Vec<Line> = Vec::new();
         for t in &e.sensors {

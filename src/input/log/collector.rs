@@ -18,7 +18,7 @@ use super::reference::{self, ReferenceType};
 use super::sensor::{SensorState, decode_sensor};
 use super::stream::{Codec, Stream};
 use super::topic::TopicState;
-use super::{InputError, LogOptions, decode, tf};
+use super::{InputError, LogOptions, decode, tf, velocity};
 use crate::input::suggest;
 
 impl LogOptions {
@@ -45,6 +45,8 @@ pub(super) struct Collector<'a, 'o> {
     topics: BTreeMap<String, TopicState>,
     /// The sensor topics (covariance-carrying messages that are not poses).
     sensors: BTreeMap<String, SensorState>,
+    /// The twist half of each `nav_msgs/Odometry` pose topic, read beside its pose.
+    twists: BTreeMap<String, SensorState>,
     /// Per topic of another type: its type, messages and the first one's log time.
     skipped: BTreeMap<String, (String, u64, i64)>,
     not_selected: BTreeMap<String, ()>,
@@ -100,6 +102,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             cancelled: false,
             topics: BTreeMap::new(),
             sensors: BTreeMap::new(),
+            twists: BTreeMap::new(),
             skipped: BTreeMap::new(),
             not_selected: BTreeMap::new(),
             total: 0,
@@ -137,6 +140,7 @@ impl<'a, 'o> Collector<'a, 'o> {
         let mut plan = assemble(
             self.topics.clone(),
             self.sensors.clone(),
+            self.twists.clone(),
             self.skipped.clone(),
             self.not_selected.clone(),
             self.total,
@@ -440,6 +444,17 @@ impl<'a, 'o> Collector<'a, 'o> {
             return;
         }
         let decoded = decode(state.kind);
+        if state.kind == PoseMessageKind::Odometry {
+            let twist = match &decoded {
+                Ok(m) => velocity::odometry_twist(m)
+                    .ok_or_else(|| decode::DecodeError("no twist".to_owned())),
+                Err(e) => Err(e.clone()),
+            };
+            self.twists
+                .entry(topic.to_owned())
+                .or_insert_with(|| SensorState::new(SensorKind::OdometryTwist))
+                .add(twist, log_time_ns);
+        }
         let observer = self.observer.as_deref_mut();
         state.add(decoded, log_time_ns, |a, m| {
             if let Some(observer) = observer {
@@ -495,6 +510,7 @@ impl<'a, 'o> Collector<'a, 'o> {
         Ok(assemble(
             self.topics,
             self.sensors,
+            self.twists,
             self.skipped,
             self.not_selected,
             self.total,
@@ -511,6 +527,7 @@ impl<'a, 'o> Collector<'a, 'o> {
 fn assemble(
     mut topics: BTreeMap<String, TopicState>,
     mut sensors: BTreeMap<String, SensorState>,
+    twists: BTreeMap<String, SensorState>,
     mut skipped: BTreeMap<String, (String, u64, i64)>,
     not_selected: BTreeMap<String, ()>,
     total: u64,
@@ -536,10 +553,11 @@ fn assemble(
             .into_iter()
             .map(|(name, s)| s.into_plan(name))
             .collect(),
-        sensors: sensors
-            .into_iter()
-            .map(|(name, s)| s.into_plan(name))
-            .collect(),
+        sensors: {
+            let mut all: Vec<_> = sensors.into_iter().chain(twists).collect();
+            all.sort_by(|a, b| a.0.cmp(&b.0));
+            all.into_iter().map(|(name, s)| s.into_plan(name)).collect()
+        },
         skipped: skipped
             .into_iter()
             .map(|(name, (message_type, count, _))| SkippedTopic {

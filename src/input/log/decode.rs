@@ -283,10 +283,6 @@ pub struct Odometry {
     pub twist: TwistWithCovariance,
 }
 
-fn flat(m: &[[f64; 6]; 6]) -> [f64; COV_LEN] {
-    std::array::from_fn(|i| m[i / 6][i % 6])
-}
-
 /// The 36 row-major entries as the 6 × 6 nesting the CDR types use.
 ///
 /// ```
@@ -330,7 +326,8 @@ pub(super) fn header_stamp(t: Time) -> Option<i64> {
     stamp(i64::from(t.sec), t.nanosec)
 }
 
-/// Decodes a CDR (ROS 2) message of `kind`, encapsulation header included.
+/// Decodes a CDR (ROS 2) message of `kind`, encapsulation header included: read by hand
+/// (`cdr_pose.rs`), with the results of `re_cdr` reading the serde types below.
 ///
 /// ```
 /// use posecov::input::log::decode::{decode_cdr, PoseWithCovariance};
@@ -343,38 +340,18 @@ pub(super) fn header_stamp(t: Time) -> Option<i64> {
 /// ```
 pub fn decode_cdr(kind: PoseMessageKind, bytes: &[u8]) -> Result<PoseMessage, DecodeError> {
     not_text(kind)?;
-    let what = kind.ros2_name();
-    let (stamp_ns, frame_id, child_frame_id, pose, twist) = match kind {
-        PoseMessageKind::Odometry => {
-            let m: Odometry = cdr(bytes, what)?;
-            let s = header_stamp(m.header.stamp);
-            (
-                s,
-                m.header.frame_id,
-                m.child_frame_id,
-                m.pose,
-                Some(m.twist),
-            )
-        }
-        PoseMessageKind::PoseWithCovarianceStamped => {
-            let m: PoseWithCovarianceStamped = cdr(bytes, what)?;
-            let s = header_stamp(m.header.stamp);
-            (s, m.header.frame_id, String::new(), m.pose, None)
-        }
-        PoseMessageKind::PoseWithCovariance | PoseMessageKind::OvEval => {
-            let m: PoseWithCovariance = cdr(bytes, what)?;
-            (None, String::new(), String::new(), m, None)
-        }
-    };
+    let (stamp_ns, frame_id, child_frame_id, position, orientation_xyzw, covariance, twist) =
+        super::cdr_pose::read_pose(kind, bytes)
+            .map_err(|e| DecodeError(format!("{}: {}", kind.ros2_name(), e.0)))?;
     within_reach(PoseMessage {
         stamp_ns: stamp_ns.unwrap_or(0),
         from_log_time: stamp_ns.is_none(),
         frame_id,
         child_frame_id,
-        position: pose.pose.position,
-        orientation_xyzw: pose.pose.orientation,
-        covariance: flat(&pose.covariance),
-        twist_covariance: twist.map(|t| flat(&t.covariance)),
+        position,
+        orientation_xyzw,
+        covariance,
+        twist_covariance: twist,
     })
 }
 
@@ -461,6 +438,142 @@ mod tests {
             assert_eq!(d.child_frame_id, "base_link");
             assert_eq!(d.covariance, cov);
             assert_eq!(d.orientation_xyzw, [0.0, 0.0, 0.6, 0.8]);
+        }
+    }
+
+    fn flat(m: &[[f64; 6]; 6]) -> [f64; COV_LEN] {
+        std::array::from_fn(|i| m[i / 6][i % 6])
+    }
+
+    /// What `re_cdr`'s serde deserializer reads of `bytes` as `kind`, as the hand reader's
+    /// fields (float bits, so that NaNs compare).
+    fn by_serde(kind: PoseMessageKind, bytes: &[u8]) -> Option<Vec<u64>> {
+        let (stamp, frame, child, pose, twist) = match kind {
+            PoseMessageKind::Odometry => {
+                let m: Odometry = cdr(bytes, "").ok()?;
+                let s = header_stamp(m.header.stamp);
+                (
+                    s,
+                    m.header.frame_id,
+                    m.child_frame_id,
+                    m.pose,
+                    Some(m.twist),
+                )
+            }
+            PoseMessageKind::PoseWithCovarianceStamped => {
+                let m: PoseWithCovarianceStamped = cdr(bytes, "").ok()?;
+                let s = header_stamp(m.header.stamp);
+                (s, m.header.frame_id, String::new(), m.pose, None)
+            }
+            _ => {
+                let m: PoseWithCovariance = cdr(bytes, "").ok()?;
+                (None, String::new(), String::new(), m, None)
+            }
+        };
+        Some(fields_bits((
+            stamp,
+            frame,
+            child,
+            pose.pose.position,
+            pose.pose.orientation,
+            flat(&pose.covariance),
+            twist.map(|t| flat(&t.covariance)),
+        )))
+    }
+
+    fn fields_bits(f: super::super::cdr_pose::PoseFields) -> Vec<u64> {
+        let (stamp, frame, child, p, q, c, t) = f;
+        let mut out = vec![stamp.map_or(u64::MAX, |s| s as u64)];
+        out.extend(frame.bytes().map(u64::from).chain([u64::MAX - 1]));
+        out.extend(child.bytes().map(u64::from).chain([u64::MAX - 1]));
+        let floats = p
+            .into_iter()
+            .chain(q)
+            .chain(c)
+            .chain(t.into_iter().flatten());
+        out.extend(floats.map(f64::to_bits));
+        out
+    }
+
+    #[test]
+    fn the_hand_cdr_reader_agrees_with_serde_on_every_cut_and_flip() {
+        use super::super::cdr_pose::read_pose;
+        let cov: [f64; 36] = std::array::from_fn(|i| 0.5 + i as f64);
+        for frame in ["", "m", "odom", "map_frame_x"] {
+            let header = Header {
+                stamp: Time {
+                    sec: 9,
+                    nanosec: 11,
+                },
+                frame_id: frame.into(),
+            };
+            let pose = PoseWithCovariance {
+                pose: Pose {
+                    position: [1.0, 2.0, 3.0],
+                    orientation: [0.0, 0.0, 0.6, 0.8],
+                },
+                covariance: nested(&cov),
+            };
+            let odometry = Odometry {
+                header: header.clone(),
+                child_frame_id: format!("{frame}_c"),
+                pose,
+                twist: TwistWithCovariance {
+                    twist: [1.0; 6],
+                    covariance: nested(&cov),
+                },
+            };
+            let stamped = PoseWithCovarianceStamped { header, pose };
+            for big in [false, true] {
+                let encode = |v: &dyn Fn(bool) -> Vec<u8>| {
+                    let mut b = if big {
+                        vec![0, 0, 0, 0]
+                    } else {
+                        vec![0, 1, 0, 0]
+                    };
+                    b.extend(v(big));
+                    b
+                };
+                let messages = [
+                    (
+                        PoseMessageKind::Odometry,
+                        encode(&|big| match big {
+                            true => re_cdr::to_vec::<_, re_cdr::BigEndian>(&odometry).unwrap(),
+                            false => re_cdr::to_vec::<_, re_cdr::LittleEndian>(&odometry).unwrap(),
+                        }),
+                    ),
+                    (
+                        PoseMessageKind::PoseWithCovarianceStamped,
+                        encode(&|big| match big {
+                            true => re_cdr::to_vec::<_, re_cdr::BigEndian>(&stamped).unwrap(),
+                            false => re_cdr::to_vec::<_, re_cdr::LittleEndian>(&stamped).unwrap(),
+                        }),
+                    ),
+                    (
+                        PoseMessageKind::PoseWithCovariance,
+                        encode(&|big| match big {
+                            true => re_cdr::to_vec::<_, re_cdr::BigEndian>(&pose).unwrap(),
+                            false => re_cdr::to_vec::<_, re_cdr::LittleEndian>(&pose).unwrap(),
+                        }),
+                    ),
+                ];
+                for (kind, full) in messages {
+                    assert!(by_serde(kind, &full).is_some());
+                    let mut cases: Vec<Vec<u8>> =
+                        (0..=full.len()).map(|n| full[..n].to_vec()).collect();
+                    for at in 0..full.len().min(64) {
+                        for v in [0x00, 0x80, 0xff, 0xc0] {
+                            let mut b = full.clone();
+                            b[at] = v;
+                            cases.push(b);
+                        }
+                    }
+                    for b in cases {
+                        let hand = read_pose(kind, &b).ok().map(fields_bits);
+                        assert_eq!(hand, by_serde(kind, &b), "{kind:?} {frame:?} {b:?}");
+                    }
+                }
+            }
         }
     }
 }

@@ -7,7 +7,9 @@
 //!
 //! Messages read: `nav_msgs/Odometry`, `geometry_msgs/PoseWithCovarianceStamped`,
 //! `geometry_msgs/PoseWithCovariance` (pose topics), `sensor_msgs/Imu` (sensor topics,
-//! `sensor.rs`: health and σ of each covariance block), and `/tf` + `/tf_static` kept per edge
+//! `sensor.rs`: health and σ of each covariance block), `TwistWithCovarianceStamped`,
+//! `AccelWithCovarianceStamped` and each Odometry's twist (`velocity.rs`: the diagonal blocks of
+//! their 6 × 6 covariance, as sensor topics), and `/tf` + `/tf_static` kept per edge
 //! (`tf.rs`); other types are listed as skipped. Stamps are the header stamp, or the log time when it is zero.
 //!
 //! ```
@@ -27,6 +29,7 @@ use super::format::{self, Format};
 use super::{InputError, Located, Place};
 
 pub mod bundled;
+mod cdr_pose;
 mod collector;
 pub mod decode;
 pub mod health;
@@ -42,6 +45,7 @@ mod sqlite;
 mod stream;
 mod tf;
 mod topic;
+pub mod velocity;
 pub mod ws;
 
 use collector::Collector;

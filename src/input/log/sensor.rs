@@ -15,8 +15,11 @@ use crate::plan::log::{
 };
 
 /// MD5 sums of the ROS 1 definitions read (what `rosmsg md5` prints).
-pub const ROS1_MD5: [(SensorKind, &str); 1] =
-    [(SensorKind::Imu, "6a62c6daae103f4ff57a132d6f95cec2")];
+pub const ROS1_MD5: [(SensorKind, &str); 3] = [
+    (SensorKind::Imu, "6a62c6daae103f4ff57a132d6f95cec2"),
+    (SensorKind::Twist, "8927a1a12fb2607ceea095b2dc440a96"),
+    (SensorKind::Accel, "96adb295225031ec8d57fb4251b0a886"),
+];
 
 /// The sensor kind of a ROS 1 type (`md5` `*`: taken by name); `Err` when the MD5 sum says
 /// another definition.
@@ -41,12 +44,15 @@ pub fn ros1_sensor(type_name: &str, md5: &str) -> Option<Result<SensorKind, Stri
 /// ```
 /// use posecov::input::log::sensor::ros2_sensor;
 /// assert!(ros2_sensor("sensor_msgs/msg/Imu").is_some());
+/// assert!(ros2_sensor("geometry_msgs/msg/TwistWithCovarianceStamped").is_some());
+/// // An Odometry topic is a pose topic (its twist is read beside it).
+/// assert!(ros2_sensor("nav_msgs/msg/Odometry").is_none());
 /// assert!(ros2_sensor("sensor_msgs/msg/Image").is_none());
 /// ```
 pub fn ros2_sensor(schema_name: &str) -> Option<SensorKind> {
-    SensorKind::ALL
-        .into_iter()
-        .find(|k| k.ros2_name() == schema_name || k.ros1_name() == schema_name)
+    SensorKind::ALL.into_iter().find(|k| {
+        k.is_own_message() && (k.ros2_name() == schema_name || k.ros1_name() == schema_name)
+    })
 }
 
 /// A decoded sensor message: its stamp, frame and covariance blocks (row-major 3 × 3, in
@@ -103,6 +109,9 @@ pub fn decode_sensor(
     bytes: &[u8],
 ) -> Result<SensorMessage, DecodeError> {
     let imu = match (kind, codec) {
+        (SensorKind::Twist | SensorKind::Accel | SensorKind::OdometryTwist, _) => {
+            return super::velocity::decode(kind, codec, bytes);
+        }
         (SensorKind::Imu, Codec::Cdr) => cdr::<Imu>(bytes, kind.ros2_name())?,
         (SensorKind::Imu, Codec::Ros1) => {
             let mut r = Ros1 { bytes, at: 0 };
@@ -249,19 +258,30 @@ impl SensorState {
         }
     }
 
-    /// Takes the next message, logged at `log_time_ns`.
+    /// Takes the next message, logged at `log_time_ns` (an Odometry's twist: every message of
+    /// the pose topic, so that both count messages alike).
     pub(super) fn add(&mut self, decoded: Result<SensorMessage, DecodeError>, log_time_ns: i64) {
         let index = self.count;
         self.count += 1;
+        // An Odometry's twist: its bytes and stamps are the pose topic's, whose findings they are.
+        let own = self.kind.is_own_message();
         let Ok(mut m) = decoded else {
-            self.health.note(Issue::Undecodable, log_time_ns, index);
+            if own {
+                self.health.note(Issue::Undecodable, log_time_ns, index);
+            }
             return;
         };
         if m.from_log_time {
             m.stamp_ns = log_time_ns;
         }
+        let mut pose_topics = Health::default();
+        let health = if own {
+            &mut self.health
+        } else {
+            &mut pose_topics
+        };
         self.stamps
-            .next(m.stamp_ns, m.from_log_time, true, index, &mut self.health);
+            .next(m.stamp_ns, m.from_log_time, true, index, health);
         if self.frame_id.is_none() && !m.frame_id.is_empty() {
             self.frame_id = Some(m.frame_id);
         }

@@ -289,6 +289,7 @@ pub(super) fn no_covariance_topic(plan: &LogSummary) -> String {
         .chain(
             SensorKind::ALL
                 .iter()
+                .filter(|k| k.is_own_message())
                 .map(|k| (k.ros1_name(), k.ros2_name())),
         );
     let reads: Vec<String> = names

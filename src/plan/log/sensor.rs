@@ -32,13 +32,25 @@ pub struct BlockSpec {
     pub axes: [&'static str; 3],
 }
 
-/// The message types posecov reads covariances from that are not poses.
+/// The message types posecov reads covariances from that are not poses, and the twist half of
+/// `nav_msgs/Odometry`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SensorKind {
     /// `sensor_msgs/Imu` (REP 145): orientation, angular velocity and linear acceleration,
     /// each with its 3 × 3 covariance in the message's `header.frame_id` axes.
     Imu,
+    /// `geometry_msgs/TwistWithCovarianceStamped` (wheel or visual odometry's velocity): the
+    /// two 3 × 3 diagonal blocks of `twist.covariance` (linear, angular), in `header.frame_id`.
+    Twist,
+    /// `geometry_msgs/AccelWithCovarianceStamped`: the two 3 × 3 diagonal blocks of
+    /// `accel.covariance` (linear, angular), in `header.frame_id`.
+    Accel,
+    /// The twist half of a `nav_msgs/Odometry` pose topic: `twist.covariance`'s two diagonal
+    /// blocks, in the message's `child_frame_id` (nav_msgs/Odometry: "the twist in this message
+    /// should be specified in the coordinate frame given by the child_frame_id"). Read beside
+    /// the topic's pose, which it leaves unchanged; its stamps are the pose's, checked there.
+    OdometryTwist,
 }
 
 /// An IMU's three blocks, in the message's order.
@@ -60,9 +72,78 @@ const IMU_BLOCKS: [BlockSpec; 3] = [
     },
 ];
 
+/// A twist's two blocks (`twist.covariance` rows and columns 0–2, then 3–5).
+const TWIST_BLOCKS: [BlockSpec; 2] = [
+    BlockSpec {
+        name: "linear_velocity",
+        unit: "m/s",
+        axes: ["x", "y", "z"],
+    },
+    IMU_BLOCKS[1],
+];
+
+/// An acceleration's two blocks (`accel.covariance` rows and columns 0–2, then 3–5).
+const ACCEL_BLOCKS: [BlockSpec; 2] = [
+    IMU_BLOCKS[2],
+    BlockSpec {
+        name: "angular_acceleration",
+        unit: "rad/s²",
+        axes: ["x", "y", "z"],
+    },
+];
+
 impl SensorKind {
     /// Every sensor kind.
-    pub const ALL: [SensorKind; 1] = [SensorKind::Imu];
+    pub const ALL: [SensorKind; 4] = [
+        SensorKind::Imu,
+        SensorKind::Twist,
+        SensorKind::Accel,
+        SensorKind::OdometryTwist,
+    ];
+
+    /// Whether the kind is a message type of its own (a topic of it is a sensor topic), not a
+    /// part of a pose topic's message ([`SensorKind::OdometryTwist`]).
+    ///
+    /// ```
+    /// use posecov::plan::log::SensorKind;
+    /// assert!(SensorKind::Twist.is_own_message() && !SensorKind::OdometryTwist.is_own_message());
+    /// ```
+    pub fn is_own_message(self) -> bool {
+        self != SensorKind::OdometryTwist
+    }
+
+    /// The message field whose value names the frame the covariances are in.
+    ///
+    /// ```
+    /// use posecov::plan::log::SensorKind;
+    /// assert_eq!(SensorKind::OdometryTwist.frame_field(), "child_frame_id");
+    /// ```
+    pub fn frame_field(self) -> &'static str {
+        match self {
+            SensorKind::OdometryTwist => "child_frame_id",
+            _ => "header.frame_id",
+        }
+    }
+
+    /// The message field a block's covariance is, as a user reads it in the message
+    /// (`orientation_covariance`; `twist.covariance[0:3, 0:3]` for a 6 × 6 field's block: its
+    /// rows and columns, end excluded).
+    ///
+    /// ```
+    /// use posecov::plan::log::SensorKind;
+    /// let k = SensorKind::Accel;
+    /// assert_eq!(k.field(&k.blocks()[1]), "accel.covariance[3:6, 3:6]");
+    /// assert_eq!(SensorKind::Imu.field(&SensorKind::Imu.blocks()[0]), "orientation_covariance");
+    /// ```
+    pub fn field(self, block: &BlockSpec) -> String {
+        let six = match self {
+            SensorKind::Twist | SensorKind::OdometryTwist => "twist",
+            SensorKind::Accel => "accel",
+            _ => return format!("{}_covariance", block.name),
+        };
+        let k = self.blocks().iter().position(|b| b == block).unwrap_or(0) * 3;
+        format!("{six}.covariance[{k}:{}, {k}:{}]", k + 3, k + 3)
+    }
 
     /// The ROS 1 type name (`sensor_msgs/Imu`).
     ///
@@ -72,6 +153,9 @@ impl SensorKind {
     pub fn ros1_name(self) -> &'static str {
         match self {
             SensorKind::Imu => "sensor_msgs/Imu",
+            SensorKind::Twist => "geometry_msgs/TwistWithCovarianceStamped",
+            SensorKind::Accel => "geometry_msgs/AccelWithCovarianceStamped",
+            SensorKind::OdometryTwist => "nav_msgs/Odometry",
         }
     }
 
@@ -83,6 +167,9 @@ impl SensorKind {
     pub fn ros2_name(self) -> &'static str {
         match self {
             SensorKind::Imu => "sensor_msgs/msg/Imu",
+            SensorKind::Twist => "geometry_msgs/msg/TwistWithCovarianceStamped",
+            SensorKind::Accel => "geometry_msgs/msg/AccelWithCovarianceStamped",
+            SensorKind::OdometryTwist => "nav_msgs/msg/Odometry",
         }
     }
 
@@ -95,6 +182,8 @@ impl SensorKind {
     pub fn blocks(self) -> &'static [BlockSpec] {
         match self {
             SensorKind::Imu => &IMU_BLOCKS,
+            SensorKind::Twist | SensorKind::OdometryTwist => &TWIST_BLOCKS,
+            SensorKind::Accel => &ACCEL_BLOCKS,
         }
     }
 
@@ -111,6 +200,23 @@ impl SensorKind {
         match issue {
             Issue::UnknownMarker => Class::Note,
             other => other.class(false),
+        }
+    }
+
+    /// The class of `issue` on a block or topic of this kind: [`SensorKind::class`], except
+    /// `all_zero` on an Odometry's twist, a note: many odometry publishers leave the twist
+    /// covariance unset, and a consumer of the pose never reads it (on a
+    /// `TwistWithCovarianceStamped`, published to be fused, it stays a defect).
+    ///
+    /// ```
+    /// use posecov::plan::log::{Class, Issue, SensorKind};
+    /// assert_eq!(SensorKind::OdometryTwist.class_of(Issue::AllZero), Class::Note);
+    /// assert_eq!(SensorKind::Twist.class_of(Issue::AllZero), Class::Defect);
+    /// ```
+    pub fn class_of(self, issue: Issue) -> Class {
+        match (self, issue) {
+            (SensorKind::OdometryTwist, Issue::AllZero) => Class::Note,
+            _ => Self::class(issue),
         }
     }
 }
@@ -187,7 +293,7 @@ impl SensorTopicSummary {
         });
         let mut all: Vec<_> = own
             .chain(blocks)
-            .map(|(b, i, c)| (b, i, c, SensorKind::class(i)))
+            .map(|(b, i, c)| (b, i, c, self.kind.class_of(i)))
             .collect();
         all.sort_by_key(|f| f.3);
         all.into_iter()
