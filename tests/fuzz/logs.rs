@@ -30,7 +30,8 @@ pub enum LogKind {
     Ros1,
     Mcap,
     Db3,
-    /// ROS 1 bags of `sensor_msgs/Imu` (tests/data/imu): mutations reach the IMU messages.
+    /// ROS 1 bags of sensor messages, `sensor_msgs/Imu` (tests/data/imu) and
+    /// `sensor_msgs/NavSatFix` (tests/data/navsat): mutations reach the sensor messages.
     Imu,
 }
 
@@ -50,7 +51,7 @@ impl Logs {
             LogKind::Ros1 => bundled.chain([small_bag()]).collect(),
             LogKind::Mcap => bundled.collect(),
             LogKind::Db3 => DB3_SEEDS.iter().map(|s| s.to_vec()).collect(),
-            LogKind::Imu => vec![IMU_SEED.to_vec()],
+            LogKind::Imu => vec![IMU_SEED.to_vec(), NAVSAT_SEED.to_vec()],
         };
         Self { kind, seeds }
     }
@@ -77,6 +78,11 @@ pub const DB3_SEEDS: [&[u8]; 3] = [
 /// written by PyPI `rosbags` (tests/data/imu/make_imu.py).
 pub const IMU_SEED: &[u8] = include_bytes!("../data/imu/imu_rep145.bag");
 
+/// The second `imu` seed: an uncompressed ROS 1 bag of four `sensor_msgs/NavSatFix` topics
+/// (known, unknown with a NO_FIX, approximated, diagonal known with off-diagonal entries),
+/// written by PyPI `rosbags` (tests/data/navsat/make_navsat.py).
+pub const NAVSAT_SEED: &[u8] = include_bytes!("../data/navsat/navsat.bag");
+
 /// Strings the mutator inserts: record field names and values of both formats.
 const TOKENS: &[&str] = &[
     "op=",
@@ -101,6 +107,10 @@ const TOKENS: &[&str] = &[
     "geometry_msgs/msg/PoseWithCovarianceStamped",
     "type=sensor_msgs/Imu",
     "sensor_msgs/msg/Imu",
+    "type=sensor_msgs/NavSatFix",
+    "sensor_msgs/msg/NavSatFix",
+    "\u{3}",
+    "\u{7f}",
 ];
 
 impl Family for Logs {

@@ -39,6 +39,10 @@ pub enum SensorKind {
     /// `sensor_msgs/Imu` (REP 145): orientation, angular velocity and linear acceleration,
     /// each with its 3 × 3 covariance in the message's `header.frame_id` axes.
     Imu,
+    /// `sensor_msgs/NavSatFix`: a GNSS fix (WGS84 latitude, longitude, altitude) and its
+    /// position covariance, m², in the East-North-Up tangent plane at the fix (REP 145, the
+    /// message's comment), with its `position_covariance_type`.
+    NavSatFix,
 }
 
 /// An IMU's three blocks, in the message's order.
@@ -60,9 +64,16 @@ const IMU_BLOCKS: [BlockSpec; 3] = [
     },
 ];
 
+/// A fix's one block: its position in the East-North-Up plane at the fix.
+const NAVSAT_BLOCKS: [BlockSpec; 1] = [BlockSpec {
+    name: "position",
+    unit: "m",
+    axes: ["east", "north", "up"],
+}];
+
 impl SensorKind {
     /// Every sensor kind.
-    pub const ALL: [SensorKind; 1] = [SensorKind::Imu];
+    pub const ALL: [SensorKind; 2] = [SensorKind::Imu, SensorKind::NavSatFix];
 
     /// The ROS 1 type name (`sensor_msgs/Imu`).
     ///
@@ -72,6 +83,7 @@ impl SensorKind {
     pub fn ros1_name(self) -> &'static str {
         match self {
             SensorKind::Imu => "sensor_msgs/Imu",
+            SensorKind::NavSatFix => "sensor_msgs/NavSatFix",
         }
     }
 
@@ -83,6 +95,7 @@ impl SensorKind {
     pub fn ros2_name(self) -> &'static str {
         match self {
             SensorKind::Imu => "sensor_msgs/msg/Imu",
+            SensorKind::NavSatFix => "sensor_msgs/msg/NavSatFix",
         }
     }
 
@@ -95,16 +108,21 @@ impl SensorKind {
     pub fn blocks(self) -> &'static [BlockSpec] {
         match self {
             SensorKind::Imu => &IMU_BLOCKS,
+            SensorKind::NavSatFix => &NAVSAT_BLOCKS,
         }
     }
 
     /// The class of `issue` on a sensor's block or topic. As on a pose topic
     /// ([`Issue::class`] of a topic that is not dead-reckoned), except `unknown_marker`: REP 145
     /// defines −1 in element 0 as "not provided", a note (the block is then not checked).
+    /// A NavSatFix's `covariance_type_unknown`, `covariance_approximated` and `no_fix` are
+    /// notes, `diagonal_known_off_diagonal` a defect ([`Issue::class`]).
     ///
     /// ```
     /// use posecov::plan::log::{Class, Issue, SensorKind};
     /// assert_eq!(SensorKind::class(Issue::AllZero), Class::Defect);
+    /// assert_eq!(SensorKind::class(Issue::CovarianceTypeUnknown), Class::Note);
+    /// assert_eq!(SensorKind::class(Issue::DiagonalKnownOffDiagonal), Class::Defect);
     /// assert_eq!(SensorKind::class(Issue::Constant), Class::Note);
     /// ```
     pub fn class(issue: Issue) -> Class {
@@ -160,6 +178,54 @@ pub struct SensorTopicSummary {
     pub blocks: Vec<BlockSummary>,
     /// σ over the stamp (bounded, in stamp order).
     pub series: Vec<SensorSeriesPoint>,
+    /// What is drawn of it ([`SensorDrawn`]).
+    pub drawn: SensorDrawn,
+}
+
+/// What a sensor topic keeps for drawing: a NavSatFix's fixes, an IMU's newest orientation.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SensorDrawn {
+    /// A NavSatFix's fixes (status not `NO_FIX`, a finite position), thinned as a pose topic's
+    /// drawn messages (`--every`), in message order.
+    pub fixes: Vec<FixPoint>,
+    /// An IMU's newest message whose orientation is a unit quaternion and whose orientation
+    /// block is usable and estimates some axis.
+    pub orientation: Option<OrientationPoint>,
+}
+
+/// One GNSS fix kept for drawing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixPoint {
+    /// The message's number on its topic.
+    pub index: u64,
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// WGS84 latitude, degrees (north positive).
+    pub latitude_deg: f64,
+    /// WGS84 longitude, degrees (east positive).
+    pub longitude_deg: f64,
+    /// Altitude above the WGS84 ellipsoid, m.
+    pub altitude_m: f64,
+    /// The position covariance, row-major over (east, north, up), m², when its block is usable
+    /// and checked.
+    pub covariance_enu: Option<[f64; 9]>,
+}
+
+/// An IMU's orientation at one message and its orientation covariance (for the spray of
+/// SO(3) samples).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrientationPoint {
+    /// The message's number on its topic.
+    pub index: u64,
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// `orientation` (x, y, z, w): parent_from_imu.
+    pub orientation_xyzw: [f64; 4],
+    /// `orientation_covariance`, row-major over rotations about x, y, z, rad², with the rows
+    /// and columns of an axis not estimated zeroed.
+    pub covariance: [f64; 9],
+    /// The axes whose variance is not estimated (0 or ≥ 1e6): not sprayed.
+    pub unestimated: [bool; 3],
 }
 
 impl SensorTopicSummary {
