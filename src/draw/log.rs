@@ -87,9 +87,11 @@ pub struct LogDrawSettings {
 /// let topic = paths::topic("/jackal_velocity_controller/odom");
 /// assert_eq!(topic, "world/jackal_velocity_controller/odom");
 /// assert!(scene.items.iter().any(|i| i.path == paths::child(&topic, "meaning/banana")));
-/// // Beside the whole trajectory (84 m), the selected message at the robot's scale.
-/// assert_eq!(scene.views.len(), 2);
+/// // Beside the whole trajectory (84 m), the selected message at the robot's scale, and the
+/// // IMU's orientation spray.
+/// assert_eq!(scene.views.len(), 3);
 /// assert_eq!(scene.views[1].include, vec![paths::child(&topic, "robot")]);
+/// assert_eq!(scene.views[2].include, vec![paths::orientation_spray("/imu/data")]);
 /// ```
 pub fn draw_log(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene {
     super::counted(build(e, settings, summary))

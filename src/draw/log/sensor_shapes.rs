@@ -200,7 +200,7 @@ fn spray(p: &mut Painter, t: &SensorEvaluation, s: &OrientationSpray) {
             translation: [0.0; 3],
             rotation: s.mean.to_quaternion_xyzw(),
             axis_length: 1.0,
-            label: Some(format!("message {}: mean orientation", s.index)),
+            label: Some(format!("mean orientation at message {}", s.index)),
         }),
     );
     for (axis, color) in AXIS_COLORS.iter().enumerate() {
@@ -309,15 +309,30 @@ pub(super) fn shapes_paragraph(e: &LogEvaluation, confidence: Confidence, s: &mu
             let _ = writeln!(
                 s,
                 "\n**{}** drawn: its orientation at message {} with {} seeded samples' axis \
-                 tips, the covariance read {}: {}.",
+                 tips, the covariance read {}: {}.{}",
                 t.name,
                 sp.index,
                 sp.samples.len(),
                 side_words(sp.side),
-                sigma.join(", ")
+                sigma.join(", "),
+                zoom_words(sp)
             );
         }
     }
+}
+
+/// When a spray is too tight to see at 1 m (largest σ below 1°): how close to the axis tips
+/// its samples lie (3 σ at 1 m), and that the view must be zoomed.
+fn zoom_words(s: &OrientationSpray) -> String {
+    let largest = s.sigma.iter().flatten().fold(0.0, |m: f64, v| m.max(*v));
+    if largest.to_degrees() >= 1.0 {
+        return String::new();
+    }
+    format!(
+        " The samples lie within about {:.1} mm of the 1 m axis tips (3 σ): zoom on a tip to \
+         see them.",
+        3.0 * largest * 1e3
+    )
 }
 
 /// The points a view's static items draw (for its camera).

@@ -182,7 +182,7 @@ mod tests {
             altitude_m: h,
             covariance_enu: Some([4.0, 1.0, 0.0, 1.0, 9.0, 0.0, 0.0, 0.0, 16.0]),
         };
-        // Munich: 1e-4° of longitude is 7.45 m east (N cos φ); 1e-4° of latitude 11.12 m.
+        // Munich: 1e-4° of longitude is 7.44 m east ((N + h) cos φ); 1e-4° of latitude 11.12 m.
         let l = local_fixes(&[
             fix(48.137, 11.575, 520.0),
             fix(48.137, 11.5751, 521.0),
@@ -192,11 +192,11 @@ mod tests {
         assert_eq!(l.fixes[0].east_north_up, [0.0, 0.0, 0.0]);
         let e = l.fixes[1].east_north_up;
         assert!(
-            (e[0] - 7.4505).abs() < 1e-3 && e[1] == 0.0 && e[2] == 1.0,
+            (e[0] - 7.4434).abs() < 1e-3 && e[1] == 0.0 && e[2] == 1.0,
             "{e:?}"
         );
         let n = l.fixes[2].east_north_up;
-        assert!(n[0] == 0.0 && (n[1] - 11.1265).abs() < 1e-3, "{n:?}");
+        assert!(n[0] == 0.0 && (n[1] - 11.1202).abs() < 1e-3, "{n:?}");
         assert_eq!(l.fixes[0].covariance_en, Some([4.0, 1.0, 1.0, 9.0]));
         // Across the antimeridian: a small step east, not 360° west.
         let w = local_fixes(&[fix(0.0, 179.9999, 0.0), fix(0.0, -179.9999, 0.0)]).unwrap();

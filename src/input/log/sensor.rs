@@ -338,7 +338,8 @@ impl SensorState {
         }
         let q = m.orientation_xyzw;
         let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if self.kind != SensorKind::Imu || !((norm - 1.0).abs() < 1e-6) {
+        let unit = (norm - 1.0).abs() < 1e-6; // false for NaN too
+        if self.kind != SensorKind::Imu || !unit {
             return;
         }
         let unestimated = sigma[0].map(|s| s.is_none());
