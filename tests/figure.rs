@@ -210,9 +210,10 @@ fn a_log_has_a_panel_per_view_and_its_last_message_once() {
         &Overrides::default(),
     )
     .expect("scene");
+    // A third: the IMU's orientation spray (issue 32).
     assert_eq!(
         s.views.len(),
-        2,
+        3,
         "{:?}",
         s.views.iter().map(|v| &v.name).collect::<Vec<_>>()
     );
@@ -230,7 +231,7 @@ fn a_log_has_a_panel_per_view_and_its_last_message_once() {
     }
     assert_eq!(
         text.matches("clip-path=\"url(#world").count(),
-        2,
+        3,
         "{summary}"
     );
     let labels: Vec<&str> = summary

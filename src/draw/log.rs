@@ -43,6 +43,7 @@ mod plots;
 mod robot;
 mod rviz;
 mod sensor;
+mod sensor_shapes;
 mod text;
 
 pub use frames::frame_problem_sentence;
@@ -87,9 +88,11 @@ pub struct LogDrawSettings {
 /// let topic = paths::topic("/jackal_velocity_controller/odom");
 /// assert_eq!(topic, "world/jackal_velocity_controller/odom");
 /// assert!(scene.items.iter().any(|i| i.path == paths::child(&topic, "meaning/banana")));
-/// // Beside the whole trajectory (84 m), the selected message at the robot's scale.
-/// assert_eq!(scene.views.len(), 2);
+/// // Beside the whole trajectory (84 m), the selected message at the robot's scale, and the
+/// // IMU's orientation spray.
+/// assert_eq!(scene.views.len(), 3);
 /// assert_eq!(scene.views[1].include, vec![paths::child(&topic, "robot")]);
+/// assert_eq!(scene.views[2].include, vec![paths::orientation_spray("/imu/data")]);
 /// ```
 pub fn draw_log(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene {
     super::counted(build(e, settings, summary))
@@ -123,6 +126,7 @@ fn build(e: &LogEvaluation, settings: &LogDrawSettings, summary: &str) -> Scene 
     for (k, topic) in e.topics.iter().enumerate() {
         draw_topic(&mut p, k, topic, noting.contains(&topic.name.as_str()));
     }
+    sensor_shapes::draw_sensor_shapes(&mut p, e);
     // Dates, or durations when the stamps are not dates (simulated time).
     let stamps = p.scene.items.iter().filter_map(|i| match i.timing {
         Timing::Stamp(ns) => Some(ns),
@@ -232,14 +236,26 @@ fn log_views(scene: &Scene, e: &LogEvaluation, planar: bool) -> Vec<View3d> {
         let points = views::points_of(scene, &view, |i| i.timing == at);
         out.push((view, points));
     }
-    // Each camera fitted to the shape its view has above the plots.
-    let aspect = views_aspect(scene, out.len());
-    out.into_iter()
-        .map(|(mut view, points)| {
-            view.camera = views::camera(&points, &inputs, aspect);
-            view
+    // A sensor's drawing (fixes seen from above, an IMU's spray): its own view.
+    let sensors: Vec<_> = sensor_shapes::sensor_views(e)
+        .into_iter()
+        .map(|(view, top)| {
+            let points = sensor_shapes::view_points(scene, &view);
+            (view, points, top)
         })
-        .collect()
+        .collect();
+    // Each camera fitted to the shape its view has above the plots.
+    let aspect = views_aspect(scene, out.len() + sensors.len());
+    let topics = out.into_iter().map(|(mut view, points)| {
+        view.camera = views::camera(&points, &inputs, aspect);
+        view
+    });
+    let sensors = sensors.into_iter().map(|(mut view, points, top)| {
+        let inputs = views::ViewInputs { top, ..inputs };
+        view.camera = views::camera(&points, &inputs, aspect);
+        view
+    });
+    topics.chain(sensors).collect()
 }
 
 fn extent(e: &LogEvaluation) -> f64 {

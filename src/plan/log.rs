@@ -33,7 +33,8 @@ mod health;
 pub use health::{Class, Health, Issue, IssueCount, Stretch};
 mod sensor;
 pub use sensor::{
-    BlockSpec, BlockSummary, MAX_BLOCKS, SensorKind, SensorSeriesPoint, SensorTopicSummary,
+    BlockSpec, BlockSummary, FixPoint, MAX_BLOCKS, OrientationPoint, SensorDrawn, SensorKind,
+    SensorSeriesPoint, SensorTopicSummary,
 };
 
 /// A variance at or above this is a placeholder ("not estimated"), not a measurement.

@@ -229,6 +229,26 @@ pub fn robot(topic_name: &str) -> String {
     child(&topic(topic_name), "robot")
 }
 
+/// A NavSatFix topic's fixes in the local East-North plane at its first fix:
+/// `world/<topic>/fixes`.
+///
+/// ```
+/// assert_eq!(posecov::scene::paths::fixes("/gps/fix"), "world/gps/fix/fixes");
+/// ```
+pub fn fixes(topic_name: &str) -> String {
+    child(&topic(topic_name), "fixes")
+}
+
+/// An IMU topic's orientation spray (SO(3) samples at one message):
+/// `world/<topic>/orientation_spray`.
+///
+/// ```
+/// assert_eq!(posecov::scene::paths::orientation_spray("/imu"), "world/imu/orientation_spray");
+/// ```
+pub fn orientation_spray(topic_name: &str) -> String {
+    child(&topic(topic_name), "orientation_spray")
+}
+
 /// A plot's entity: `plots/<plot>`.
 ///
 /// ```

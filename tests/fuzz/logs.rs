@@ -30,8 +30,9 @@ pub enum LogKind {
     Ros1,
     Mcap,
     Db3,
-    /// ROS 1 bags of sensor messages: `sensor_msgs/Imu` (tests/data/imu), twists,
-    /// accelerations and an Odometry's twist (tests/data/twist): mutations reach their messages.
+    /// ROS 1 bags of sensor messages: `sensor_msgs/Imu` (tests/data/imu), `sensor_msgs/NavSatFix`
+    /// (tests/data/navsat), twists, accelerations and an Odometry's twist (tests/data/twist):
+    /// mutations reach their messages.
     Imu,
 }
 
@@ -51,7 +52,7 @@ impl Logs {
             LogKind::Ros1 => bundled.chain([small_bag()]).collect(),
             LogKind::Mcap => bundled.collect(),
             LogKind::Db3 => DB3_SEEDS.iter().map(|s| s.to_vec()).collect(),
-            LogKind::Imu => vec![IMU_SEED.to_vec(), TWIST_SEED.to_vec()],
+            LogKind::Imu => vec![IMU_SEED.to_vec(), NAVSAT_SEED.to_vec(), TWIST_SEED.to_vec()],
         };
         Self { kind, seeds }
     }
@@ -80,10 +81,14 @@ pub const DB3_SEEDS: [&[u8]; 4] = [
 /// written by PyPI `rosbags` (tests/data/imu/make_imu.py).
 pub const IMU_SEED: &[u8] = include_bytes!("../data/imu/imu_rep145.bag");
 
-/// The `imu` family's second seed: an uncompressed ROS 1 bag of `TwistWithCovarianceStamped`,
+/// An `imu` seed: an uncompressed ROS 1 bag of `TwistWithCovarianceStamped`,
 /// `AccelWithCovarianceStamped` and `nav_msgs/Odometry` (a PSD defect, all zero, −1, placeholders),
 /// written by PyPI `rosbags` (tests/data/twist/make_twist.py).
 pub const TWIST_SEED: &[u8] = include_bytes!("../data/twist/twist.bag");
+/// An `imu` seed: an uncompressed ROS 1 bag of four `sensor_msgs/NavSatFix` topics
+/// (known, unknown with a NO_FIX, approximated, diagonal known with off-diagonal entries),
+/// written by PyPI `rosbags` (tests/data/navsat/make_navsat.py).
+pub const NAVSAT_SEED: &[u8] = include_bytes!("../data/navsat/navsat.bag");
 
 /// Strings the mutator inserts: record field names and values of both formats.
 const TOKENS: &[&str] = &[
@@ -111,6 +116,10 @@ const TOKENS: &[&str] = &[
     "sensor_msgs/msg/Imu",
     "type=geometry_msgs/TwistWithCovarianceStamped",
     "geometry_msgs/msg/AccelWithCovarianceStamped",
+    "type=sensor_msgs/NavSatFix",
+    "sensor_msgs/msg/NavSatFix",
+    "\u{3}",
+    "\u{7f}",
 ];
 
 impl Family for Logs {

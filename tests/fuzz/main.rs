@@ -10,7 +10,7 @@
 //! | `graph` | the g2o / GTSAM / TORO graphs, mutated by token, line and byte | read → lower → evaluate (16 samples) → draw → validate → `report --json` |
 //! | `ros1` | the bundled bz2 bag and a small uncompressed bag written here, mutated by byte (lengths and counts set to edge values) | read → evaluate → draw → validate → `report --json` |
 //! | `mcap` | the bundled MCAP, mutated by byte | the same |
-//! | `imu` | ROS 1 bags of sensor messages: `sensor_msgs/Imu` (tests/data/imu: −1 "not provided", all-zero covariances), twists, accelerations and an Odometry's twist (tests/data/twist), mutated by byte | the same |
+//! | `imu` | ROS 1 bags of sensor messages: `sensor_msgs/Imu` (tests/data/imu: −1 "not provided", all-zero covariances), `sensor_msgs/NavSatFix` (tests/data/navsat: each `position_covariance_type`, a NO_FIX), twists, accelerations and an Odometry's twist (tests/data/twist), mutated by byte | the same |
 //! | `db3` | four ROS 2 SQLite bags: three of tests/data/ros2 (version 9, Humble's 5, zstd messages) and tests/data/twist's CDR twists, accelerations and Odometry, mutated by byte | the same |
 //! | `ov_eval` | the OpenVINS text trajectories of tests/data/ov_eval (cut) and one mixing 8- and 20-column lines, mutated by token, line and byte | read as an estimate → evaluate → draw → validate → `report --json`; read as a NEES reference (the TUM reader) |
 //! | `live_ws` | a scripted Foxglove WebSocket server on 127.0.0.1, each session a good one (a ROS 2 and a ROS 1 pose topic) damaged: frames' JSON and bytes mutated, bad frames of the list inserted, frames dropped, repeated, swapped | `report --json` of `ws://127.0.0.1:PORT` (read → evaluate → report), Ctrl-C once the server is done |
@@ -178,7 +178,7 @@ fn seeds_are_valid() {
         assert!(found.iter().all(|f| f.class == "ok"), "db3 seed: {found:?}");
     }
     let imu = logs::Logs::new(logs::LogKind::Imu);
-    for seed in [logs::IMU_SEED, logs::TWIST_SEED] {
+    for seed in [logs::IMU_SEED, logs::NAVSAT_SEED, logs::TWIST_SEED] {
         let (found, _) = imu.check(seed, &limits);
         assert!(found.iter().all(|f| f.class == "ok"), "imu seed: {found:?}");
     }

@@ -6,6 +6,7 @@ use serde_json::{Map, Value, json};
 use super::{stamp_seconds, stamps_json};
 use crate::draw::log::{issue_word, sensor_sentence};
 use crate::eval::log::sensor::SensorEvaluation;
+use crate::eval::log::sensor_shapes::LocalFixes;
 use crate::plan::log::{BlockSummary, Class, Health, Issue, LogSummary, SensorTopicSummary};
 
 /// A health map as the pose topics' (`health` in json-report.md): per finding its class, count,
@@ -64,7 +65,7 @@ pub(super) fn sensors_json(plan: &LogSummary, e: &[SensorEvaluation]) -> Value {
                     (b.spec.name.to_owned(), value)
                 })
                 .collect();
-            json!({
+            let mut topic = json!({
                 "name": t.name,
                 "type": t.kind.ros1_name(),
                 "kind": t.kind,
@@ -74,10 +75,32 @@ pub(super) fn sensors_json(plan: &LogSummary, e: &[SensorEvaluation]) -> Value {
                 "stamps": stamps_json(t.stamp_range, t.stamps_from_log_time, t.stamps_out_of_order),
                 "health": health_json(&t.health, None, t),
                 "blocks": blocks,
-            })
+            });
+            if let Some(l) = &te.fixes {
+                topic["fixes"] = fixes_json(l);
+            }
+            topic
         })
         .collect();
     Value::Array(topics)
+}
+
+/// `fixes` of a NavSatFix topic: the tangent plane its fixes are drawn in.
+fn fixes_json(l: &LocalFixes) -> Value {
+    let [latitude_deg, longitude_deg, altitude_m] = l.origin;
+    json!({
+        "projection": "local_tangent_wgs84",
+        "origin": {
+            "latitude_deg": latitude_deg,
+            "longitude_deg": longitude_deg,
+            "altitude_m": altitude_m,
+            "message": l.fixes.first().map_or(0, |f| f.index),
+        },
+        "meridian_radius_m": l.radii[0],
+        "prime_vertical_radius_m": l.radii[1],
+        "drawn": l.fixes.len(),
+        "with_region": l.fixes.iter().filter(|f| f.covariance_en.is_some()).count(),
+    })
 }
 
 /// What `check` says of the sensor topics: for each topic with a defect not in `allow`, its

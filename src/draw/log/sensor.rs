@@ -1,8 +1,8 @@
-//! A log's sensor topics (`sensor_msgs/Imu`, twists and accelerations with covariance, an
-//! Odometry's twist) in words and plots: each finding's sentence
+//! A log's sensor topics (`sensor_msgs/Imu`, `sensor_msgs/NavSatFix`, twists and accelerations
+//! with covariance, an Odometry's twist) in words and plots: each finding's sentence
 //! ([`sensor_sentence`]), a paragraph per topic in the text panel, and one σ plot per kind of
 //! block (`σ orientation`, `σ angular velocity`, `σ linear acceleration`, `σ linear velocity`,
-//! `σ angular acceleration`) over the stamp, one
+//! `σ angular acceleration`, a fix's `σ position`) over the stamp, one
 //! line per topic and axis, in a unit fitted to the values. Velocities and accelerations are
 //! σ plots only: there is nothing in the world view to put them on.
 
@@ -74,6 +74,23 @@ pub fn sensor_sentence(
             t.health.other_types.join(", "),
             t.kind.ros1_name()
         ),
+        Issue::CovarianceTypeUnknown => format!(
+            "position_covariance_type = COVARIANCE_TYPE_UNKNOWN (0): the receiver gives no \
+             covariance; {field} is not checked and its σ not plotted (an estimator fusing this \
+             fix needs one: set it from the receiver's accuracy, or a measured one)."
+        ),
+        Issue::CovarianceApproximated => format!(
+            "position_covariance_type = COVARIANCE_TYPE_APPROXIMATED (1): {field} is made up \
+             (e.g. from the dilution of precision), not the receiver's estimate."
+        ),
+        Issue::DiagonalKnownOffDiagonal => format!(
+            "position_covariance_type = COVARIANCE_TYPE_DIAGONAL_KNOWN (2), but {field} has \
+             off-diagonal entries that are not 0: the type says only the variances are known, \
+             the numbers say more (use COVARIANCE_TYPE_KNOWN (3), or zero them)."
+        ),
+        Issue::NoFix => "status = STATUS_NO_FIX (−1): the receiver has no position; the fix \
+             is not drawn."
+            .to_owned(),
         Issue::FrozenStamp => "the same header stamp as the message before.".to_owned(),
         Issue::StampFallback => "a zero header stamp: the log time is used.".to_owned(),
         Issue::StampOrder => "stamped earlier than the message before.".to_owned(),
@@ -146,11 +163,21 @@ fn unit_for(si: &'static str, max: f64) -> (&'static str, f64) {
         "m/s²" if max < 0.1 => ("mm/s²", 1e3),
         "m/s" if max < 0.1 => ("mm/s", 1e3),
         "rad/s²" if max < 0.1 => ("mrad/s²", 1e3),
+        "m" if max < 0.1 => ("mm", 1e3),
         other => (other, 1.0),
     }
 }
 
-/// One σ plot per kind of block over the stamp (id `sigma_<block>`), one line per sensor
+/// A sensor block's σ plot: `sigma_<block>`, but `sigma_fix_position` for a fix's `position`
+/// (the pose topics' σ xyz plot is `sigma_position`).
+fn plot_id(spec: &crate::plan::log::BlockSpec) -> PlotId {
+    match spec.name {
+        "position" => PlotId::new("sigma_fix_position"),
+        name => PlotId::new(format!("sigma_{name}")),
+    }
+}
+
+/// One σ plot per kind of block over the stamp (id [`plot_id`]), one line per sensor
 /// topic and axis, ranged from 0 with room above.
 pub(super) fn sensor_plots(scene: &mut Scene, e: &LogEvaluation) {
     let several = e.sensors.len() > 1;
@@ -196,7 +223,7 @@ pub(super) fn sensor_plots(scene: &mut Scene, e: &LogEvaluation) {
             .flat_map(|l| l.3.iter().map(|p| p.1))
             .fold(0.0, f64::max);
         let (unit, factor) = unit_for(spec.unit, max);
-        let id = PlotId::new(format!("sigma_{}", spec.name));
+        let id = plot_id(spec);
         scene.plots.push(Plot {
             id: id.clone(),
             title: format!("σ {}", spec.name.replace('_', " ")),
@@ -226,5 +253,7 @@ mod tests {
         assert_eq!(unit_for("rad/s", 0.01), ("mrad/s", 1e3));
         assert_eq!(unit_for("m/s²", 0.5), ("m/s²", 1.0));
         assert_eq!(unit_for("rad", 0.001), ("mrad", 1e3));
+        assert_eq!(unit_for("m", 0.05), ("mm", 1e3));
+        assert_eq!(unit_for("m", 2.0), ("m", 1.0));
     }
 }

@@ -43,6 +43,10 @@ pub fn issue_word(issue: Issue) -> &'static str {
         Issue::TfMissingLink => "frames /tf does not join",
         Issue::TfNoTransform => "a frame never in /tf",
         Issue::TfTiltsPlane => "a transform that tilts the plane",
+        Issue::CovarianceTypeUnknown => "covariance type unknown",
+        Issue::CovarianceApproximated => "covariance approximated",
+        Issue::DiagonalKnownOffDiagonal => "off-diagonal entries in a diagonal covariance",
+        Issue::NoFix => "no fix",
     }
 }
 
@@ -151,6 +155,11 @@ pub fn issue_sentence(issue: Issue, t: &TopicSummary) -> String {
             "the transform to the common frame tilts this planar topic's plane: drawn apart."
                 .to_owned()
         }
+        // A NavSatFix's own: said on its sensor topic by `sensor_sentence`.
+        Issue::CovarianceTypeUnknown
+        | Issue::CovarianceApproximated
+        | Issue::DiagonalKnownOffDiagonal
+        | Issue::NoFix => format!("{}.", issue_word(issue)),
     }
 }
 
@@ -240,6 +249,7 @@ pub fn description(
         topic(&mut s, t, te, confidence, e.reading);
     }
     super::sensor::sensor_paragraph(plan, &mut s);
+    super::sensor_shapes::shapes_paragraph(e, confidence, &mut s);
     if !plan.skipped.is_empty() {
         let _ = writeln!(s, "\n---\n\n**Skipped** (other message types):\n");
         for k in &plan.skipped {

@@ -21,6 +21,7 @@ pub mod frames;
 mod meaning;
 pub mod nees;
 pub mod sensor;
+pub mod sensor_shapes;
 pub mod stamped;
 
 use std::collections::BTreeMap;
@@ -43,6 +44,10 @@ use crate::uncertain::UncertainPose;
 
 /// Samples drawn per message by default (a cloud per drawn message).
 pub const DEFAULT_CLOUD_SAMPLES: usize = 100;
+
+/// The random family of sensor topic k's orientation spray is this + k (pose topic k's clouds
+/// are family k).
+pub const SPRAY_FAMILY: u64 = 1 << 32;
 
 /// What evaluating a log needs.
 #[derive(Debug, Clone, PartialEq)]
@@ -352,7 +357,16 @@ pub fn evaluate_log(plan: &mut LogSummary, settings: &LogEvalSettings) -> LogEva
         sensors: plan
             .sensors
             .iter_mut()
-            .map(sensor::evaluate_sensor)
+            .enumerate()
+            .map(|(k, t)| {
+                let mut e = sensor::evaluate_sensor(t);
+                e.orientation = t.drawn.orientation.as_ref().and_then(|o| {
+                    let family = SPRAY_FAMILY + k as u64;
+                    let n = settings.cloud_samples;
+                    sensor_shapes::orientation_spray(o, settings.reading, settings.seed, family, n)
+                });
+                e
+            })
             .collect(),
         reading: settings.reading,
         frames: FrameFindings {

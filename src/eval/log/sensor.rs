@@ -13,6 +13,7 @@
 //! assert_eq!(x.min, x.max); // test2.bag's IMU publishes one covariance throughout
 //! ```
 
+use super::sensor_shapes::{LocalFixes, OrientationSpray, local_fixes};
 use super::{SigmaSummary, summary_of};
 use crate::plan::log::{BlockSpec, SensorSeriesPoint, SensorTopicSummary};
 
@@ -34,6 +35,11 @@ pub struct SensorEvaluation {
     pub blocks: Vec<BlockEvaluation>,
     /// σ over the stamp (moved out of the plan).
     pub series: Vec<SensorSeriesPoint>,
+    /// A NavSatFix's drawn fixes in the tangent plane at the first ([`local_fixes`]).
+    pub fixes: Option<LocalFixes>,
+    /// An IMU's orientation spray at its newest usable message (set by `evaluate_log`, which
+    /// holds the seed and the reading).
+    pub orientation: Option<OrientationSpray>,
 }
 
 /// Evaluates one sensor topic: its σ series moves out of `topic` (empty afterwards).
@@ -59,5 +65,7 @@ pub fn evaluate_sensor(topic: &mut SensorTopicSummary) -> SensorEvaluation {
         name: topic.name.clone(),
         blocks,
         series,
+        fixes: local_fixes(&topic.drawn.fixes),
+        orientation: None,
     }
 }

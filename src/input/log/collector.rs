@@ -180,7 +180,7 @@ impl<'a, 'o> Collector<'a, 'o> {
                 // a type change).
                 let known = self.topics.contains_key(&stream.topic);
                 if !known && !self.sensors.contains_key(&stream.topic) {
-                    let state = SensorState::new(*kind);
+                    let state = SensorState::new(*kind, self.options.every);
                     self.sensors.insert(stream.topic.clone(), state);
                 }
             }
@@ -217,7 +217,7 @@ impl<'a, 'o> Collector<'a, 'o> {
         let state = self
             .sensors
             .entry(topic.to_owned())
-            .or_insert_with(|| SensorState::new(kind));
+            .or_insert_with(|| SensorState::new(kind, self.options.every));
         if state.kind != kind {
             let index = state.count();
             state
@@ -452,7 +452,7 @@ impl<'a, 'o> Collector<'a, 'o> {
             };
             self.twists
                 .entry(topic.to_owned())
-                .or_insert_with(|| SensorState::new(SensorKind::OdometryTwist))
+                .or_insert_with(|| SensorState::new(SensorKind::OdometryTwist, every))
                 .add(twist, log_time_ns);
         }
         let observer = self.observer.as_deref_mut();

@@ -6,10 +6,11 @@
 //! drawing, and time series are kept at a bounded length (halving their density when full).
 //!
 //! Messages read: `nav_msgs/Odometry`, `geometry_msgs/PoseWithCovarianceStamped`,
-//! `geometry_msgs/PoseWithCovariance` (pose topics), `sensor_msgs/Imu` (sensor topics,
-//! `sensor.rs`: health and σ of each covariance block), `TwistWithCovarianceStamped`,
-//! `AccelWithCovarianceStamped` and each Odometry's twist (`velocity.rs`: the diagonal blocks of
-//! their 6 × 6 covariance, as sensor topics), and `/tf` + `/tf_static` kept per edge
+//! `geometry_msgs/PoseWithCovariance` (pose topics), `sensor_msgs/Imu` and
+//! `sensor_msgs/NavSatFix` (sensor topics, `navsat.rs` for a fix; `sensor.rs`: health and σ of
+//! each covariance block), `TwistWithCovarianceStamped`, `AccelWithCovarianceStamped` and each
+//! Odometry's twist (`velocity.rs`: the diagonal blocks of their 6 × 6 covariance, as sensor
+//! topics), and `/tf` + `/tf_static` kept per edge
 //! (`tf.rs`); other types are listed as skipped. Stamps are the header stamp, or the log time when it is zero.
 //!
 //! ```
@@ -35,6 +36,7 @@ pub mod decode;
 pub mod health;
 mod mcap;
 mod mcap_records;
+pub mod navsat;
 pub mod ov_eval;
 pub mod reference;
 mod ros1;

@@ -1,22 +1,26 @@
-//! Covariance-carrying messages that are not poses (`sensor_msgs/Imu`): their type names,
-//! their decoding from ROS 1 and CDR bytes ([`decode_sensor`]) and one topic's streaming state
-//! (`SensorState`: stamps, health per 3 × 3 block, σ statistics and a bounded σ series),
-//! reduced to a [`SensorTopicSummary`].
+//! Covariance-carrying messages that are not poses (`sensor_msgs/Imu`, `sensor_msgs/NavSatFix`
+//! in `navsat.rs`): their type names, their decoding from ROS 1 and CDR bytes
+//! ([`decode_sensor`]) and one topic's streaming state (`SensorState`: stamps, health per
+//! 3 × 3 block, σ statistics, a bounded σ series and what is drawn: the thinned fixes, the
+//! newest orientation), reduced to a [`SensorTopicSummary`].
 
 use serde::{Deserialize, Serialize};
 
 use super::Codec;
 use super::decode::{DecodeError, Header, Ros1, cdr, header_stamp};
 use super::health::{BlockHealth, CONSTANT_MIN_MESSAGES, Trend, classify_block};
+use super::navsat::{Declared, Fix, declared, decode_navsat};
 use super::topic::Stamps;
 use crate::plan::log::{
-    AxisStats, BlockSummary, Decimator, Health, Issue, IssueCount, MAX_BLOCKS, SensorKind,
+    AxisStats, BlockSummary, DEFAULT_MAX_DRAWN, Decimator, FixPoint, Health, Issue, IssueCount,
+    MAX_BLOCKS, MAX_DRAWN_LIMIT, OrientationPoint, PLACEHOLDER, SensorDrawn, SensorKind,
     SensorSeriesPoint, SensorTopicSummary,
 };
 
 /// MD5 sums of the ROS 1 definitions read (what `rosmsg md5` prints).
-pub const ROS1_MD5: [(SensorKind, &str); 3] = [
+pub const ROS1_MD5: [(SensorKind, &str); 4] = [
     (SensorKind::Imu, "6a62c6daae103f4ff57a132d6f95cec2"),
+    (SensorKind::NavSatFix, "2d3a8cd499b9b4a0249fb98fd05cfa48"),
     (SensorKind::Twist, "8927a1a12fb2607ceea095b2dc440a96"),
     (SensorKind::Accel, "96adb295225031ec8d57fb4251b0a886"),
 ];
@@ -69,6 +73,8 @@ pub struct SensorMessage {
     pub orientation_xyzw: [f64; 4],
     /// The covariance blocks.
     pub blocks: [[f64; 9]; MAX_BLOCKS],
+    /// A NavSatFix's fix (`navsat.rs`).
+    pub fix: Option<Fix>,
 }
 
 /// `sensor_msgs/Imu` as CDR lays it out (field order is the wire order).
@@ -109,6 +115,7 @@ pub fn decode_sensor(
     bytes: &[u8],
 ) -> Result<SensorMessage, DecodeError> {
     let imu = match (kind, codec) {
+        (SensorKind::NavSatFix, _) => return decode_navsat(codec, bytes),
         (SensorKind::Twist | SensorKind::Accel | SensorKind::OdometryTwist, _) => {
             return super::velocity::decode(kind, codec, bytes);
         }
@@ -146,6 +153,7 @@ fn imu_message(imu: Imu, stamp: Option<i64>) -> SensorMessage {
             imu.angular_velocity_covariance,
             imu.linear_acceleration_covariance,
         ],
+        fix: None,
     }
 }
 
@@ -166,9 +174,21 @@ struct BlockState {
 }
 
 impl BlockState {
-    /// Message `index`'s block `b` at `stamp_ns`: its variance per axis where usable and
-    /// estimated.
-    fn add(&mut self, index: u64, stamp_ns: i64, b: &[f64; 9]) -> [Option<f64>; 3] {
+    /// Message `index`'s block `b` at `stamp_ns`, with what its message `declared` of it
+    /// (a NavSatFix's covariance type): its σ per axis where usable and estimated.
+    fn add(
+        &mut self,
+        index: u64,
+        stamp_ns: i64,
+        b: &[f64; 9],
+        declared: Declared,
+    ) -> [Option<f64>; 3] {
+        for issue in declared.issues.iter() {
+            self.health.note(issue, stamp_ns, index);
+        }
+        if declared.unchecked {
+            return [None; 3];
+        }
         let h = match &self.last {
             Some((last, h)) if last.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()) => *h,
             _ => {
@@ -243,10 +263,15 @@ pub(super) struct SensorState {
     pub(super) health: Health,
     blocks: Vec<BlockState>,
     series: Decimator<SensorSeriesPoint>,
+    /// A NavSatFix's drawn fixes, thinned as a pose topic's drawn messages.
+    fixes: Decimator<FixPoint>,
+    orientation: Option<OrientationPoint>,
 }
 
 impl SensorState {
-    pub(super) fn new(kind: SensorKind) -> Self {
+    /// A topic of `kind`, its fixes drawn every `every`-th (`--every`; `None`: at most
+    /// [`DEFAULT_MAX_DRAWN`]).
+    pub(super) fn new(kind: SensorKind, every: Option<u64>) -> Self {
         SensorState {
             kind,
             frame_id: None,
@@ -255,6 +280,11 @@ impl SensorState {
             health: Health::default(),
             blocks: vec![BlockState::default(); kind.blocks().len()],
             series: Decimator::new(1, super::MAX_SERIES),
+            fixes: match every {
+                Some(n) => Decimator::new(n, MAX_DRAWN_LIMIT),
+                None => Decimator::new(1, DEFAULT_MAX_DRAWN),
+            },
+            orientation: None,
         }
     }
 
@@ -283,12 +313,18 @@ impl SensorState {
         self.stamps
             .next(m.stamp_ns, m.from_log_time, true, index, health);
         if self.frame_id.is_none() && !m.frame_id.is_empty() {
-            self.frame_id = Some(m.frame_id);
+            self.frame_id = Some(std::mem::take(&mut m.frame_id));
         }
         let mut sigma = [[None; 3]; MAX_BLOCKS];
         for (k, block) in self.blocks.iter_mut().enumerate() {
-            sigma[k] = block.add(index, m.stamp_ns, &m.blocks[k]);
+            // A fix's covariance type speaks of its one block.
+            let said = match &m.fix {
+                Some(fix) if k == 0 => declared(fix, &m.blocks[0]),
+                _ => Declared::default(),
+            };
+            sigma[k] = block.add(index, m.stamp_ns, &m.blocks[k], said);
         }
+        self.keep_drawn(index, &m, &sigma);
         self.series.push(
             index,
             SensorSeriesPoint {
@@ -296,6 +332,55 @@ impl SensorState {
                 sigma,
             },
         );
+    }
+
+    /// Keeps what is drawn of message `index` (`sigma`: its blocks' σ, `None` where unusable
+    /// or not estimated): a fix that has a position (else `no_fix`), an IMU's orientation.
+    fn keep_drawn(&mut self, index: u64, m: &SensorMessage, sigma: &[[Option<f64>; 3]]) {
+        if let Some(fix) = &m.fix {
+            if fix.status == super::navsat::STATUS_NO_FIX {
+                self.health.note(Issue::NoFix, m.stamp_ns, index);
+            }
+            if fix.drawable() && self.fixes.wants(index) {
+                let checked = sigma[0].iter().any(Option::is_some);
+                let point = FixPoint {
+                    index,
+                    stamp_ns: m.stamp_ns,
+                    latitude_deg: fix.latitude_deg,
+                    longitude_deg: fix.longitude_deg,
+                    altitude_m: fix.altitude_m,
+                    covariance_enu: checked.then_some(m.blocks[0]),
+                };
+                self.fixes.push(index, point);
+            }
+            return;
+        }
+        let q = m.orientation_xyzw;
+        let norm = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let unit = (norm - 1.0).abs() < 1e-6; // false for NaN too
+        if self.kind != SensorKind::Imu || !unit {
+            return;
+        }
+        let unestimated = sigma[0].map(|s| s.is_none());
+        if unestimated.iter().all(|u| *u) {
+            return;
+        }
+        let b = &m.blocks[0];
+        let covariance = std::array::from_fn(|i| {
+            let (r, c) = (i / 3, i % 3);
+            if unestimated[r] || unestimated[c] || b[i] >= PLACEHOLDER {
+                0.0
+            } else {
+                b[i]
+            }
+        });
+        self.orientation = Some(OrientationPoint {
+            index,
+            stamp_ns: m.stamp_ns,
+            orientation_xyzw: q,
+            covariance,
+            unestimated,
+        });
     }
 
     /// Messages taken so far.
@@ -322,6 +407,10 @@ impl SensorState {
                 .map(|(b, spec)| b.into_plan(*spec))
                 .collect(),
             series,
+            drawn: SensorDrawn {
+                fixes: self.fixes.into_items(),
+                orientation: self.orientation,
+            },
         }
     }
 }
@@ -374,7 +463,7 @@ mod tests {
 
     #[test]
     fn a_not_provided_block_is_a_note_and_the_others_are_read() {
-        let mut s = SensorState::new(SensorKind::Imu);
+        let mut s = SensorState::new(SensorKind::Imu, None);
         for k in 0..12 {
             let m = decode_sensor(SensorKind::Imu, Codec::Ros1, &imu_ros1(-1.0));
             s.add(m, k);

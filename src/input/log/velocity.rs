@@ -114,6 +114,7 @@ fn message(stamp: Option<i64>, frame_id: String, covariance: &[f64; COV_LEN]) ->
         frame_id,
         orientation_xyzw: [0.0, 0.0, 0.0, 1.0],
         blocks,
+        fix: None,
     }
 }
 

@@ -73,11 +73,23 @@ pub enum Issue {
     TfNoTransform,
     /// A planar topic whose transform tilts its plane: drawn apart.
     TfTiltsPlane,
+    /// `sensor_msgs/NavSatFix` with `position_covariance_type` = `COVARIANCE_TYPE_UNKNOWN` (0):
+    /// the receiver gives no covariance; the block is not checked.
+    CovarianceTypeUnknown,
+    /// `sensor_msgs/NavSatFix` with `COVARIANCE_TYPE_APPROXIMATED` (1): a covariance made up
+    /// from the dilution of precision, not the receiver's estimate.
+    CovarianceApproximated,
+    /// `sensor_msgs/NavSatFix` with `COVARIANCE_TYPE_DIAGONAL_KNOWN` (2) whose off-diagonal
+    /// entries are not all zero: the type and the numbers disagree.
+    DiagonalKnownOffDiagonal,
+    /// `sensor_msgs/NavSatFix` with `status.status` = `STATUS_NO_FIX` (−1): the position is not
+    /// a fix (not drawn).
+    NoFix,
 }
 
 impl Issue {
     /// Every finding, defects first.
-    pub const ALL: [Issue; 21] = [
+    pub const ALL: [Issue; 25] = [
         Issue::NonFinite,
         Issue::Asymmetric,
         Issue::NotPsd,
@@ -99,6 +111,10 @@ impl Issue {
         Issue::TfMissingLink,
         Issue::TfNoTransform,
         Issue::TfTiltsPlane,
+        Issue::CovarianceTypeUnknown,
+        Issue::CovarianceApproximated,
+        Issue::DiagonalKnownOffDiagonal,
+        Issue::NoFix,
     ];
 
     /// The `--allow` name and JSON key.
@@ -131,6 +147,10 @@ impl Issue {
             Issue::TfMissingLink => "tf_missing_link",
             Issue::TfNoTransform => "tf_no_transform",
             Issue::TfTiltsPlane => "tf_tilts_plane",
+            Issue::CovarianceTypeUnknown => "covariance_type_unknown",
+            Issue::CovarianceApproximated => "covariance_approximated",
+            Issue::DiagonalKnownOffDiagonal => "diagonal_known_off_diagonal",
+            Issue::NoFix => "no_fix",
         }
     }
 
@@ -159,7 +179,10 @@ impl Issue {
             | Issue::Growth
             | Issue::TfMissingLink
             | Issue::TfNoTransform
-            | Issue::TfTiltsPlane => Class::Note,
+            | Issue::TfTiltsPlane
+            | Issue::CovarianceTypeUnknown
+            | Issue::CovarianceApproximated
+            | Issue::NoFix => Class::Note,
             _ => Class::Defect,
         }
     }
@@ -182,6 +205,7 @@ impl Issue {
                 | Issue::BadOrientation
                 | Issue::UnknownMarker
                 | Issue::AllZero
+                | Issue::CovarianceTypeUnknown
         )
     }
 }

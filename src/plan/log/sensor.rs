@@ -40,6 +40,10 @@ pub enum SensorKind {
     /// `sensor_msgs/Imu` (REP 145): orientation, angular velocity and linear acceleration,
     /// each with its 3 × 3 covariance in the message's `header.frame_id` axes.
     Imu,
+    /// `sensor_msgs/NavSatFix`: a GNSS fix (WGS84 latitude, longitude, altitude) and its
+    /// position covariance, m², in the East-North-Up tangent plane at the fix (REP 145, the
+    /// message's comment), with its `position_covariance_type`.
+    NavSatFix,
     /// `geometry_msgs/TwistWithCovarianceStamped` (wheel or visual odometry's velocity): the
     /// two 3 × 3 diagonal blocks of `twist.covariance` (linear, angular), in `header.frame_id`.
     Twist,
@@ -72,6 +76,13 @@ const IMU_BLOCKS: [BlockSpec; 3] = [
     },
 ];
 
+/// A fix's one block: its position in the East-North-Up plane at the fix.
+const NAVSAT_BLOCKS: [BlockSpec; 1] = [BlockSpec {
+    name: "position",
+    unit: "m",
+    axes: ["east", "north", "up"],
+}];
+
 /// A twist's two blocks (`twist.covariance` rows and columns 0–2, then 3–5).
 const TWIST_BLOCKS: [BlockSpec; 2] = [
     BlockSpec {
@@ -94,8 +105,9 @@ const ACCEL_BLOCKS: [BlockSpec; 2] = [
 
 impl SensorKind {
     /// Every sensor kind.
-    pub const ALL: [SensorKind; 4] = [
+    pub const ALL: [SensorKind; 5] = [
         SensorKind::Imu,
+        SensorKind::NavSatFix,
         SensorKind::Twist,
         SensorKind::Accel,
         SensorKind::OdometryTwist,
@@ -153,6 +165,7 @@ impl SensorKind {
     pub fn ros1_name(self) -> &'static str {
         match self {
             SensorKind::Imu => "sensor_msgs/Imu",
+            SensorKind::NavSatFix => "sensor_msgs/NavSatFix",
             SensorKind::Twist => "geometry_msgs/TwistWithCovarianceStamped",
             SensorKind::Accel => "geometry_msgs/AccelWithCovarianceStamped",
             SensorKind::OdometryTwist => "nav_msgs/Odometry",
@@ -167,6 +180,7 @@ impl SensorKind {
     pub fn ros2_name(self) -> &'static str {
         match self {
             SensorKind::Imu => "sensor_msgs/msg/Imu",
+            SensorKind::NavSatFix => "sensor_msgs/msg/NavSatFix",
             SensorKind::Twist => "geometry_msgs/msg/TwistWithCovarianceStamped",
             SensorKind::Accel => "geometry_msgs/msg/AccelWithCovarianceStamped",
             SensorKind::OdometryTwist => "nav_msgs/msg/Odometry",
@@ -182,6 +196,7 @@ impl SensorKind {
     pub fn blocks(self) -> &'static [BlockSpec] {
         match self {
             SensorKind::Imu => &IMU_BLOCKS,
+            SensorKind::NavSatFix => &NAVSAT_BLOCKS,
             SensorKind::Twist | SensorKind::OdometryTwist => &TWIST_BLOCKS,
             SensorKind::Accel => &ACCEL_BLOCKS,
         }
@@ -190,10 +205,14 @@ impl SensorKind {
     /// The class of `issue` on a sensor's block or topic. As on a pose topic
     /// ([`Issue::class`] of a topic that is not dead-reckoned), except `unknown_marker`: REP 145
     /// defines −1 in element 0 as "not provided", a note (the block is then not checked).
+    /// A NavSatFix's `covariance_type_unknown`, `covariance_approximated` and `no_fix` are
+    /// notes, `diagonal_known_off_diagonal` a defect ([`Issue::class`]).
     ///
     /// ```
     /// use posecov::plan::log::{Class, Issue, SensorKind};
     /// assert_eq!(SensorKind::class(Issue::AllZero), Class::Defect);
+    /// assert_eq!(SensorKind::class(Issue::CovarianceTypeUnknown), Class::Note);
+    /// assert_eq!(SensorKind::class(Issue::DiagonalKnownOffDiagonal), Class::Defect);
     /// assert_eq!(SensorKind::class(Issue::Constant), Class::Note);
     /// ```
     pub fn class(issue: Issue) -> Class {
@@ -266,6 +285,54 @@ pub struct SensorTopicSummary {
     pub blocks: Vec<BlockSummary>,
     /// σ over the stamp (bounded, in stamp order).
     pub series: Vec<SensorSeriesPoint>,
+    /// What is drawn of it ([`SensorDrawn`]).
+    pub drawn: SensorDrawn,
+}
+
+/// What a sensor topic keeps for drawing: a NavSatFix's fixes, an IMU's newest orientation.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SensorDrawn {
+    /// A NavSatFix's fixes (status not `NO_FIX`, a finite position), thinned as a pose topic's
+    /// drawn messages (`--every`), in message order.
+    pub fixes: Vec<FixPoint>,
+    /// An IMU's newest message whose orientation is a unit quaternion and whose orientation
+    /// block is usable and estimates some axis.
+    pub orientation: Option<OrientationPoint>,
+}
+
+/// One GNSS fix kept for drawing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixPoint {
+    /// The message's number on its topic.
+    pub index: u64,
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// WGS84 latitude, degrees (north positive).
+    pub latitude_deg: f64,
+    /// WGS84 longitude, degrees (east positive).
+    pub longitude_deg: f64,
+    /// Altitude above the WGS84 ellipsoid, m.
+    pub altitude_m: f64,
+    /// The position covariance, row-major over (east, north, up), m², when its block is usable
+    /// and checked.
+    pub covariance_enu: Option<[f64; 9]>,
+}
+
+/// An IMU's orientation at one message and its orientation covariance (for the spray of
+/// SO(3) samples).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrientationPoint {
+    /// The message's number on its topic.
+    pub index: u64,
+    /// Stamp, ns.
+    pub stamp_ns: i64,
+    /// `orientation` (x, y, z, w): parent_from_imu.
+    pub orientation_xyzw: [f64; 4],
+    /// `orientation_covariance`, row-major over rotations about x, y, z, rad², with the rows
+    /// and columns of an axis not estimated zeroed.
+    pub covariance: [f64; 9],
+    /// The axes whose variance is not estimated (0 or ≥ 1e6): not sprayed.
+    pub unestimated: [bool; 3],
 }
 
 impl SensorTopicSummary {

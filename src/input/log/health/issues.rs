@@ -36,7 +36,7 @@ impl Issues {
     /// (the orientation; the covariance: not finite, ROS's −1, all zero, placeholders,
     /// asymmetric, not PSD; the position trace's trend), then the kinds found per topic or
     /// per log (never in a message's list today), in [`Issue::ALL`]'s order.
-    pub const ORDER: [Issue; 21] = [
+    pub const ORDER: [Issue; 25] = [
         Issue::BadOrientation,
         Issue::NonFinite,
         Issue::UnknownMarker,
@@ -58,6 +58,11 @@ impl Issues {
         Issue::TfMissingLink,
         Issue::TfNoTransform,
         Issue::TfTiltsPlane,
+        // A NavSatFix's declared covariance type (`input::log::navsat`).
+        Issue::CovarianceTypeUnknown,
+        Issue::CovarianceApproximated,
+        Issue::DiagonalKnownOffDiagonal,
+        Issue::NoFix,
     ];
 
     /// The bit of `issue`: its place in [`Self::ORDER`]. An exhaustive `match`: a new kind of
@@ -85,6 +90,10 @@ impl Issues {
             Issue::TfMissingLink => 18,
             Issue::TfNoTransform => 19,
             Issue::TfTiltsPlane => 20,
+            Issue::CovarianceTypeUnknown => 21,
+            Issue::CovarianceApproximated => 22,
+            Issue::DiagonalKnownOffDiagonal => 23,
+            Issue::NoFix => 24,
         }
     }
 
