@@ -108,7 +108,7 @@ fn a_log_without_pose_topics_cannot_be_processed_and_writes_nothing() {
     );
     assert!(
         err.ends_with(
-            "sensor_msgs/Imu (ROS 2: sensor_msgs/msg/Imu), geometry_msgs/TwistWithCovarianceStamped (ROS 2: geometry_msgs/msg/TwistWithCovarianceStamped), geometry_msgs/AccelWithCovarianceStamped (ROS 2: geometry_msgs/msg/AccelWithCovarianceStamped)\n"
+            "sensor_msgs/Imu (ROS 2: sensor_msgs/msg/Imu), sensor_msgs/NavSatFix (ROS 2: sensor_msgs/msg/NavSatFix), geometry_msgs/TwistWithCovarianceStamped (ROS 2: geometry_msgs/msg/TwistWithCovarianceStamped), geometry_msgs/AccelWithCovarianceStamped (ROS 2: geometry_msgs/msg/AccelWithCovarianceStamped)\n"
         ),
         "{err}"
     );

@@ -257,7 +257,7 @@ fn check_gates_on_non_finite_and_constant_and_allow_accepts_both() {
         assert_eq!(out.status.code(), Some(code), "{said}");
         if allow {
             assert!(
-                said.contains(": ok (2 pose topic(s), 60 messages"),
+                said.contains(": ok (2 pose topic(s), 2 sensor topic(s), 60 messages"),
                 "{said}"
             );
             assert!(

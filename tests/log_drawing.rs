@@ -51,9 +51,11 @@ fn eye_distance(view: &View3d) -> f64 {
 fn the_robot_view_is_at_the_scale_of_the_covariance() {
     // test2.bag: 84 m of driving, σx = σy = 31.6 mm, Σzz = 1e6 (a placeholder).
     let scene = scene_of("robot_localization/test2.bag");
-    let [whole, robot] = scene.views.as_slice() else {
+    // The whole log, the robot view, and /imu/data's orientation spray (a view of its own).
+    let [whole, robot, spray] = scene.views.as_slice() else {
         panic!("{:?}", scene.views);
     };
+    assert!(spray.name.starts_with("/imu/data: orientation"), "{}", spray.name);
     assert_eq!(whole.name, "frame odom: the whole log");
     // The 95 % position region is r σ = 2.448 × 31.6 mm = 77 mm wide each way: the robot
     // view's eye stands well under a metre away, the whole log's tens of metres.
