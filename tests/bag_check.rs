@@ -11,16 +11,8 @@ use posecov::input::log::decode::{
     Header, Odometry, Pose, PoseWithCovariance, Time, TwistWithCovariance, nested,
 };
 
-const BIN: &str = env!("CARGO_BIN_EXE_posecov");
-
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(BIN).args(args).output().expect("run posecov");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod posecov_cli;
+use posecov_cli::{BIN, run};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("posecov-check-{name}-{}", std::process::id()));

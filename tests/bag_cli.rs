@@ -2,24 +2,16 @@
 //! bundled logs, and errors that name the file.
 
 use std::path::PathBuf;
-use std::process::Command;
+
+mod posecov_cli;
+use posecov_cli::run;
 
 mod rrd;
 
-const BIN: &str = env!("CARGO_BIN_EXE_posecov");
 const TEST2: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/tests/data/robot_localization/test2.bag"
 );
-
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(BIN).args(args).output().expect("run posecov");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("posecov-bagcli-{name}-{}", std::process::id()));

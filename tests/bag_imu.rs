@@ -3,33 +3,18 @@
 //! PyPI `rosbags` (tests/data/imu), the CDR path on the ROS 2 bags, and `check` on a log that
 //! holds only IMUs.
 
-use std::process::Command;
-
 use posecov::input::log::{LogOptions, read_log};
 use posecov::plan::log::{Class, Issue, SensorKind};
 
-const BIN: &str = env!("CARGO_BIN_EXE_posecov");
+mod posecov_cli;
+use posecov_cli::{json, run};
+
 const TEST2: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/tests/data/robot_localization/test2.bag"
 );
 const REP145: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/imu/imu_rep145.bag");
 const ARC: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ros2/arc.mcap");
-
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(BIN).args(args).output().expect("run posecov");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let (code, out, err) = run(args);
-    assert_eq!(code, Some(0), "{err}");
-    serde_json::from_str(&out).expect("json")
-}
 
 #[test]
 fn test2_bag_imu_is_checked_with_its_constant_covariances() {

@@ -4,8 +4,6 @@
 //! codes, and what is drawn: the fixes and their regions in the local East-North plane, and an
 //! IMU's orientation spray.
 
-use std::process::Command;
-
 use posecov::draw::log::{LogDrawSettings, description, draw_log};
 use posecov::eval::log::{LogEvalSettings, evaluate_log};
 use posecov::input::log::{LogOptions, read_log};
@@ -13,22 +11,15 @@ use posecov::plan::log::{Class, Issue, LogSummary, SensorKind};
 use posecov::scene::{ItemKind, Scene, Timing, paths};
 use posecov::uncertain::Confidence;
 
-const BIN: &str = env!("CARGO_BIN_EXE_posecov");
+mod posecov_cli;
+use posecov_cli::run;
+
 const BAG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/navsat/navsat.bag");
 const MCAP: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/navsat/navsat.mcap");
 const TEST2: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/tests/data/robot_localization/test2.bag"
 );
-
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(BIN).args(args).output().expect("run posecov");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn read(path: &str) -> LogSummary {
     read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap()

@@ -4,11 +4,12 @@
 //! the same exit code, `--reference`, several at once — and every bad input located.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use serde_json::Value;
 
-const BIN: &str = env!("CARGO_BIN_EXE_posecov");
+mod posecov_cli;
+use posecov_cli::run;
+
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ros2");
 const BAGS: [&str; 6] = [
     "arc_v9",
@@ -18,15 +19,6 @@ const BAGS: [&str; 6] = [
     "arc_zstd_message",
     "arc_humble",
 ];
-
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(BIN).args(args).output().expect("run posecov");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn data(name: &str) -> String {
     format!("{DATA}/{name}")

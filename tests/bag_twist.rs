@@ -3,29 +3,14 @@
 //! ROS 2 `.db3` bag of the same messages written by PyPI `rosbags` (tests/data/twist): their
 //! health classes, σ per axis with units in `report --json`, the plots, and `check`'s exit codes.
 
-use std::process::Command;
-
 use posecov::input::log::{LogOptions, read_log};
 use posecov::plan::log::{Class, Issue, SensorKind, SensorTopicSummary};
 
-const BIN: &str = env!("CARGO_BIN_EXE_posecov");
+mod posecov_cli;
+use posecov_cli::{json, run};
+
 const BAG: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/twist/twist.bag");
 const DB3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/twist/twist_db3");
-
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(BIN).args(args).output().expect("run posecov");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let (code, out, err) = run(args);
-    assert_eq!(code, Some(0), "{err}");
-    serde_json::from_str(&out).expect("json")
-}
 
 fn sensors(path: &str) -> Vec<SensorTopicSummary> {
     let plan = read_log(path.as_ref(), &LogOptions::default(), &mut |_, _| {}, None).unwrap();

@@ -55,7 +55,11 @@ fn the_robot_view_is_at_the_scale_of_the_covariance() {
     let [whole, robot, spray] = scene.views.as_slice() else {
         panic!("{:?}", scene.views);
     };
-    assert!(spray.name.starts_with("/imu/data: orientation"), "{}", spray.name);
+    assert!(
+        spray.name.starts_with("/imu/data: orientation"),
+        "{}",
+        spray.name
+    );
     assert_eq!(whole.name, "frame odom: the whole log");
     // The 95 % position region is r σ = 2.448 × 31.6 mm = 77 mm wide each way: the robot
     // view's eye stands well under a metre away, the whole log's tens of metres.

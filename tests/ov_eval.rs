@@ -6,10 +6,12 @@
 //! ov_core's JPL formulas, independently of posecov's conventions); an ov_eval file as the
 //! reference of a log topic; every line error located.
 
+mod posecov_cli;
+use posecov_cli::run;
+
 mod common;
 
 use std::path::PathBuf;
-use std::process::Command;
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use posecov::app::Overrides;
@@ -17,17 +19,7 @@ use posecov::app::run::{Run, RunOptions, open};
 use posecov::lie::{LieGroup, Se3};
 use serde_json::Value;
 
-const BIN: &str = env!("CARGO_BIN_EXE_posecov");
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ov_eval");
-
-fn run(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(BIN).args(args).output().expect("run posecov");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn data(name: &str) -> String {
     format!("{DATA}/{name}")
