@@ -2,7 +2,7 @@
 //! and ROS 2, the Foxglove SDK's server) read as one more log source. The server's binary frames
 //! carry each message's bytes as a bag stores them (`cdr` for ROS 2, `ros1` for ROS 1), so they
 //! go through the same decoders and the same per-topic collector as a file's; everything after
-//! sees a [`LogSummary`](crate::plan::log::LogSummary).
+//! sees a [`LogSummary`].
 //!
 //! - `client.rs`: the connection (`tungstenite`, blocking, `ws://` only): connect timeout,
 //!   bounded frames, both subprotocols offered, errors in words;
