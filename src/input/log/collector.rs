@@ -21,22 +21,6 @@ use super::topic::TopicState;
 use super::{InputError, LogOptions, decode, tf, velocity};
 use crate::input::suggest;
 
-impl LogOptions {
-    /// Whether `topic` is read (`--topic`, or every pose topic when none is given).
-    pub(super) fn selects(&self, topic: &str) -> bool {
-        self.topics.is_empty() || self.topics.iter().any(|t| t == topic)
-    }
-
-    /// Whether `topic` carries the reference asked for (its topic, or `/tf` for `tf:CHILD`).
-    pub(super) fn carries_reference(&self, topic: &str) -> bool {
-        match &self.reference {
-            Some(ReferenceInLog::Topic(name)) => name == topic,
-            Some(ReferenceInLog::Tf { .. }) => topic == "/tf",
-            None => false,
-        }
-    }
-}
-
 /// Receives every message of a log in file order.
 pub(super) struct Collector<'a, 'o> {
     options: &'a LogOptions,

@@ -86,6 +86,22 @@ pub struct LogOptions {
     pub live: ws::LiveOptions,
 }
 
+impl LogOptions {
+    /// Whether `topic` is read (`--topic`, or every pose topic when none is given).
+    fn selects(&self, topic: &str) -> bool {
+        self.topics.is_empty() || self.topics.iter().any(|t| t == topic)
+    }
+
+    /// Whether `topic` carries the reference asked for (its topic, or `/tf` for `tf:CHILD`).
+    fn carries_reference(&self, topic: &str) -> bool {
+        match &self.reference {
+            Some(ReferenceInLog::Topic(name)) => name == topic,
+            Some(ReferenceInLog::Tf { .. }) => topic == "/tf",
+            None => false,
+        }
+    }
+}
+
 /// Reads a log file into a [`LogSummary`], its format by content and extension
 /// ([`format::detect`]): [`locate`](crate::input::locate) the file, then [`read_located`].
 /// For tests and benchmarks that hold a path; the application locates once and calls
