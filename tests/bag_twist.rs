@@ -238,3 +238,20 @@ fn velocities_are_sigma_plots_over_the_stamp() {
     let vo_x = lines.iter().find(|l| l.name == "/vo/twist σx").unwrap();
     assert_eq!(vo_x.points.len(), 10);
 }
+
+#[test]
+fn the_report_keeps_an_odometrys_last_twist_sigma_after_evaluation() {
+    // `twist_sigma_last` is read from the plan after the evaluation has moved the drawn
+    // messages out: it was `null` on every log until the plan kept it.
+    let test2 = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/robot_localization/test2.bag"
+    );
+    let report = json(&["report", test2, "--json"]);
+    let twist = &report["topics"][0]["twist_sigma_last"];
+    assert!(
+        (twist["vx"].as_f64().unwrap() - 0.001f64.sqrt()).abs() < 1e-12,
+        "{twist}"
+    );
+    assert!(twist["wx"].is_null(), "a 1e6 placeholder: {twist}");
+}

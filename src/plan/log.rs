@@ -320,6 +320,10 @@ pub struct TopicSummary {
     pub group: GroupKind,
     /// Messages kept for drawing (at most the configured count; evenly spaced by `stride`).
     pub drawn: Vec<DrawnMessage>,
+    /// The twist covariance (row-major 6 × 6, child frame) of the last drawn Odometry
+    /// message, kept when the log is read: [`TopicSummary::twist_sigmas`] reads it after the
+    /// evaluation has moved `drawn` out.
+    pub last_twist_covariance: Option<[f64; COV_LEN]>,
     /// One kept message in `stride`.
     pub stride: u64,
     /// Positions along the trajectory (bounded, in stamp order), with their stamps.
@@ -379,7 +383,7 @@ impl TopicSummary {
     /// assert_eq!(sigma[3], None); // a 1e6 placeholder
     /// ```
     pub fn twist_sigmas(&self) -> Option<[Option<f64>; 6]> {
-        let twist = self.drawn.last()?.message.twist_covariance?;
+        let twist = self.last_twist_covariance?;
         Some(std::array::from_fn(|i| {
             let v = twist[i * 7];
             (v.is_finite() && (0.0..PLACEHOLDER).contains(&v)).then(|| v.sqrt())

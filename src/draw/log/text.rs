@@ -57,7 +57,7 @@ pub fn issue_word(issue: Issue) -> &'static str {
 /// use posecov::{draw::log::issue_sentence, plan::log::{Issue, TopicSummary, PoseMessageKind}};
 /// # let t = TopicSummary { name: "/odom".into(), kind: PoseMessageKind::Odometry, frame_id: "odom".into(),
 /// #     child_frame_id: String::new(), count: 0, stamps_from_log_time: 0, stamps_out_of_order: 0,
-/// #     stamp_range: None, health: Default::default(), group: posecov::lie::GroupKind::Se2, drawn: vec![], stride: 1,
+/// #     stamp_range: None, health: Default::default(), group: posecov::lie::GroupKind::Se2, drawn: vec![], last_twist_covariance: None, stride: 1,
 /// #     trajectory: vec![], series: vec![], sigma_stats: [None; 6] };
 /// assert!(issue_sentence(Issue::AllZero, &t).starts_with("every estimated entry is 0"));
 /// ```

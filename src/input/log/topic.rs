@@ -229,6 +229,8 @@ impl TopicState {
             );
             health.constant = Some(stretch);
         }
+        let drawn = self.drawn.into_items();
+        let last_twist_covariance = drawn.last().and_then(|d| d.message.twist_covariance);
         TopicSummary {
             name,
             kind: self.kind,
@@ -244,7 +246,8 @@ impl TopicState {
             } else {
                 GroupKind::Se3
             },
-            drawn: self.drawn.into_items(),
+            drawn,
+            last_twist_covariance,
             stride,
             trajectory,
             series,
