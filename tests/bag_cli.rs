@@ -114,8 +114,10 @@ fn save_writes_a_recording_and_every_thins_it() {
     let (code, _, err) = run(&[TEST2, "--every", "500", "--save", thin.to_str().unwrap()]);
     assert_eq!(code, Some(0), "{err}");
     let size = |p: &PathBuf| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+    // Every 500th message drawn: a file well under a third of the size (the σ plots keep
+    // every message's points in both).
     assert!(
-        size(&thin) > 10_000 && size(&thin) * 4 < size(&all),
+        size(&thin) > 10_000 && size(&thin) * 3 < size(&all),
         "{} {}",
         size(&thin),
         size(&all)

@@ -285,3 +285,32 @@ fn rows_that_do_not_decode_are_counted_and_named_as_in_mcap() {
         "{err}"
     );
 }
+
+#[test]
+fn a_file_compressed_bag_cut_short_inside_is_located_at_its_own_file() {
+    // rosbag2's `file` compression: the database is decompressed in memory (no temporary
+    // file). A database cut short inside its zstd stream is named by the bag's own file.
+    let dir = scratch("zstd-file-cut");
+    let bag = copy_bag("arc_zstd_file", &dir);
+    let file = bag.join("arc_zstd_file.db3.zstd");
+    let image = zstd::decode_all(std::fs::File::open(&file).unwrap()).unwrap();
+    let cut = &image[..image.len() / 2];
+    std::fs::write(&file, zstd::encode_all(cut, 3).unwrap()).unwrap();
+    let (code, _, err) = run(&["check", bag.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "{err}");
+    // Named by the bag's file, not a decompressed copy.
+    let named = format!("error: {}: ", file.display());
+    assert!(
+        err.starts_with(&named) && err.contains("the file is cut short"),
+        "{err}"
+    );
+    // A zstd stream cut short itself: said as such.
+    let packed = std::fs::read(&file).unwrap();
+    std::fs::write(&file, &packed[..packed.len() / 2]).unwrap();
+    let (code, _, err) = run(&["check", bag.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.starts_with(&named) && err.contains("does not decompress"),
+        "{err}"
+    );
+}

@@ -55,7 +55,7 @@
 //!   its pattern), `parts.rs` the gauge of each connected part, `evaluate.rs` loop closures'
 //!   residuals before and after at the confidence, the joint marginals asked for (`--joint`) and
 //!   the relative pose's covariance, `timeline.rs` the graph re-solved loop closure by loop closure
-//!   (bounded: 24 steps, 10⁴ poses), every solve's steps reported to a `ProgressHook` the app
+//!   (bounded: 12 steps, 10⁴ poses), every solve's steps reported to a `ProgressHook` the app
 //!   draws, `report.rs` the `optimized` records of `report --json`);
 //! - `log/` — a robot log's numbers — `mod.rs` (`evaluate_log`: each topic's drawn messages,
 //!   trajectory and series moved — never copied — out of its summary as `TopicMessages`; per drawn

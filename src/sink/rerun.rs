@@ -1,9 +1,11 @@
 //! Scene → Rerun 0.36 archetypes (the layout is [`super::blueprint`]'s).
 //!
-//! One item becomes one chunk on its own entity path (so each pose × method toggles on its
-//! own), with all its instances batched in one row: a cloud is one `Points3D`, a path of
-//! ellipsoids one `Ellipsoids3D`, a set of triads one `LineStrips3D`. This is also the only
-//! place where `f64` becomes `f32`.
+//! One item becomes one row on its own entity path (so each pose × method toggles on its
+//! own), with all its instances batched in the row: a cloud is one `Points3D`, a path of
+//! ellipsoids one `Ellipsoids3D`, a set of triads one `LineStrips3D`. The rows of one path
+//! (with the same components, all static or all timed) go out together, up to
+//! `ROWS_PER_CHUNK` (256) rows or `BYTES_PER_CHUNK` (4 MiB) a chunk (`Rows`). This is also the only place where `f64` becomes
+//! `f32`.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -134,23 +136,134 @@ pub fn log_part_cancellable(
     log_items(rec, part, cancel)
 }
 
-/// Every item of `scene` in log order, stopping when `cancel` is raised.
+/// Every item of `scene` in log order, stopping when `cancel` is raised; the rows are sent
+/// (the last ones when the items end or stop: what was logged is a consistent prefix).
 fn log_items(
     rec: &rr::RecordingStream,
     scene: &Scene,
     cancel: &AtomicBool,
 ) -> Result<LogOutcome, SinkError> {
+    let mut rows = Rows::default();
     for item in scene.items_in_log_order() {
         if cancel.load(Ordering::Relaxed) {
             let next_step = match item.timing {
                 Timing::Static | Timing::Stamp(_) => None,
                 Timing::Step(k) => Some(k),
             };
+            rows.send_all(rec)?;
             return Ok(LogOutcome::Cancelled { next_step });
         }
-        log_item(rec, item, scene.timeline)?;
+        log_item(&mut rows, item, scene.timeline);
+        rows.send_full(rec)?;
     }
+    rows.send_all(rec)?;
     Ok(LogOutcome::Complete)
+}
+
+/// Most rows of one path sent in one chunk ([`Rows`]).
+const ROWS_PER_CHUNK: usize = 256;
+
+/// A group of rows this large (their arrays' bytes) is sent at once, however few its rows: a
+/// large cloud does not wait for the scene's end (memory stays what one chunk needs).
+const BYTES_PER_CHUNK: usize = 4 << 20;
+
+/// Rows waiting to be sent, grouped by entity path, components and static-or-timed, in the
+/// order their groups began. A propagation's per-step items (a frame and an ellipsoid at each
+/// of a thousand steps) then go out as a few chunks rather than thousands: each chunk costs a
+/// schema, a compression frame and allocations to encode, which for one-row chunks was most
+/// of the time a recording took (`--save` of a pose graph; a live run's pictures). The
+/// content — every row, its time and components, in order per path — is what one chunk per
+/// row would say.
+#[derive(Default)]
+struct Rows {
+    groups: Vec<Group>,
+    /// Group index by key ([`Rows::key`]).
+    index: std::collections::HashMap<String, usize>,
+}
+
+/// One group's rows: (row id, time, components), and their arrays' bytes.
+struct Group {
+    path: rr::EntityPath,
+    rows: Vec<(RowId, rr::TimePoint, Vec<rr::SerializedComponentBatch>)>,
+    bytes: usize,
+}
+
+impl Rows {
+    /// What a group is: the path, static or timed, and the components' descriptors.
+    fn key(
+        path: &rr::EntityPath,
+        at: &rr::TimePoint,
+        batches: &[rr::SerializedComponentBatch],
+    ) -> String {
+        let mut key = format!("{path}\u{0}{}", at.is_static());
+        for b in batches {
+            key.push_str(&format!("\u{0}{:?}", b.descriptor));
+        }
+        key
+    }
+
+    /// Adds one row with all `parts` (a new row id: rows keep the order they were added in).
+    fn add(&mut self, path: &str, at: rr::TimePoint, parts: &[&dyn AsComponents]) {
+        let path = rr::EntityPath::from(path);
+        let batches: Vec<rr::SerializedComponentBatch> = parts
+            .iter()
+            .flat_map(|p| p.as_serialized_batches())
+            .collect();
+        let key = Self::key(&path, &at, &batches);
+        let next = self.groups.len();
+        let group = *self.index.entry(key).or_insert(next);
+        if group == next {
+            self.groups.push(Group {
+                path,
+                rows: Vec::new(),
+                bytes: 0,
+            });
+        }
+        let group = &mut self.groups[group];
+        group.bytes += batches
+            .iter()
+            .map(|b| rr::external::arrow::array::Array::get_array_memory_size(&b.array))
+            .sum::<usize>();
+        group.rows.push((RowId::new(), at, batches));
+    }
+
+    /// Sends the groups that reached [`ROWS_PER_CHUNK`] rows or [`BYTES_PER_CHUNK`] bytes.
+    fn send_full(&mut self, rec: &rr::RecordingStream) -> Result<(), SinkError> {
+        for group in &mut self.groups {
+            if group.rows.len() >= ROWS_PER_CHUNK || group.bytes >= BYTES_PER_CHUNK {
+                group.send(rec)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Sends every row waiting, group by group in the order they began.
+    fn send_all(&mut self, rec: &rr::RecordingStream) -> Result<(), SinkError> {
+        for group in &mut self.groups {
+            group.send(rec)?;
+        }
+        Ok(())
+    }
+}
+
+impl Group {
+    /// The rows as one chunk (none when there are none).
+    fn send(&mut self, rec: &rr::RecordingStream) -> Result<(), SinkError> {
+        if self.rows.is_empty() {
+            return Ok(());
+        }
+        self.bytes = 0;
+        let mut builder = Chunk::builder(self.path.clone());
+        for (row_id, at, batches) in self.rows.drain(..) {
+            builder = builder.with_serialized_batches(row_id, at, batches);
+        }
+        let chunk = builder.build().map_err(|err| SinkError::Chunk {
+            path: self.path.to_string(),
+            message: err.to_string(),
+        })?;
+        rec.send_chunk(chunk);
+        Ok(())
+    }
 }
 
 /// Where an item of `timing` is logged: nowhere on a timeline (static), at a step of the `step`
@@ -194,22 +307,17 @@ pub(super) fn send(
     Ok(())
 }
 
-fn log_item(
-    rec: &rr::RecordingStream,
-    item: &SceneItem,
-    timeline: scene::Timeline,
-) -> Result<(), SinkError> {
+fn log_item(rows: &mut Rows, item: &SceneItem, timeline: scene::Timeline) {
     let (path, at) = (item.path.as_str(), time_point(item.timing, timeline));
     match &item.kind {
-        ItemKind::Frame(frame) => log_frame(rec, path, at, frame),
-        ItemKind::Triads(triads) => send(rec, path, at, &[&triad_strips(triads)]),
-        ItemKind::Points(cloud) => send(rec, path, at, &[&points(cloud)]),
-        ItemKind::Ellipsoids(e) => send(rec, path, at, &[&ellipsoids(e)]),
-        ItemKind::Surface(surface) => send(rec, path, at, &[&mesh(surface)]),
-        ItemKind::LineStrips(strips) => send(rec, path, at, &[&line_strips(strips)]),
-        ItemKind::Arrows(arrows) => send(rec, path, at, &[&arrows3d(arrows)]),
-        ItemKind::Text(markdown) => send(
-            rec,
+        ItemKind::Frame(frame) => log_frame(rows, path, at, frame),
+        ItemKind::Triads(triads) => rows.add(path, at, &[&triad_strips(triads)]),
+        ItemKind::Points(cloud) => rows.add(path, at, &[&points(cloud)]),
+        ItemKind::Ellipsoids(e) => rows.add(path, at, &[&ellipsoids(e)]),
+        ItemKind::Surface(surface) => rows.add(path, at, &[&mesh(surface)]),
+        ItemKind::LineStrips(strips) => rows.add(path, at, &[&line_strips(strips)]),
+        ItemKind::Arrows(arrows) => rows.add(path, at, &[&arrows3d(arrows)]),
+        ItemKind::Text(markdown) => rows.add(
             path,
             at,
             &[&rr::TextDocument::from_markdown(markdown.as_str())],
@@ -219,24 +327,19 @@ fn log_item(
 
 /// A frame is a transform of its own entity plus its axes; its viewer label
 /// ([`Frame::viewer_label`]) is a tiny point at the frame's origin (in the frame's coordinates, hence `[0, 0, 0]`).
-fn log_frame(
-    rec: &rr::RecordingStream,
-    path: &str,
-    at: rr::TimePoint,
-    frame: &Frame,
-) -> Result<(), SinkError> {
+fn log_frame(rows: &mut Rows, path: &str, at: rr::TimePoint, frame: &Frame) {
     let transform =
         rr::Transform3D::from_translation_rotation(v3(&frame.translation), quat(&frame.rotation));
     let axes = rr::TransformAxes3D::new(f(frame.axis_length));
     match frame.viewer_label() {
-        None => send(rec, path, at, &[&transform, &axes]),
+        None => rows.add(path, at, &[&transform, &axes]),
         Some(label) => {
             let marker = rr::Points3D::new([[0.0f32; 3]])
                 .with_radii([f(0.04 * frame.axis_length)])
                 .with_colors([color(Color::rgb(128, 128, 128))])
                 .with_labels([label])
                 .with_show_labels(true);
-            send(rec, path, at, &[&transform, &axes, &marker])
+            rows.add(path, at, &[&transform, &axes, &marker]);
         }
     }
 }

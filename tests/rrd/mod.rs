@@ -2,6 +2,7 @@
 //! finding the Rerun CLI 0.36.3 for `rrd verify`.
 #![allow(dead_code)]
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
@@ -27,14 +28,49 @@ pub fn store_chunks(bytes: &[u8], kind: rerun::StoreKind) -> Vec<Chunk> {
         .collect()
 }
 
-/// Panics unless both recordings hold the same chunks (entity paths, timelines, component
-/// data), ignoring row and chunk ids, which Rerun randomises.
+/// The recording's rows as one-row chunks, by entity path: static rows first, then by time
+/// (stream order among rows at the same time). How many rows a chunk holds is the sink's
+/// choice, not content.
+pub fn recording_rows(bytes: &[u8]) -> BTreeMap<String, Vec<Chunk>> {
+    let mut rows: BTreeMap<String, Vec<Chunk>> = BTreeMap::new();
+    for chunk in recording_chunks(bytes) {
+        for i in 0..chunk.num_rows() {
+            rows.entry(chunk.entity_path().to_string())
+                .or_default()
+                .push(chunk.row_sliced_deep(i, 1));
+        }
+    }
+    for list in rows.values_mut() {
+        list.sort_by_key(|row| {
+            let mut times: Vec<(String, i64)> = row
+                .timelines()
+                .iter()
+                .map(|(name, column)| (name.to_string(), column.times_raw()[0]))
+                .collect();
+            times.sort();
+            (!row.is_static(), times)
+        });
+    }
+    rows
+}
+
+/// Panics unless both recordings hold the same rows (entity paths, timelines, component
+/// data; [`recording_rows`]), ignoring row and chunk ids, which Rerun randomises, and how the
+/// rows are chunked.
 pub fn assert_same_content(a: &[u8], b: &[u8]) {
-    let (a, b) = (recording_chunks(a), recording_chunks(b));
-    assert_eq!(a.len(), b.len(), "number of chunks");
-    for (x, y) in a.iter().zip(&b) {
-        if let Err(err) = Chunk::ensure_similar(x, y) {
-            panic!("{} differs: {err:#}", x.entity_path());
+    let (a, b) = (recording_rows(a), recording_rows(b));
+    assert_eq!(
+        a.keys().collect::<Vec<_>>(),
+        b.keys().collect::<Vec<_>>(),
+        "entity paths"
+    );
+    for (path, xs) in &a {
+        let ys = &b[path];
+        assert_eq!(xs.len(), ys.len(), "{path}: number of rows");
+        for (x, y) in xs.iter().zip(ys) {
+            if let Err(err) = Chunk::ensure_similar(x, y) {
+                panic!("{path} differs: {err:#}");
+            }
         }
     }
 }

@@ -93,9 +93,11 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         ellipses: &ellipses,
         bananas: &banana_poses,
         ramp: &ramp,
+        map: map_size(&s.poses),
     };
     // Under the trajectory: its colours stay on top.
     loop_closure_lines(p, g, &index_of, radius);
+    let mut left_out = 0;
     if g.timeline.steps.is_empty() {
         state(p, g, &s.poses, &s.covariances, None, &look);
     } else {
@@ -103,8 +105,20 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         let mut states = Vec::new();
         for (i, step) in g.timeline.steps.iter().enumerate() {
             let at = if i == 0 { 0 } else { chain_end + i as u64 };
-            state(p, g, &step.poses, &step.covariances, Some(at), &look);
             let last = i + 1 == g.timeline.steps.len();
+            left_out += state(
+                p,
+                g,
+                &step.poses,
+                &step.covariances,
+                Some(at),
+                &Look {
+                    // The final state draws what the figure draws; an earlier one (dead reckoning,
+                    // a few loop closures) leaves out what would cover the map.
+                    map: if last { f64::INFINITY } else { look.map },
+                    ..look
+                },
+            );
             closed_so_far(p, g, (step, last), at, radius);
             states.push(scene::State {
                 closures: step.closures as u64,
@@ -125,6 +139,16 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         ramp::RAMP[2],
         Swatch::Dashed,
     );
+    if left_out > 0 {
+        p.legend(
+            "after, on the step timeline before the final solution: marginals wider than the \
+             map not drawn (the trajectory's σ colours carry them; the before view shows dead \
+             reckoning's)"
+                .to_owned(),
+            ramp::RAMP[ramp::RAMP.len() - 1],
+            Swatch::Dashed,
+        );
+    }
     p.scene.add_legend(legend::axes("optimised poses"));
     if !banana_poses.is_empty() && s.covariances.iter().any(Option::is_some) {
         p.legend(
@@ -279,17 +303,38 @@ fn sparse<G: LieGroup<N>, const N: usize>(
 }
 
 /// What every state of the after picture draws the same way.
+#[derive(Clone, Copy)]
 struct Look<'a> {
     radius: f64,
     /// The poses drawn as axes with their marginal ellipse ([`sparse`]).
     ellipses: &'a BTreeSet<usize>,
     bananas: &'a [usize],
     ramp: &'a Ramp,
+    /// The largest half-size of a marginal region drawn (∞: every one): the final
+    /// solution's map size ([`map_size`]) for the timeline's earlier states, whose marginals
+    /// (dead reckoning's: hundreds of metres on a map of tens) would cover the view.
+    map: f64,
+}
+
+/// The longest side of the bounding box of `poses`' positions (0 for none).
+fn map_size<G: LieGroup<N>, const N: usize>(poses: &[G]) -> f64 {
+    let (lo, hi) = poses.iter().fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), x| {
+            let t = x.to_se3().translation().to_owned();
+            (lo.inf(&t), hi.sup(&t))
+        },
+    );
+    (hi - lo).max().max(0.0)
 }
 
 /// One state of the optimised graph (the final one, static; or a timeline step): the
 /// trajectory and the drawn poses' marginal ellipses in their σ colours, the drawn poses, and
-/// the bananas.
+/// the bananas; a region whose half-size exceeds `look.map` is left out. Returns how many
+/// were left out.
 fn state<G: LieGroup<N>, const N: usize>(
     p: &mut Painter,
     g: &GraphEvaluation<G, N>,
@@ -297,7 +342,7 @@ fn state<G: LieGroup<N>, const N: usize>(
     covariances: &[Option<TangentMatrix<N>>],
     step: Option<u64>,
     look: &Look,
-) {
+) -> usize {
     let position = |x: &G| x.to_se3().translation().to_owned();
     let points: Vec<Vec3> = poses.iter().map(|x| v3(&position(x))).collect();
     let sigma: Vec<f64> = covariances.iter().map(position_sigma::<G, N>).collect();
@@ -312,14 +357,18 @@ fn state<G: LieGroup<N>, const N: usize>(
     let uncertain = |k: usize| {
         covariances[k].map(|cov| UncertainPose::new_unchecked(poses[k], cov, Side::Right))
     };
+    let fits = |e: &scene::Ellipsoid| e.half_sizes.iter().all(|&h| h <= look.map);
+    let mut left_out = 0;
     let shapes: Vec<_> = look
         .ellipses
         .iter()
         .filter_map(|&k| {
-            Some((
-                shapes::position_region(&uncertain(k)?, p.confidence())?,
-                sigma[k],
-            ))
+            let e = shapes::position_region(&uncertain(k)?, p.confidence())?;
+            if !fits(&e) {
+                left_out += 1;
+                return None;
+            }
+            Some((e, sigma[k]))
         })
         .collect();
     ramp::ellipses(
@@ -343,17 +392,46 @@ fn state<G: LieGroup<N>, const N: usize>(
             line_radius: look.radius * 0.5,
         }),
     );
+    let timing = step.map_or(Timing::Static, |k| Timing::Step(k as i64));
     for &k in look.bananas {
-        if let Some(pose) = uncertain(k) {
-            p.region_banana(
-                &paths::vertex(&paths::child(&paths::optimized(), "bananas"), g.ids[k]),
-                step.map_or(Timing::Static, |k| Timing::Step(k as i64)),
-                &pose,
-                BANANA,
-                |x: &G| x.to_se3().translation().to_owned(),
-            );
+        let base = paths::vertex(&paths::child(&paths::optimized(), "bananas"), g.ids[k]);
+        match uncertain(k) {
+            Some(pose)
+                if shapes::position_region(&pose, p.confidence()).is_some_and(|e| fits(&e)) =>
+            {
+                p.region_banana(&base, timing, &pose, BANANA, |x: &G| {
+                    x.to_se3().translation().to_owned()
+                });
+            }
+            Some(_) => {
+                // Left out at this step: logged empty, so that an earlier step's does not stay.
+                left_out += 1;
+                let surface = scene::Surface {
+                    vertices: Vec::new(),
+                    triangles: Vec::new(),
+                    normals: Vec::new(),
+                    color: BANANA,
+                };
+                p.push(
+                    paths::child(&base, "banana"),
+                    step,
+                    ItemKind::Surface(surface),
+                );
+                let outline = LineStrips {
+                    strips: Vec::new(),
+                    color: BANANA,
+                    radius: look.radius,
+                };
+                p.push(
+                    paths::child(&base, "banana_outline"),
+                    step,
+                    ItemKind::LineStrips(outline),
+                );
+            }
+            None => {}
         }
     }
+    left_out
 }
 
 /// The loop closures in the graph at a timeline step, thick between the step's poses

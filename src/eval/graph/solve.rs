@@ -33,9 +33,18 @@ pub fn edge_jacobians<G: LieGroup<N>, const N: usize>(
     edge: &GraphEdge<G, N>,
     poses: &[G],
 ) -> (TangentMatrix<N>, TangentMatrix<N>) {
+    jacobians_at(edge, poses, &edge.residual(poses))
+}
+
+/// [`edge_jacobians`] at the residual `r` already computed (the solver's linearisation needs
+/// r too: one Log per edge, not two).
+fn jacobians_at<G: LieGroup<N>, const N: usize>(
+    edge: &GraphEdge<G, N>,
+    poses: &[G],
+    r: &Tangent<N>,
+) -> (TangentMatrix<N>, TangentMatrix<N>) {
     let (xi, xj) = (poses[edge.from], poses[edge.to]);
-    let r = edge.residual(poses);
-    let jr_inv = G::jr_inv(&r);
+    let jr_inv = G::jr_inv(r);
     let ad = xj.inverse().compose(&xi).adj();
     (-jr_inv * ad, jr_inv)
 }
@@ -92,7 +101,7 @@ impl<'a, G: LieGroup<N>, const N: usize> Problem<'a, G, N> {
                 continue;
             }
             let r = e.residual(poses);
-            let (ji, jj) = edge_jacobians(e, poses);
+            let (ji, jj) = jacobians_at(e, poses, &r);
             let lambda = e.information_in(self.reading);
             let (li, lj) = (lambda * ji, lambda * jj);
             if let Some(bi) = bi {

@@ -51,12 +51,25 @@ pub(super) struct Collector<'a, 'o> {
 /// of a growing run, holds at most this many points per line and picture.
 pub const GROWN_SERIES: usize = 1000;
 
+/// Messages drawn per topic in a summary handed to the growing view (the end's draws up to
+/// [`DEFAULT_MAX_DRAWN`](super::DEFAULT_MAX_DRAWN), or what `--every` asks): each drawn
+/// message is a cloud and its regions, most of what a picture costs to draw and encode, and a
+/// picture that grows while the robot drives needs fewer of them than the run's last one.
+pub const GROWN_DRAWN: usize = 50;
+
 /// A growing read ([`Collector::growing`]): when it began, when the next summary is due
 /// (`None`: at the first pose message).
 struct Growth {
     started: Instant,
     next_due: Option<Instant>,
 }
+
+/// After a picture of the growing view that took d to draw, the next waits at least this many
+/// times d (the collector's [`Collector::grow`] and a live stream's thread that draws): drawing
+/// takes at most a seventh of the time, so that a live run at 100 Hz on four topics, reading
+/// included, costs under a quarter of one core (BENCHMARKS §12), whatever the picture and the
+/// machine.
+pub(crate) const DRAWING_REST: u32 = 6;
 
 /// How long after the last summary was handed on (the collector's `grow`) the next one is due,
 /// `elapsed` into the read: every second, and once the read is past 100 s every hundredth of
@@ -109,9 +122,9 @@ impl<'a, 'o> Collector<'a, 'o> {
 
     /// The summary read so far (with the stream's `notes` so far) when one is due and a pose
     /// message has arrived, for a [`Self::growing`] collector: a copy of the bounded state, the
-    /// collector goes on unchanged. The next is due [`growth_interval`] after this one, or four
-    /// times `cost` (what drawing the last one took, on the thread that draws) if longer:
-    /// drawing takes at most a fifth of the time, whatever the machine.
+    /// collector goes on unchanged. The next is due [`growth_interval`] after this one, or
+    /// [`DRAWING_REST`] times `cost` (what drawing the last one took, on the thread that
+    /// draws) if longer: drawing takes at most a seventh of the time, whatever the machine.
     pub(super) fn grow(
         &mut self,
         notes: &dyn Fn() -> StreamNotes,
@@ -136,17 +149,19 @@ impl<'a, 'o> Collector<'a, 'o> {
         if plan.topics.iter().all(|t| t.count == 0) && plan.sensors.iter().all(|t| t.count == 0) {
             return None;
         }
-        // A picture of the run so far: its series thinner than the end's (every one stays in
-        // the viewer's recording).
+        // A picture of the run so far: its series and drawn messages thinner than the end's
+        // (every picture stays in the viewer's recording).
         for topic in &mut plan.topics {
             topic.series = Decimator::thinned(std::mem::take(&mut topic.series), GROWN_SERIES);
             topic.trajectory =
                 Decimator::thinned(std::mem::take(&mut topic.trajectory), GROWN_SERIES);
+            topic.drawn = Decimator::thinned(std::mem::take(&mut topic.drawn), GROWN_DRAWN);
         }
         plan.stream = Some(notes());
         if let Some(growth) = &mut self.growth {
-            growth.next_due =
-                Some(Instant::now() + growth_interval(growth.started.elapsed()).max(4 * cost));
+            growth.next_due = Some(
+                Instant::now() + growth_interval(growth.started.elapsed()).max(DRAWING_REST * cost),
+            );
         }
         Some(plan)
     }

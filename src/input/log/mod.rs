@@ -51,7 +51,7 @@ pub mod velocity;
 pub mod ws;
 
 use collector::Collector;
-pub use collector::{GROWN_SERIES, growth_interval};
+pub use collector::{GROWN_DRAWN, GROWN_SERIES, growth_interval};
 pub use stream::Codec;
 use stream::Stream;
 use topic::no_covariance_topic;
@@ -183,9 +183,11 @@ pub fn read_located_observed(
 /// `grow` as messages arrive, at most once per [`growth_interval`] (a file is read whole:
 /// `grow` is not called). `grow` runs on a thread of its own, so that reading never waits for
 /// drawing: a summary that comes while `grow` is still busy with the one before waits in a
-/// one-slot mailbox, where a newer one replaces it (skipped, counted in the stream's notes). Each is a bounded copy (the drawn set and statistics as the end's
-/// summary keeps them, the trajectory and series thinned to [`GROWN_SERIES`] points), `stream`
-/// with the stream's notes so far; what the observer saw is not in it.
+/// one-slot mailbox, where a newer one replaces it (skipped, counted in the stream's notes).
+/// Each is a bounded copy (the statistics as the end's summary keeps them, the drawn set
+/// thinned to [`GROWN_DRAWN`] messages a topic, the trajectory and series to
+/// [`GROWN_SERIES`] points), `stream` with the stream's notes so far; what the observer saw is
+/// not in it.
 ///
 /// ```
 /// use posecov::input::{locate, log::{LogOptions, read_located_growing}};

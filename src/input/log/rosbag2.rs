@@ -2,8 +2,10 @@
 //! `mcap`), its compression and its files in order (a split bag's `_0`, `_1`, …), beside those
 //! files. Each file is read in turn by its storage's reader (`sqlite.rs`, `mcap.rs`) into one
 //! collector, so a split bag is one log. Compression (rosbag2 writes zstd only): `file` — each
-//! file is one zstd stream (`bag_0.db3.zstd`), decompressed here to a temporary file first (as
-//! `ros2 bag` does); `message` — every message's bytes are one zstd frame (`sqlite.rs`).
+//! file is one zstd stream (`bag_0.db3.zstd`), decompressed here first: an SQLite file in
+//! memory when it fits (`IN_MEMORY_LIMIT`, 256 MiB; SQLite reads the image in place), else
+//! (and an MCAP file) to a temporary file, as `ros2 bag` does; `message` — every message's
+//! bytes are one zstd frame (`sqlite.rs`).
 //!
 //! The metadata's layout is rosbag2's (`rosbag2_storage/yaml.hpp`): versions 1 to 9 keep the
 //! keys read here (`version`, `storage_identifier`, `relative_file_paths`, and from version 3
@@ -304,23 +306,39 @@ pub(super) fn read_dir(
     let total = sizes.iter().sum::<u64>().max(1);
     let mut before = 0u64;
     for (file, &size) in files.iter().zip(&sizes) {
-        let copy = match metadata.compression {
-            Compression::File => Some(decompress_file(file)?),
+        let mcap = metadata.storage == Format::Mcap;
+        let unpacked = match metadata.compression {
+            // An MCAP reader reads a file; an SQLite image is read in memory when it fits.
+            Compression::File => Some(decompress_file(
+                file,
+                if mcap { 0 } else { IN_MEMORY_LIMIT },
+            )?),
             _ => None,
         };
-        let readable = copy.as_ref().map_or(file.as_path(), |c| c.0.as_path());
         let mut within = |done: u64, of: u64| {
             let share = u128::from(done.min(of)) * u128::from(size) / u128::from(of.max(1));
             progress(before + u64::try_from(share).unwrap_or(size), total);
         };
-        let read = match metadata.storage {
-            Format::Mcap => super::mcap::read(readable, collector, &mut within),
-            _ => {
-                let per_message = match metadata.compression {
-                    Compression::Message => Compression::Message,
-                    _ => Compression::None,
+        let (readable, read) = match unpacked {
+            Some(Unpacked::Memory(image)) => (
+                file.clone(),
+                super::sqlite::read_image(image, file, collector, &mut within),
+            ),
+            other => {
+                let copy = match &other {
+                    Some(Unpacked::File(copy)) => copy.0.clone(),
+                    _ => file.clone(),
                 };
-                super::sqlite::read(readable, Some(per_message), collector, &mut within)
+                let read = if mcap {
+                    super::mcap::read(&copy, collector, &mut within)
+                } else {
+                    let per_message = match metadata.compression {
+                        Compression::Message => Compression::Message,
+                        _ => Compression::None,
+                    };
+                    super::sqlite::read(&copy, Some(per_message), collector, &mut within)
+                };
+                (copy, read)
             }
         };
         read.map_err(|e| e.renamed(&readable.display().to_string(), &file.display().to_string()))?;
@@ -342,9 +360,23 @@ impl Drop for Decompressed {
     }
 }
 
-/// `path` (one zstd stream, rosbag2's `file` compression) decompressed to a temporary file
-/// named after it.
-pub(super) fn decompress_file(path: &Path) -> Result<Decompressed, InputError> {
+/// Most bytes a `file`-compressed SQLite bag file is decompressed to in memory (an image
+/// SQLite reads in place: no temporary file written and read back; SQLite takes its own copy,
+/// so the read holds up to twice this for a moment); a larger one goes to a temporary file.
+pub(super) const IN_MEMORY_LIMIT: usize = 256 << 20;
+
+/// A `file`-compressed bag file, decompressed.
+pub(super) enum Unpacked {
+    /// In memory (at most [`IN_MEMORY_LIMIT`] bytes, or the limit asked).
+    Memory(Vec<u8>),
+    /// In a temporary file.
+    File(Decompressed),
+}
+
+/// `path` (one zstd stream, rosbag2's `file` compression) decompressed: in memory when it
+/// decompresses to at most `in_memory` bytes (0: never), else to a temporary file named
+/// after it.
+pub(super) fn decompress_file(path: &Path, in_memory: usize) -> Result<Unpacked, InputError> {
     use std::sync::atomic::{AtomicU64, Ordering};
     static NEXT: AtomicU64 = AtomicU64::new(0);
     let io = |p: &Path, e: std::io::Error| InputError::Read {
@@ -373,12 +405,24 @@ pub(super) fn decompress_file(path: &Path) -> Result<Decompressed, InputError> {
     }
     let input = std::fs::File::open(path).map_err(|e| io(path, e))?;
     let mut decoder = zstd::stream::read::Decoder::new(input).map_err(|e| io(path, e))?;
-    let mut file = std::fs::File::create(&out.0).map_err(|e| io(&out.0, e))?;
-    std::io::copy(&mut decoder, &mut file).map_err(|e| InputError::Format {
+    let broken = |e: std::io::Error| InputError::Format {
         file: path.display().to_string(),
         message: format!("the zstd file does not decompress: {e}"),
-    })?;
-    Ok(out)
+    };
+    // Up to one byte past the limit: all of it in memory, or the start of a larger file.
+    let mut image = Vec::new();
+    (&mut decoder)
+        .take(in_memory as u64 + 1)
+        .read_to_end(&mut image)
+        .map_err(broken)?;
+    if in_memory > 0 && image.len() <= in_memory {
+        return Ok(Unpacked::Memory(image));
+    }
+    let mut file = std::fs::File::create(&out.0).map_err(|e| io(&out.0, e))?;
+    std::io::Write::write_all(&mut file, &image).map_err(|e| io(&out.0, e))?;
+    drop(image);
+    std::io::copy(&mut decoder, &mut file).map_err(broken)?;
+    Ok(Unpacked::File(out))
 }
 
 #[cfg(test)]

@@ -33,25 +33,71 @@ pub(super) fn read(
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<(), InputError> {
     let file = path.display().to_string();
-    let fail = |message: String| InputError::Format {
-        file: file.clone(),
-        message,
-    };
-    let at = |place: String, message: String| InputError::In {
-        file: file.clone(),
-        place,
-        message,
-    };
     let cut = check_magic(path)?;
     let db = Connection::open_with_flags(
         path,
         OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
     )
-    .map_err(|e| fail(format!("SQLite cannot open it: {e}")))?;
-    let damaged = |what: &str, e: rusqlite::Error| {
-        fail(format!("SQLite cannot read {what}: {e}{}{cut}", check(&db)))
+    .map_err(|e| InputError::Format {
+        file: file.clone(),
+        message: format!("SQLite cannot open it: {e}"),
+    })?;
+    scan(&db, &file, &cut, compression, collector, progress)
+}
+
+/// Streams every message of a `.db3` whose bytes are `image` (a `file`-compressed bag's file,
+/// decompressed in memory: SQLite reads the image in place, no temporary file) into
+/// `collector`; `named` is the file it came from, for errors. Its messages are not compressed.
+pub(super) fn read_image(
+    image: Vec<u8>,
+    named: &Path,
+    collector: &mut Collector<'_, '_>,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<(), InputError> {
+    let file = named.display().to_string();
+    let len = image.len() as u64;
+    let cut = check_header(&image[..image.len().min(32)], len, &file)?;
+    let fail = |e: rusqlite::Error| InputError::Format {
+        file: file.clone(),
+        message: format!("SQLite cannot open it (decompressed, {len} bytes): {e}"),
     };
-    let tables = tables(&db).map_err(|e| damaged("its list of tables", e))?;
+    let mut db = Connection::open_in_memory().map_err(fail)?;
+    db.deserialize_read_exact(rusqlite::MAIN_DB, image.as_slice(), image.len(), true)
+        .map_err(fail)?;
+    drop(image);
+    scan(
+        &db,
+        &file,
+        &cut,
+        Some(Compression::None),
+        collector,
+        progress,
+    )
+}
+
+/// Streams every message of the open bag `db` (named `file` in errors; `cut`: words for an
+/// error when its header says it is cut short) into `collector` (see [`read`]).
+fn scan(
+    db: &Connection,
+    file: &str,
+    cut: &str,
+    compression: Option<Compression>,
+    collector: &mut Collector<'_, '_>,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<(), InputError> {
+    let fail = |message: String| InputError::Format {
+        file: file.to_owned(),
+        message,
+    };
+    let at = |place: String, message: String| InputError::In {
+        file: file.to_owned(),
+        place,
+        message,
+    };
+    let damaged = |what: &str, e: rusqlite::Error| {
+        fail(format!("SQLite cannot read {what}: {e}{}{cut}", check(db)))
+    };
+    let tables = tables(db).map_err(|e| damaged("its list of tables", e))?;
     for needed in ["topics", "messages"] {
         if !tables.iter().any(|t| t == needed) {
             return Err(fail(format!(
@@ -67,11 +113,11 @@ pub(super) fn read(
     let compression = match compression {
         Some(c) => c,
         None if tables.iter().any(|t| t == "metadata") => {
-            own_compression(&db, &file).map_err(|e| damaged("table metadata", e))??
+            own_compression(db, file).map_err(|e| damaged("table metadata", e))??
         }
         None => Compression::None,
     };
-    let streams = topics(&db).map_err(|e| damaged("table topics", e))?;
+    let streams = topics(db).map_err(|e| damaged("table topics", e))?;
     for stream in streams.values() {
         collector.declare_stream(&stream.0);
     }
@@ -107,7 +153,7 @@ pub(super) fn read(
                 };
                 return Err(at(
                     format!("table messages, {after}"),
-                    format!("{e}{}{cut}", check(&db)),
+                    format!("{e}{}{cut}", check(db)),
                 ));
             }
         };
@@ -176,13 +222,19 @@ fn check_magic(path: &Path) -> Result<String, InputError> {
         path: path.display().to_string(),
         reason: e.to_string(),
     })?;
+    check_header(&head, len, &path.display().to_string())
+}
+
+/// [`check_magic`] on the first bytes `head` (up to 32) of a database of `len` bytes named
+/// `file`.
+fn check_header(head: &[u8], len: u64, file: &str) -> Result<String, InputError> {
     if !head.starts_with(SQLITE_MAGIC) {
         let shown: String = String::from_utf8_lossy(&head[..head.len().min(16)])
             .chars()
             .map(|c| if c.is_control() { '·' } else { c })
             .collect();
         return Err(InputError::Format {
-            file: path.display().to_string(),
+            file: file.to_owned(),
             message: format!(
                 "not an SQLite database (a .db3 starts with \"SQLite format 3\", this file with {shown:?})"
             ),

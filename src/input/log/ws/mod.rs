@@ -193,12 +193,17 @@ pub(super) fn read(
 }
 
 /// The thread that draws: hands each summary `mailbox` gives to `grow` until it is closed,
-/// noting what each took.
+/// noting what each took and resting [`DRAWING_REST`](super::collector::DRAWING_REST) times
+/// that before the next (the collector's own pacing cannot see a picture still being drawn:
+/// a summary put while the first is drawn would otherwise be drawn right after it).
 fn draw(mailbox: &Mailbox<LogSummary>, grow: &mut (dyn FnMut(LogSummary) + Send)) {
-    while let Some(plan) = mailbox.take() {
+    let mut rest = Duration::ZERO;
+    while let Some(plan) = mailbox.take_after(rest) {
         let started = Instant::now();
         grow(plan);
-        mailbox.handled(started.elapsed());
+        let cost = started.elapsed();
+        mailbox.handled(cost);
+        rest = cost * super::collector::DRAWING_REST;
     }
 }
 
