@@ -44,8 +44,8 @@
 //!   `graph/about.rs`; a pose graph's findings and its paragraph — loop closures
 //!   before and after, joint marginals — in `graph/mod.rs`, its after picture — marginals true
 //!   to scale following the loop-closure timeline on the `step` timeline after the chain's
-//!   steps, loop closures, relative uncertainties, a few labels by importance, a legend entry
-//!   for every mark — in `graph/after.rs`, the σ colours of its trajectory and ellipses in
+//!   steps, loop closures, relative uncertainties, a legend entry for every mark — in
+//!   `graph/after.rs`, its few labels by importance in `graph/labels.rs`, the σ colours of its trajectory and ellipses in
 //!   `graph/ramp.rs`, the close-ups of the largest marginal and the worst loop closure in
 //!   `graph/zoom.rs`; the σ before and after against pose index in `graph/sigma.rs`), the 3-D
 //!   views —

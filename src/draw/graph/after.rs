@@ -3,7 +3,7 @@
 //! ([`super::ramp`]), a few marginal bananas, each loop closure with its residual, the relative
 //! uncertainty of the worst loop closures and of every `--joint` pair, robot-scale views of
 //! the largest marginal and the worst loop closure ([`super::zoom`]), a legend entry for every
-//! colour and mark, and a few labels chosen by importance.
+//! colour and mark, and a few labels chosen by importance ([`super::labels`]).
 
 use super::super::shapes;
 use super::super::{Painter, legend, v3};
@@ -15,7 +15,7 @@ use std::collections::BTreeSet;
 use crate::eval::graph::{ClosureStep, GraphEvaluation, LoopClosure, PoseSigma};
 use crate::lie::{LieGroup, TangentMatrix};
 use crate::scene::{
-    self, Arrows, Color, Frame, ItemKind, LineStrips, QuatXyzw, Swatch, Timing, Triads, Vec3, paths,
+    self, Arrows, Color, ItemKind, LineStrips, QuatXyzw, Swatch, Timing, Triads, Vec3, paths,
 };
 use crate::uncertain::{Side, UncertainPose};
 
@@ -54,7 +54,7 @@ pub(super) fn position_sigma<G: LieGroup<N>, const N: usize>(
 /// (outliers in [`OUTLIER`]) with its residual as an arrow from the pose it predicts
 /// (X_i · Z) to X_j, relative uncertainties ([`relative`]), the robot-scale views of the
 /// largest marginal and the worst loop closure ([`zoom`], returned for the views) and a few
-/// labels ([`labels`]); a legend entry for each colour and mark. With a loop-closure
+/// labels ([`super::labels::labels`]); a legend entry for each colour and mark. With a loop-closure
 /// timeline, the trajectory, ellipses, poses and bananas follow it on the `step` timeline:
 /// the graph without loop closures from step 0 (while the chain's banana grows), then one
 /// step per value of k after the chain's last step, the loop closures added so far drawn
@@ -93,7 +93,7 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         ellipses: &ellipses,
         bananas: &banana_poses,
         ramp: &ramp,
-        map: map_size(&s.poses),
+        map: box_sides(&s.poses).max(),
     };
     // Under the trajectory: its colours stay on top.
     loop_closure_lines(p, g, &index_of, radius);
@@ -168,8 +168,8 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     if let Some(l) = worst.first() {
         zooms.extend(zoom::worst_loop_closure(p, g, l, (&sigma, &ramp)));
     }
-    labels(p, g, largest, true);
-    labels(p, g, largest, false);
+    super::labels::labels(p, g, largest, true);
+    super::labels::labels(p, g, largest, false);
     zooms
 }
 
@@ -274,17 +274,7 @@ fn sparse<G: LieGroup<N>, const N: usize>(
     }
     areas.sort_by(f64::total_cmp);
     let median = areas[areas.len() / 2];
-    let (lo, hi) = s.poses.iter().fold(
-        (
-            Vector3::repeat(f64::INFINITY),
-            Vector3::repeat(f64::NEG_INFINITY),
-        ),
-        |(lo, hi), x| {
-            let t = x.to_se3().translation().to_owned();
-            (lo.inf(&t), hi.sup(&t))
-        },
-    );
-    let mut sides: Vec<f64> = (hi - lo).iter().copied().collect();
+    let mut sides: Vec<f64> = box_sides(&s.poses).iter().copied().collect();
     sides.sort_by(f64::total_cmp);
     let map = (sides[1] * sides[2]).max(median);
     let fits = if median > 0.0 {
@@ -311,13 +301,13 @@ struct Look<'a> {
     bananas: &'a [usize],
     ramp: &'a Ramp,
     /// The largest half-size of a marginal region drawn (∞: every one): the final
-    /// solution's map size ([`map_size`]) for the timeline's earlier states, whose marginals
+    /// solution's map size (the longest side of [`box_sides`]) for the timeline's earlier states, whose marginals
     /// (dead reckoning's: hundreds of metres on a map of tens) would cover the view.
     map: f64,
 }
 
-/// The longest side of the bounding box of `poses`' positions (0 for none).
-fn map_size<G: LieGroup<N>, const N: usize>(poses: &[G]) -> f64 {
+/// The sides of the bounding box of `poses`' positions (zeros for none): the map's size.
+fn box_sides<G: LieGroup<N>, const N: usize>(poses: &[G]) -> Vector3<f64> {
     let (lo, hi) = poses.iter().fold(
         (
             Vector3::repeat(f64::INFINITY),
@@ -328,7 +318,7 @@ fn map_size<G: LieGroup<N>, const N: usize>(poses: &[G]) -> f64 {
             (lo.inf(&t), hi.sup(&t))
         },
     );
-    (hi - lo).max().max(0.0)
+    (hi - lo).map(|side| side.max(0.0))
 }
 
 /// One state of the optimised graph (the final one, static; or a timeline step): the
@@ -523,107 +513,6 @@ fn relative<G: LieGroup<N>, const N: usize>(
 /// A covariance with a banana to draw: finite and not all zero (two poses held fixed).
 fn is_drawable<const N: usize>(cov: &TangentMatrix<N>) -> bool {
     cov.iter().all(|v| v.is_finite()) && cov.amax() > 0.0
-}
-
-/// At most four labels, by importance: the worst loop closure (the largest residual d after
-/// the optimisation; before it, at the file's estimates), the largest marginal (after only),
-/// the first and the last pose. Labels of one pose, or of poses closer than 4 % of the
-/// drawing, are joined into one ("; "), so no two sit on each other. `after`: at the optimised
-/// poses (`world/optimized/labels/…`), else at the file's estimates (`world/labels/…`). A
-/// figure places each label's box where it overlaps no other (`sink::figure`); the viewer
-/// writes a short tag ("v9 ← v5 worst", "v7 largest σ", "v0 first"), the whole words going to
-/// the text panel, and leaves out a tag that would cover a more important one
-/// ([`crate::draw::tags`]).
-fn labels<G: LieGroup<N>, const N: usize>(
-    p: &mut Painter,
-    g: &GraphEvaluation<G, N>,
-    largest: Option<usize>,
-    after: bool,
-) {
-    let (poses, prefix) = if after {
-        (
-            &g.solution.poses,
-            paths::child(&paths::optimized(), "labels"),
-        )
-    } else {
-        (&g.initial, paths::initial_labels())
-    };
-    let n = poses.len();
-    if n == 0 {
-        return;
-    }
-    let index_of = |id: u64| g.ids.binary_search(&id).ok();
-    let d = |l: &LoopClosure<N>| {
-        if after {
-            l.mahalanobis
-        } else {
-            l.mahalanobis_before
-        }
-    };
-    let worst = g.loop_closures.iter().max_by(|a, b| d(a).total_cmp(&d(b)));
-    // (pose index, who: "v9 ← v5", what in words, what in a tag)
-    let mut candidates: Vec<(usize, String, String, &str)> = Vec::new();
-    if let Some(l) = worst
-        && let Some(j) = index_of(l.to)
-    {
-        let what = if after {
-            "worst loop closure"
-        } else {
-            "worst loop closure at the file's estimates"
-        };
-        candidates.push((
-            j,
-            format!("v{} ← v{}", l.to, l.from),
-            format!("{what}, d = {:.2}", d(l)),
-            "worst",
-        ));
-    }
-    if let (Some(k), true) = (largest, after) {
-        let sigma = position_sigma::<G, N>(&g.solution.covariances[k]);
-        candidates.push((
-            k,
-            format!("v{}", g.ids[k]),
-            format!("largest marginal, σ {}", ramp::length_words(sigma)),
-            "largest σ",
-        ));
-    }
-    let pose = |k: usize| format!("v{}", g.ids[k]);
-    candidates.push((0, pose(0), "first pose".to_owned(), "first"));
-    candidates.push((n - 1, pose(n - 1), "last pose".to_owned(), "last"));
-    let position = |k: usize| poses[k].to_se3().translation().to_owned();
-    let near = 0.04 * p.extent.max(1e-9);
-    // (pose index, words, tag)
-    let mut placed: Vec<(usize, String, String)> = Vec::new();
-    for (k, who, what, short) in candidates {
-        match placed
-            .iter_mut()
-            .find(|(q, ..)| *q == k || (position(*q) - position(k)).norm() < near)
-        {
-            // The same pose: its name once ("v9 ← v5: worst …; last pose").
-            Some((q, words, tag)) if *q == k => {
-                words.push_str(&format!("; {what}"));
-                tag.push_str(&format!(", {short}"));
-            }
-            Some((_, words, tag)) => {
-                words.push_str(&format!("; {who}: {what}"));
-                tag.push_str(&format!("; {who} {short}"));
-            }
-            None => placed.push((k, format!("{who}: {what}"), format!("{who} {short}"))),
-        }
-    }
-    for (k, text, tag) in placed {
-        p.push(
-            paths::vertex(&prefix, g.ids[k]),
-            None,
-            ItemKind::Frame(Frame {
-                translation: v3(&position(k)),
-                rotation: quat(&poses[k]),
-                axis_length: p.axis_length * 0.6,
-                label: Some(text),
-                tag: Some(tag),
-            }),
-        );
-    }
 }
 
 pub(super) fn quat<G: LieGroup<N>, const N: usize>(x: &G) -> QuatXyzw {

@@ -13,6 +13,7 @@ use crate::lie::LieGroup;
 
 mod about;
 mod after;
+mod labels;
 mod ramp;
 mod sigma;
 mod zoom;

@@ -7,13 +7,14 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use crate::plan::log::{
-    Decimator, EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessage, PoseMessageKind,
-    ReferenceInLog, ReferenceRead, SensorKind, SkippedTopic, StreamNotes,
+    EstimateMessage, LogCut, LogObserver, LogSummary, PoseMessage, PoseMessageKind, ReferenceInLog,
+    ReferenceRead, SensorKind, SkippedTopic, StreamNotes,
 };
 
+use super::growth::{self, Growth};
 use super::reference::{self, ReferenceType};
 use super::sensor::{SensorState, decode_sensor};
 use super::stream::{Codec, Stream};
@@ -45,48 +46,6 @@ pub(super) struct Collector<'a, 'o> {
     growth: Option<Growth>,
 }
 
-/// Points kept per topic for the trajectory and each series in a summary handed to the
-/// growing view (the end's keeps [`MAX_SERIES`](super::MAX_SERIES)): a plot a thousand points
-/// wide still shows an hour's shape, and the viewer's recording, which keeps every picture
-/// of a growing run, holds at most this many points per line and picture.
-pub const GROWN_SERIES: usize = 1000;
-
-/// Messages drawn per topic in a summary handed to the growing view (the end's draws up to
-/// [`DEFAULT_MAX_DRAWN`](super::DEFAULT_MAX_DRAWN), or what `--every` asks): each drawn
-/// message is a cloud and its regions, most of what a picture costs to draw and encode, and a
-/// picture that grows while the robot drives needs fewer of them than the run's last one.
-pub const GROWN_DRAWN: usize = 50;
-
-/// A growing read ([`Collector::growing`]): when it began, when the next summary is due
-/// (`None`: at the first pose message).
-struct Growth {
-    started: Instant,
-    next_due: Option<Instant>,
-}
-
-/// After a picture of the growing view that took d to draw, the next waits at least this many
-/// times d (the collector's [`Collector::grow`] and a live stream's thread that draws): drawing
-/// takes at most a seventh of the time, so that a live run at 100 Hz on four topics, reading
-/// included, costs under a quarter of one core (BENCHMARKS §12), whatever the picture and the
-/// machine.
-pub(crate) const DRAWING_REST: u32 = 6;
-
-/// How long after the last summary was handed on (the collector's `grow`) the next one is due,
-/// `elapsed` into the read: every second, and once the read is past 100 s every hundredth of
-/// its age (an hour: every 36 s), so a long run hands on about 100 · (1 + ln(age / 100 s))
-/// summaries, each bounded as the summary is: what drawing them costs does not grow with the
-/// messages, and their number grows with the logarithm of the run's length.
-///
-/// ```
-/// use std::time::Duration;
-/// use posecov::input::log::growth_interval;
-/// assert_eq!(growth_interval(Duration::from_secs(5)), Duration::from_secs(1));
-/// assert_eq!(growth_interval(Duration::from_secs(3600)), Duration::from_secs(36));
-/// ```
-pub fn growth_interval(elapsed: Duration) -> Duration {
-    (elapsed / 100).max(Duration::from_secs(1))
-}
-
 impl<'a, 'o> Collector<'a, 'o> {
     pub(super) fn new(
         options: &'a LogOptions,
@@ -113,25 +72,20 @@ impl<'a, 'o> Collector<'a, 'o> {
 
     /// The same collector, its summary so far handed on by [`Self::grow`] when `drawn`.
     pub(super) fn growing(mut self, drawn: bool) -> Self {
-        self.growth = drawn.then(|| Growth {
-            started: Instant::now(),
-            next_due: None,
-        });
+        self.growth = drawn.then(Growth::new);
         self
     }
 
     /// The summary read so far (with the stream's `notes` so far) when one is due and a pose
-    /// message has arrived, for a [`Self::growing`] collector: a copy of the bounded state, the
-    /// collector goes on unchanged. The next is due [`growth_interval`] after this one, or
-    /// [`DRAWING_REST`] times `cost` (what drawing the last one took, on the thread that
-    /// draws) if longer: drawing takes at most a seventh of the time, whatever the machine.
+    /// message has arrived, for a [`Self::growing`] collector: a copy of the bounded state,
+    /// thinned for a growing picture ([`growth::thin`]); the collector goes on unchanged.
+    /// `cost` is what drawing the last one took ([`Growth::handed_on`]).
     pub(super) fn grow(
         &mut self,
         notes: &dyn Fn() -> StreamNotes,
         cost: Duration,
     ) -> Option<LogSummary> {
-        let growth = self.growth.as_ref()?;
-        if growth.next_due.is_some_and(|at| Instant::now() < at) {
+        if !self.growth.as_ref()?.due() {
             return None;
         }
         let mut plan = assemble(
@@ -149,19 +103,10 @@ impl<'a, 'o> Collector<'a, 'o> {
         if plan.topics.iter().all(|t| t.count == 0) && plan.sensors.iter().all(|t| t.count == 0) {
             return None;
         }
-        // A picture of the run so far: its series and drawn messages thinner than the end's
-        // (every picture stays in the viewer's recording).
-        for topic in &mut plan.topics {
-            topic.series = Decimator::thinned(std::mem::take(&mut topic.series), GROWN_SERIES);
-            topic.trajectory =
-                Decimator::thinned(std::mem::take(&mut topic.trajectory), GROWN_SERIES);
-            topic.drawn = Decimator::thinned(std::mem::take(&mut topic.drawn), GROWN_DRAWN);
-        }
+        growth::thin(&mut plan);
         plan.stream = Some(notes());
         if let Some(growth) = &mut self.growth {
-            growth.next_due = Some(
-                Instant::now() + growth_interval(growth.started.elapsed()).max(DRAWING_REST * cost),
-            );
+            growth.handed_on(cost);
         }
         Some(plan)
     }

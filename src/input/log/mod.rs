@@ -33,6 +33,7 @@ pub mod bundled;
 mod cdr_pose;
 mod collector;
 pub mod decode;
+mod growth;
 pub mod health;
 mod mcap;
 mod mcap_records;
@@ -51,7 +52,7 @@ pub mod velocity;
 pub mod ws;
 
 use collector::Collector;
-pub use collector::{GROWN_DRAWN, GROWN_SERIES, growth_interval};
+pub use growth::{GROWN_DRAWN, GROWN_SERIES, growth_interval};
 pub use stream::Codec;
 use stream::Stream;
 use topic::no_covariance_topic;

@@ -193,7 +193,7 @@ pub(super) fn read(
 }
 
 /// The thread that draws: hands each summary `mailbox` gives to `grow` until it is closed,
-/// noting what each took and resting [`DRAWING_REST`](super::collector::DRAWING_REST) times
+/// noting what each took and resting [`DRAWING_REST`](super::growth::DRAWING_REST) times
 /// that before the next (the collector's own pacing cannot see a picture still being drawn:
 /// a summary put while the first is drawn would otherwise be drawn right after it).
 fn draw(mailbox: &Mailbox<LogSummary>, grow: &mut (dyn FnMut(LogSummary) + Send)) {
@@ -203,7 +203,7 @@ fn draw(mailbox: &Mailbox<LogSummary>, grow: &mut (dyn FnMut(LogSummary) + Send)
         grow(plan);
         let cost = started.elapsed();
         mailbox.handled(cost);
-        rest = cost * super::collector::DRAWING_REST;
+        rest = cost * super::growth::DRAWING_REST;
     }
 }
 
