@@ -314,3 +314,57 @@ fn a_file_compressed_bag_cut_short_inside_is_located_at_its_own_file() {
         "{err}"
     );
 }
+
+#[test]
+fn a_bag_of_many_batches_is_read_whole_in_order_and_ctrl_c_stops_it() {
+    use posecov::input::log::{LogOptions, read_log};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    // arc_v9 doubled six times over (245 × 64 = 15 680 rows, stamps shifted): many of the
+    // batches the SQLite thread hands to the decoding one (512 rows each).
+    let dir = scratch("batches");
+    let bag = copy_bag("arc_v9", &dir);
+    let file = bag.join("arc_v9.db3");
+    let db = rusqlite::Connection::open(&file).unwrap();
+    for k in 0..6 {
+        db.execute(
+            &format!(
+                "INSERT INTO messages (topic_id, timestamp, data) SELECT topic_id, \
+                 timestamp + {} * 1000000000, data FROM messages ORDER BY id",
+                100 << k
+            ),
+            [],
+        )
+        .unwrap();
+    }
+    drop(db);
+    let whole = read_log(&file, &LogOptions::default(), &mut |_, _| {}, None).unwrap();
+    assert!(!whole.cancelled);
+    assert_eq!(whole.messages_total, 245 * 64);
+    let counts: Vec<(&str, u64)> = whole
+        .topics
+        .iter()
+        .map(|t| (t.name.as_str(), t.count))
+        .collect();
+    assert_eq!(counts, [("/amcl_pose", 25 * 64), ("/odom", 100 * 64)]);
+    // Ctrl-C at the first progress report (row 4 096): what was read is kept, the reading
+    // thread stops (the read returns), nothing after is read.
+    let cancel = AtomicBool::new(false);
+    let part = read_log(
+        &file,
+        &LogOptions::default(),
+        &mut |done, _| {
+            if done > 0 {
+                cancel.store(true, Ordering::Relaxed)
+            }
+        },
+        Some(&cancel),
+    )
+    .unwrap();
+    assert!(part.cancelled);
+    assert!(
+        part.messages_total >= 4096 && part.messages_total < 245 * 64,
+        "{}",
+        part.messages_total
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

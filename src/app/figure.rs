@@ -53,12 +53,12 @@ pub fn figure(
 ) -> Result<(), AppError> {
     figure::FigureFormat::of(out)?;
     // A pose graph's figure of every step at once shows the graph before and its final
-    // state: the marginals of the loop-closure steps between are computed only for a figure
-    // of one of them (`--step K`).
+    // state: the loop-closure steps between are solved only for a figure of one of them
+    // (`--step K`).
     let run = RunOptions {
         step_marginals: match options.steps {
             figure::Steps::At(_) => StepMarginals::Every,
-            figure::Steps::All => StepMarginals::DeadReckoning,
+            figure::Steps::All => StepMarginals::DeadReckoningOnly,
         },
         ..RunOptions::shown()
     };

@@ -200,15 +200,17 @@ fn robust(points: Vec<Vector3<f64>>) -> Vec<Vector3<f64>> {
     if points.len() < 20 {
         return points;
     }
+    // The k-th smallest of each list by selection (O(n)), not a sort: the same value.
+    let kth = |mut v: Vec<f64>, k: usize| *v.select_nth_unstable_by(k, f64::total_cmp).1;
     let median = |axis: usize| {
-        let mut v: Vec<f64> = points.iter().map(|p| p[axis]).collect();
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
+        let v: Vec<f64> = points.iter().map(|p| p[axis]).collect();
+        let half = v.len() / 2;
+        kth(v, half)
     };
     let centre = Vector3::new(median(0), median(1), median(2));
-    let mut d: Vec<f64> = points.iter().map(|p| (p - centre).norm()).collect();
-    d.sort_by(f64::total_cmp);
-    let reach = 1.5 * d[(d.len() as f64 * 0.98) as usize];
+    let d: Vec<f64> = points.iter().map(|p| (p - centre).norm()).collect();
+    let at = (d.len() as f64 * 0.98) as usize;
+    let reach = 1.5 * kth(d, at);
     points
         .into_iter()
         .filter(|p| (p - centre).norm() <= reach)

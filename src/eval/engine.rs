@@ -18,7 +18,9 @@ use crate::lie::LieGroup;
 use crate::plan::{OpKind, Operand, Plan, PoseValue, limits};
 use crate::propagate::sigma_point::JointInputs;
 use crate::propagate::{Propagated, relative_frobenius_error};
-use crate::sample::{CHUNK_SIZE, MeanError, Sampler, sample_statistics, tangent_moments};
+use crate::sample::{
+    CHUNK_SIZE, MeanError, SampleStatistics, Sampler, sample_statistics, tangent_moments,
+};
 use crate::uncertain::{Method, Side, UncertainPose};
 
 /// An operand's Gaussian (its primary estimate) and its particles.
@@ -47,7 +49,7 @@ pub(super) enum Particles<'p, G> {
 }
 
 /// Monte Carlo statistics an operation asks for beyond the Lie mean and covariance.
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
 pub(super) struct Extras {
     /// Uncentred left covariance about the nominal (Barfoot & Furgale's).
     pub uncentred_left: bool,
@@ -63,6 +65,8 @@ pub(super) struct Draft<'p, G: LieGroup<N>, const N: usize> {
     pub estimates: Vec<Propagated<G, N>>,
     pub particles: Particles<'p, G>,
     pub extras: Extras,
+    /// Where its Monte Carlo statistics can be read off another node's instead of iterated.
+    pub stats_from: Option<LeftTranslated<G>>,
 }
 
 impl<G: LieGroup<N>, const N: usize> Draft<'_, G, N> {
@@ -74,8 +78,24 @@ impl<G: LieGroup<N>, const N: usize> Draft<'_, G, N> {
             estimates,
             particles: particles.map_or(Particles::None, Particles::Owned),
             extras: Extras::default(),
+            stats_from: None,
         }
     }
+}
+
+/// A result whose particles are `by · Xᵢ`, the particles Xᵢ of node `of` moved by a known
+/// pose (a change of frame on the left): its Monte Carlo statistics are node `of`'s, moved.
+/// The right-side Lie mean and covariance are left-invariant (CONVENTIONS §8):
+/// Log((by μ)⁻¹ · by Xᵢ) = Log(μ⁻¹ Xᵢ), so the mean of the moved particles is by · μ (the
+/// iteration from by X₀ is by times the one from X₀, step for step, with the same number of
+/// steps) and the covariance is the same matrix. Read off, not iterated again: a pose graph's
+/// drawn loop closures X_i · Z were half of its Lie-mean iterations (issue 33).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LeftTranslated<G> {
+    /// The node whose particles were moved.
+    pub of: usize,
+    /// The known pose they were moved by.
+    pub by: G,
 }
 
 /// The operation an [`Engine`] is evaluating: its index in the plan and its output's name
@@ -295,6 +315,14 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
         }
     }
 
+    /// The node `operand` names, if it names one (a known pose has none).
+    pub(super) fn node_of(&self, operand: Operand<G>) -> Option<usize> {
+        match operand {
+            Operand::Known(_) => None,
+            Operand::Defined(k) => self.defined.get(k).copied().flatten(),
+        }
+    }
+
     /// Particles for `operand`: its own, or n copies of its mean.
     pub(super) fn particles_of(
         &self,
@@ -373,7 +401,7 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
         };
         if let Some(p) = particles.filter(|_| self.monte_carlo) {
             self.blocked_consistency(index, &mut node, p);
-            let summary = self.summary(index, &node, p, draft.extras);
+            let summary = self.summary(index, &node, p, draft.extras, draft.stats_from);
             let overflow = summary.as_ref().is_some_and(|r| {
                 r.as_ref().is_ok_and(|mc| {
                     !finite_pose(&Propagated {
@@ -467,8 +495,24 @@ impl<'a, 's, G: EvalGroup<N>, const N: usize> Engine<'a, 's, G, N> {
         node: &Node<G, N>,
         particles: &[G],
         extras: Extras,
+        stats_from: Option<LeftTranslated<G>>,
     ) -> Option<Result<McSummary<G, N>, MeanError<G>>> {
+        let moved = stats_from.and_then(|from| {
+            let mc = self.out.nodes.get(from.of)?.monte_carlo.as_ref()?;
+            let plain = extras == Extras::default() && mc.stats.side == Side::Right;
+            plain.then(|| McSummary {
+                stats: SampleStatistics {
+                    mean: from.by.compose(&mc.stats.mean),
+                    ..mc.stats
+                },
+                uncentred_left: None,
+                uncentred_left_stderr: None,
+                position_mean: None,
+                position_mean_stderr: None,
+            })
+        });
         match &mut self.stats {
+            StatsMode::Own if moved.is_some() => moved.map(Ok),
             StatsMode::Own => Some(sample_statistics(particles, Side::Right).map(|stats| {
                 let (uncentred_left, uncentred_left_stderr) = if extras.uncentred_left {
                     let mut sums = BatchSums::new(particles.len());

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 use super::EvalError;
-use super::engine::{Draft, Engine};
+use super::engine::{Draft, Engine, LeftTranslated};
 use super::groups::EvalGroup;
 use super::model::{FailureReason, Finding, Role};
 use crate::lie::{LieGroup, Tangent, TangentMatrix};
@@ -140,6 +140,10 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
 
     /// `by · X` or `X · by`, `by` known.
     fn change_frame(&mut self, input: Operand<G>, by: G, side: FrameSide) -> Result<(), EvalError> {
+        let moved_from = match side {
+            FrameSide::Left => self.node_of(input),
+            FrameSide::Right => None,
+        };
         let (x, px) = self.gaussian(input)?;
         let known = UncertainPose::certain(by);
         let map = move |g: &G| match side {
@@ -163,7 +167,10 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             |g: &[G]| map(&g[0]),
             JointInputs::independent(&[x]),
         );
-        self.single(estimates, particles)
+        let name = self.output();
+        let mut draft = Draft::single(estimates, particles);
+        draft.stats_from = moved_from.map(|of| LeftTranslated { of, by });
+        self.push(&name, Role::Output, draft)
     }
 
     /// X · Y or X⁻¹ · Y: independent operands, or correlated by Σ_XY.

@@ -177,6 +177,7 @@ impl<G: EvalGroup<N>, const N: usize> Engine<'_, '_, G, N> {
             estimates,
             particles: particles.map_or(Particles::None, Particles::Step),
             extras,
+            stats_from: None,
         };
         self.push(name, Role::Output, draft)
     }

@@ -16,8 +16,8 @@ use std::fmt;
 use nalgebra::{Isometry3, Matrix3, Matrix3x6, Matrix4, Matrix6, Translation3, Vector3, Vector6};
 
 use super::series::{
-    SMALL_ANGLE, one_minus_cos_by_theta2_taylor, q_coefficient_2, q_coefficient_3, sinc_taylor,
-    theta_minus_sin_by_theta3, theta_minus_sin_by_theta3_taylor,
+    SMALL_ANGLE, jinv_coefficient, one_minus_cos_by_theta2_taylor, q_coefficient_2,
+    q_coefficient_3, sinc_taylor, theta_minus_sin_by_theta3, theta_minus_sin_by_theta3_taylor,
 };
 use super::{ActJacobians, LieGroup, So3, Tangent, TangentMatrix};
 use crate::error::{Error, Result, check_finite};
@@ -275,11 +275,23 @@ impl LieGroup<6> for Se3 {
         Self::from_parts(translation, So3::from_half_angle_terms(&theta, cos_half, k))
     }
 
-    /// Log(R, t) = [Jl(θ)⁻¹ t; θ] with θ = Log(R) (Solà eq. 173).
+    /// Log(R, t) = [Jl(θ)⁻¹ t; θ] with θ = Log(R) (Solà eq. 173), Jl⁻¹ applied without
+    /// building 3×3 matrices: Jl(θ)⁻¹ t = t − ½ θ×t + c θ×(θ×t) (Solà eq. 146, as
+    /// [`So3::jl_inv`]), c = 1/θ² − cot(θ/2)/(2θ) ([`jinv_coefficient`]). In closed form
+    /// cot(θ/2) = w/|v| of the quaternion Log(R) read (θ = 2 atan2(|v|, w)), so Log takes one
+    /// atan2 and no sine or cosine; below [`SMALL_ANGLE`] c takes its Taylor series.
     #[inline]
     fn log(&self) -> Tangent<6> {
-        let theta = self.rotation.log();
-        let rho = So3::jl_inv(&theta) * self.translation;
+        let (theta, w, n) = self.rotation.log_with_parts();
+        let angle = theta.norm();
+        let c = if angle < SMALL_ANGLE {
+            jinv_coefficient(angle)
+        } else {
+            1.0 / (angle * angle) - w / (n * 2.0 * angle)
+        };
+        let t = self.translation;
+        let theta_x_t = theta.cross(&t);
+        let rho = t - theta_x_t * 0.5 + theta.cross(&theta_x_t) * c;
         Vector6::new(rho.x, rho.y, rho.z, theta.x, theta.y, theta.z)
     }
 
@@ -438,5 +450,55 @@ mod tests {
             }
         }
         eprintln!("Se3::exp vs the matrix Jl form: worst error {worst:e} × max|ρ|");
+    }
+
+    #[test]
+    fn log_agrees_with_the_matrix_jl_inverse_form() {
+        // Log reads cot(θ/2) off the quaternion instead of calling cos and sin: the same
+        // numbers as Jl(θ)⁻¹ t with So3::jl_inv, on both sides of the series switch and
+        // towards π, and Exp undoes it.
+        let switch = crate::lie::series::SMALL_ANGLE;
+        let angles = [
+            0.0,
+            1e-9,
+            1e-6,
+            0.05,
+            switch * (1.0 - 1e-15),
+            switch,
+            switch * (1.0 + 1e-15),
+            0.7,
+            2.0,
+            std::f64::consts::PI - 1e-6,
+        ];
+        let axes = [
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(0.3, -0.5, 0.8),
+            Vector3::new(0.0, 0.0, -1.0),
+        ];
+        let ts = [
+            Vector3::new(1.0, 2.0, 3.0),
+            Vector3::new(-0.5, 0.1, 0.0),
+            Vector3::new(100.0, -40.0, 7.0),
+        ];
+        for axis in axes {
+            for angle in angles {
+                let rotation = So3::exp(&(axis.normalize() * angle));
+                for t in ts {
+                    let x = Se3::from_parts(t, rotation);
+                    let xi = x.log();
+                    let theta = rotation.log();
+                    let expected = So3::jl_inv(&theta) * t;
+                    let rho = Vector3::new(xi[0], xi[1], xi[2]);
+                    let err = (rho - expected).amax() / t.amax();
+                    assert!(err <= 1e-12, "θ = {angle}: relative error {err:e}");
+                    assert_eq!(Vector3::new(xi[3], xi[4], xi[5]), theta);
+                    let back = Se3::exp(&xi);
+                    assert!(
+                        (back.translation() - t).amax() <= 1e-12 * t.amax(),
+                        "θ = {angle}"
+                    );
+                }
+            }
+        }
     }
 }

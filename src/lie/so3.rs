@@ -238,6 +238,23 @@ impl So3 {
         Self::from_quaternion(Unit::new_unchecked(q))
     }
 
+    /// [`log`](LieGroup::log) with the canonical quaternion's scalar part w and the norm |v|
+    /// of its vector part, from which it is read: cot(θ/2) = w/|v| (θ = |Log R| = 2 atan2(|v|,
+    /// w)), what SE(3)'s Log needs for Jl(θ)⁻¹ without another trigonometric call.
+    #[inline]
+    pub(super) fn log_with_parts(&self) -> (Tangent<3>, f64, f64) {
+        let q = self.canonical_quaternion();
+        let v = Vector3::new(q.i, q.j, q.k);
+        let n = v.norm();
+        let factor = if n < LOG_SMALL_VECTOR_PART {
+            let x2 = (n / q.w).powi(2);
+            2.0 / q.w * (1.0 - x2 / 3.0)
+        } else {
+            2.0 * n.atan2(q.w) / n
+        };
+        (v * factor, q.w, n)
+    }
+
     /// The quaternion with w ≥ 0; at w = 0 (θ = π exactly) the sign that makes the first
     /// non-zero vector component positive. q and −q are the same rotation: this picks the one
     /// whose Log has |θ| ≤ π and makes the result at θ = π defined.
@@ -303,16 +320,7 @@ impl LieGroup<3> for So3 {
     /// component positive.
     #[inline]
     fn log(&self) -> Tangent<3> {
-        let q = self.canonical_quaternion();
-        let v = Vector3::new(q.i, q.j, q.k);
-        let n = v.norm();
-        let factor = if n < LOG_SMALL_VECTOR_PART {
-            let x2 = (n / q.w).powi(2);
-            2.0 / q.w * (1.0 - x2 / 3.0)
-        } else {
-            2.0 * n.atan2(q.w) / n
-        };
-        v * factor
+        self.log_with_parts().0
     }
 
     #[inline]

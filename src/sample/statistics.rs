@@ -100,6 +100,9 @@ pub fn tangent_moments<G: LieGroup<N>, const N: usize>(
     about: &G,
     side: Side,
 ) -> (Tangent<N>, TangentMatrix<N>) {
+    // about⁻¹ once, not once a sample: the same operations as `tangent_about`'s rminus
+    // (about⁻¹ · X, then Log) and lminus (X · about⁻¹, then Log), so the same bits.
+    let about_inverse = about.inverse();
     let chunk_sums: Vec<(Tangent<N>, TangentMatrix<N>)> = samples
         .par_chunks(CHUNK_SIZE)
         .enumerate()
@@ -108,7 +111,10 @@ pub fn tangent_moments<G: LieGroup<N>, const N: usize>(
             let mut outer = TangentMatrix::<N>::zeros();
             for (i, x) in chunk.iter().enumerate() {
                 let w = weights.map_or(1.0, |w| w[c * CHUNK_SIZE + i]);
-                let xi = tangent_about(x, about, side);
+                let xi = match side {
+                    Side::Right => about_inverse.compose(x).log(),
+                    Side::Left => x.compose(&about_inverse).log(),
+                };
                 sum += xi * w;
                 outer.ger(w, &xi, &xi, 1.0);
             }

@@ -143,21 +143,61 @@ fn log_items(
     scene: &Scene,
     cancel: &AtomicBool,
 ) -> Result<LogOutcome, SinkError> {
+    use rayon::prelude::*;
+    let items: Vec<&SceneItem> = scene.items_in_log_order();
     let mut rows = Rows::default();
-    for item in scene.items_in_log_order() {
-        if cancel.load(Ordering::Relaxed) {
-            let next_step = match item.timing {
-                Timing::Static | Timing::Stamp(_) => None,
-                Timing::Step(k) => Some(k),
-            };
-            rows.send_all(rec)?;
-            return Ok(LogOutcome::Cancelled { next_step });
+    // Items are turned into Arrow arrays on every core, a slice at a time (the arrays of one
+    // slice in memory at once), then grouped and sent in log order.
+    for slice in items.chunks(ITEMS_SERIALIZED_AT_ONCE) {
+        let serialized: Vec<ItemRows> = slice
+            .par_iter()
+            .map(|item| item_rows(item, scene.timeline))
+            .collect();
+        for (item, item_rows) in slice.iter().zip(serialized) {
+            if cancel.load(Ordering::Relaxed) {
+                let next_step = match item.timing {
+                    Timing::Static | Timing::Stamp(_) => None,
+                    Timing::Step(k) => Some(k),
+                };
+                rows.send_all(rec)?;
+                return Ok(LogOutcome::Cancelled { next_step });
+            }
+            for row in item_rows.0 {
+                rows.push(row);
+            }
+            rows.send_full(rec)?;
         }
-        log_item(&mut rows, item, scene.timeline);
-        rows.send_full(rec)?;
     }
     rows.send_all(rec)?;
     Ok(LogOutcome::Complete)
+}
+
+/// How many scene items are serialized at once, in parallel ([`log_items`]).
+const ITEMS_SERIALIZED_AT_ONCE: usize = 256;
+
+/// One row not yet sent: its path, time and components.
+struct Row {
+    path: rr::EntityPath,
+    at: rr::TimePoint,
+    batches: Vec<rr::SerializedComponentBatch>,
+}
+
+/// The rows of one scene item.
+#[derive(Default)]
+struct ItemRows(Vec<Row>);
+
+impl ItemRows {
+    /// Adds one row with all `parts`.
+    fn add(&mut self, path: &str, at: rr::TimePoint, parts: &[&dyn AsComponents]) {
+        self.0.push(Row {
+            path: rr::EntityPath::from(path),
+            at,
+            batches: parts
+                .iter()
+                .flat_map(|p| p.as_serialized_batches())
+                .collect(),
+        });
+    }
 }
 
 /// Most rows of one path sent in one chunk ([`Rows`]).
@@ -202,13 +242,9 @@ impl Rows {
         key
     }
 
-    /// Adds one row with all `parts` (a new row id: rows keep the order they were added in).
-    fn add(&mut self, path: &str, at: rr::TimePoint, parts: &[&dyn AsComponents]) {
-        let path = rr::EntityPath::from(path);
-        let batches: Vec<rr::SerializedComponentBatch> = parts
-            .iter()
-            .flat_map(|p| p.as_serialized_batches())
-            .collect();
+    /// Adds one row (a new row id: rows keep the order they were added in).
+    fn push(&mut self, row: Row) {
+        let Row { path, at, batches } = row;
         let key = Self::key(&path, &at, &batches);
         let next = self.groups.len();
         let group = *self.index.entry(key).or_insert(next);
@@ -307,10 +343,12 @@ pub(super) fn send(
     Ok(())
 }
 
-fn log_item(rows: &mut Rows, item: &SceneItem, timeline: scene::Timeline) {
+/// The rows `item` is logged as.
+fn item_rows(item: &SceneItem, timeline: scene::Timeline) -> ItemRows {
+    let mut rows = ItemRows::default();
     let (path, at) = (item.path.as_str(), time_point(item.timing, timeline));
     match &item.kind {
-        ItemKind::Frame(frame) => log_frame(rows, path, at, frame),
+        ItemKind::Frame(frame) => log_frame(&mut rows, path, at, frame),
         ItemKind::Triads(triads) => rows.add(path, at, &[&triad_strips(triads)]),
         ItemKind::Points(cloud) => rows.add(path, at, &[&points(cloud)]),
         ItemKind::Ellipsoids(e) => rows.add(path, at, &[&ellipsoids(e)]),
@@ -323,11 +361,12 @@ fn log_item(rows: &mut Rows, item: &SceneItem, timeline: scene::Timeline) {
             &[&rr::TextDocument::from_markdown(markdown.as_str())],
         ),
     }
+    rows
 }
 
 /// A frame is a transform of its own entity plus its axes; its viewer label
 /// ([`Frame::viewer_label`]) is a tiny point at the frame's origin (in the frame's coordinates, hence `[0, 0, 0]`).
-fn log_frame(rows: &mut Rows, path: &str, at: rr::TimePoint, frame: &Frame) {
+fn log_frame(rows: &mut ItemRows, path: &str, at: rr::TimePoint, frame: &Frame) {
     let transform =
         rr::Transform3D::from_translation_rotation(v3(&frame.translation), quat(&frame.rotation));
     let axes = rr::TransformAxes3D::new(f(frame.axis_length));

@@ -38,8 +38,12 @@ pub enum StepMarginals {
     Every,
     /// Step 0's only (dead reckoning, the σ before of [`GraphEvaluation::sigmas`]): the other
     /// steps keep their poses and χ² but no marginals ([`ClosureStep::covariances`] all None),
-    /// for a report or a figure of the final state, which show no other step's.
+    /// for a report, which shows no other step's.
     DeadReckoning,
+    /// Step 0's only, and no step between it and the final solution solved at all
+    /// ([`ClosureTimeline::steps`] holds step 0 alone): for a figure of the final state, which
+    /// draws the graph before (dead reckoning) and after and nothing between.
+    DeadReckoningOnly,
 }
 
 /// Why a graph could not be evaluated.

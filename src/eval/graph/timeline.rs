@@ -24,6 +24,12 @@ pub const MAX_TIMELINE_POSES: usize = 10_000;
 /// closures).
 pub const MAX_TIMELINE_STEPS: usize = 12;
 
+/// The relative decrease of f = χ²/2 at which a state between dead reckoning and the final
+/// solution stops (at least; the solver's own when larger). A state is drawn and its χ²
+/// listed: 1e-3 of f moves no pose by a pixel, and takes one or two fewer iterations than
+/// the final solution's 1e-5 (GTSAM's default) on every benchmark graph (issue 33).
+pub const STATE_RELATIVE_TOLERANCE: f64 = 1e-3;
+
 /// The graph with its first `closures` loop closures, optimised.
 #[derive(Debug, Clone)]
 pub struct ClosureStep<G, const N: usize> {
@@ -96,12 +102,13 @@ pub(super) fn closure_timeline<G: LieGroup<N>, const N: usize>(
     let counts = closure_counts(loop_edges.len());
     let of = counts.len().saturating_sub(1);
     for (step, k) in counts.into_iter().enumerate() {
-        if k == loop_edges.len() {
+        if k == loop_edges.len() || (k > 0 && marginals == StepMarginals::DeadReckoningOnly) {
             break;
         }
         let solver = SolverSettings {
             pairs: Vec::new(),
             marginals: k == 0 || marginals == StepMarginals::Every,
+            relative_tolerance: settings.relative_tolerance.max(STATE_RELATIVE_TOLERANCE),
             ..settings.clone()
         };
         let sub = first_closures(graph, &rank, k, &start);

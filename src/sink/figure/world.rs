@@ -183,26 +183,34 @@ pub struct Pen {
 }
 
 /// Draws the clouds of `items`.
+/// Each cloud's visible dots are found on its own core ([`visible_dots`]; written in order).
 pub fn draw_clouds(svg: &mut Svg, items: &[&SceneItem], plane: Plane, m: &Mapping, pen: Pen) {
-    for item in items {
-        let ItemKind::Points(cloud) = &item.kind else {
-            continue;
-        };
-        let stride = cloud.positions.len().div_ceil(MAX_DOTS).max(1);
-        let radius = (cloud.radius * m.scale).clamp(0.6 * pen.unit, 1.6 * pen.unit);
-        let alpha = (f64::from(cloud.color.0[3]) / 255.0).min(0.7);
-        let color = on_white(darker(cloud.color, 0.25), alpha);
-        let centers: Vec<Px> = cloud
-            .positions
-            .iter()
-            .step_by(stride)
-            .map(|p| m.px(plane.project(*p)))
-            .collect();
-        svg.dots(
-            visible_dots(&centers, radius),
-            radius,
-            &format!("class=\"cloud\" stroke=\"{}\"", rgb(color)),
-        );
+    use rayon::prelude::*;
+    let clouds: Vec<(Vec<Px>, f64, String)> = items
+        .par_iter()
+        .filter_map(|item| {
+            let ItemKind::Points(cloud) = &item.kind else {
+                return None;
+            };
+            let stride = cloud.positions.len().div_ceil(MAX_DOTS).max(1);
+            let radius = (cloud.radius * m.scale).clamp(0.6 * pen.unit, 1.6 * pen.unit);
+            let alpha = (f64::from(cloud.color.0[3]) / 255.0).min(0.7);
+            let color = on_white(darker(cloud.color, 0.25), alpha);
+            let centers: Vec<Px> = cloud
+                .positions
+                .iter()
+                .step_by(stride)
+                .map(|p| m.px(plane.project(*p)))
+                .collect();
+            Some((
+                visible_dots(&centers, radius),
+                radius,
+                format!("class=\"cloud\" stroke=\"{}\"", rgb(color)),
+            ))
+        })
+        .collect();
+    for (dots, radius, style) in clouds {
+        svg.dots(dots, radius, &style);
     }
 }
 
@@ -493,8 +501,9 @@ pub struct LabelPlace {
 
 /// The first free place for a label of `lines` at font size `f` beside `anchor` (a frame's
 /// pixel): above right of it first (where labels always went), then in eight directions at
-/// growing distances (up to 12 font sizes away); free means inside `area` and overlapping
-/// none of `taken`. `None` when no place is free.
+/// growing distances (up to 12 font sizes away); free means inside `area` and at least
+/// [`LABEL_GAP`] font sizes from each of `taken` (two labels that touch read as one phrase).
+/// `None` when no place is free.
 ///
 /// ```
 /// use posecov::sink::figure::chart::Rect;
@@ -552,10 +561,22 @@ pub fn place_label(
                 && rect.y >= area.y
                 && rect.right() <= area.right()
                 && rect.bottom() <= area.bottom()
-                && !taken.iter().any(|t| overlaps(t, rect))
+                && !taken.iter().any(|t| {
+                    let gap = LABEL_GAP * f;
+                    let around = Rect {
+                        x: t.x - gap,
+                        y: t.y - gap,
+                        w: t.w + 2.0 * gap,
+                        h: t.h + 2.0 * gap,
+                    };
+                    overlaps(&around, rect)
+                })
         })
         .map(|(rect, moved)| LabelPlace { rect, moved })
 }
+
+/// The least room between two labels' boxes, in font sizes ([`place_label`]).
+pub const LABEL_GAP: f64 = 0.5;
 
 /// Whether two boxes overlap (sharing an edge is not overlapping).
 ///
