@@ -148,7 +148,7 @@ fn log_items(
     let mut rows = Rows::default();
     // Items are turned into Arrow arrays on every core, a slice at a time (the arrays of one
     // slice in memory at once), then grouped and sent in log order.
-    for slice in items.chunks(ITEMS_SERIALIZED_AT_ONCE) {
+    for slice in slices(&items) {
         let serialized: Vec<ItemRows> = slice
             .par_iter()
             .map(|item| item_rows(item, scene.timeline))
@@ -172,8 +172,42 @@ fn log_items(
     Ok(LogOutcome::Complete)
 }
 
-/// How many scene items are serialized at once, in parallel ([`log_items`]).
+/// Most scene items serialized at once, in parallel ([`log_items`]).
 const ITEMS_SERIALIZED_AT_ONCE: usize = 256;
+
+/// Most points (positions, vertices, shapes) in the items serialized at once: a slice of large
+/// clouds holds about what one [`BYTES_PER_CHUNK`] chunk does, not 256 clouds' arrays.
+const POINTS_SERIALIZED_AT_ONCE: usize = 1 << 18;
+
+/// `items` in consecutive slices of at most [`ITEMS_SERIALIZED_AT_ONCE`] items and, but for a
+/// single larger item, [`POINTS_SERIALIZED_AT_ONCE`] points.
+fn slices<'a, 'i>(items: &'a [&'i SceneItem]) -> Vec<&'a [&'i SceneItem]> {
+    let points = |item: &SceneItem| match &item.kind {
+        ItemKind::Points(c) => c.positions.len(),
+        ItemKind::Surface(m) => m.vertices.len() + m.triangles.len(),
+        ItemKind::LineStrips(l) => l.strips.iter().map(Vec::len).sum(),
+        ItemKind::Ellipsoids(e) => e.shapes.len(),
+        ItemKind::Triads(t) => 6 * t.translations.len(),
+        ItemKind::Arrows(a) => 2 * a.origins.len(),
+        ItemKind::Frame(_) | ItemKind::Text(_) => 1,
+    };
+    let mut out = Vec::new();
+    let (mut start, mut weight) = (0, 0);
+    for (i, item) in items.iter().enumerate() {
+        let w = points(item);
+        if i > start
+            && (i - start >= ITEMS_SERIALIZED_AT_ONCE || weight + w > POINTS_SERIALIZED_AT_ONCE)
+        {
+            out.push(&items[start..i]);
+            (start, weight) = (i, 0);
+        }
+        weight += w;
+    }
+    if start < items.len() {
+        out.push(&items[start..]);
+    }
+    out
+}
 
 /// One row not yet sent: its path, time and components.
 struct Row {
@@ -566,4 +600,44 @@ fn quat(q: &QuatXyzw) -> rr::Quaternion {
 fn color(c: Color) -> rr::Color {
     let [r, g, b, a] = c.0;
     rr::Color::from_unmultiplied_rgba(r, g, b, a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Color, PointCloud, SceneItem, Timing};
+
+    #[test]
+    fn items_are_serialized_in_bounded_slices_in_order() {
+        let cloud = |n: usize| {
+            SceneItem::new(
+                "world/c",
+                Timing::Static,
+                ItemKind::Points(PointCloud {
+                    positions: vec![[0.0; 3]; n],
+                    color: Color::rgb(1, 2, 3),
+                    radius: 0.1,
+                }),
+            )
+        };
+        let text =
+            |i: usize| SceneItem::new("t", Timing::Step(i as i64), ItemKind::Text("x".into()));
+        // 600 small items: slices of 256, 256, 88.
+        let small: Vec<SceneItem> = (0..600).map(text).collect();
+        let refs: Vec<&SceneItem> = small.iter().collect();
+        let lens: Vec<usize> = slices(&refs).iter().map(|s| s.len()).collect();
+        assert_eq!(lens, [256, 256, 88]);
+        // Large clouds: at most POINTS_SERIALIZED_AT_ONCE points a slice, one larger alone.
+        let big = vec![
+            cloud(POINTS_SERIALIZED_AT_ONCE / 2),
+            cloud(POINTS_SERIALIZED_AT_ONCE / 2),
+            cloud(1),
+            cloud(3 * POINTS_SERIALIZED_AT_ONCE),
+            cloud(1),
+        ];
+        let refs: Vec<&SceneItem> = big.iter().collect();
+        let lens: Vec<usize> = slices(&refs).iter().map(|s| s.len()).collect();
+        assert_eq!(lens, [2, 1, 1, 1]);
+        assert!(slices(&[]).is_empty());
+    }
 }
