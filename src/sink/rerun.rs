@@ -628,7 +628,7 @@ mod tests {
         let lens: Vec<usize> = slices(&refs).iter().map(|s| s.len()).collect();
         assert_eq!(lens, [256, 256, 88]);
         // Large clouds: at most POINTS_SERIALIZED_AT_ONCE points a slice, one larger alone.
-        let big = vec![
+        let big = [
             cloud(POINTS_SERIALIZED_AT_ONCE / 2),
             cloud(POINTS_SERIALIZED_AT_ONCE / 2),
             cloud(1),
