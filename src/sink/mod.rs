@@ -61,6 +61,8 @@ pub mod rerun;
 #[cfg(feature = "viewer")]
 pub mod restream;
 #[cfg(feature = "viewer")]
+mod rows;
+#[cfg(feature = "viewer")]
 pub mod stream;
 #[cfg(feature = "viewer")]
 pub mod viewer;

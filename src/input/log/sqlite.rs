@@ -169,20 +169,20 @@ fn scan(
     let (full, filled) = std::sync::mpsc::sync_channel(BATCHES_IN_FLIGHT);
     let (empty, emptied) = std::sync::mpsc::channel();
     std::thread::scope(|threads| {
-        let reader = std::thread::Builder::new()
+        let thread = std::thread::Builder::new()
             .name("posecov-db3".to_owned())
             .spawn_scoped(threads, move || {
-                let rows = Rows {
+                let reader = Reader {
                     file,
                     cut,
                     named,
                     message_compressed: compression == Compression::Message,
                 };
-                rows.send(db, full, emptied)
+                reader.send(db, full, emptied)
             })
             .map_err(|e| fail(format!("cannot start a thread to read it: {e}")))?;
         let read = collect(filled, empty, &streams, file, total, collector, progress);
-        match reader.join() {
+        match thread.join() {
             Ok(()) => read,
             Err(panic) => std::panic::resume_unwind(panic),
         }
@@ -207,7 +207,7 @@ struct Batch {
 }
 
 /// The reading side of [`scan`]: what it needs to read the rows and to locate an error.
-struct Rows<'a> {
+struct Reader<'a> {
     file: &'a str,
     cut: &'a str,
     /// Topic names by topic id, for errors.
@@ -215,7 +215,7 @@ struct Rows<'a> {
     message_compressed: bool,
 }
 
-impl Rows<'_> {
+impl Reader<'_> {
     /// Steps through the `messages` table in row order, sending full batches to `full` (and
     /// reusing those that come back on `emptied`); an error ends the batches. Returns when
     /// the table is read, on an error, or when the other side stops listening.

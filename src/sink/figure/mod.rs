@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 use crate::scene::{ItemKind, Scene, SceneItem, Timeline};
 
 pub mod chart;
+pub mod labels;
 mod layout;
 mod panel;
 mod raster;
@@ -450,7 +451,7 @@ fn draw_world(
     region::draw_regions(out, items, plane, &m, pen);
     world::draw_clouds(out, items, plane, &m, pen);
     world::draw_lines(out, items, plane, &m, pen);
-    world::draw_labels(
+    labels::draw_labels(
         out,
         items,
         (plane, &m),
