@@ -107,9 +107,14 @@ pub(super) fn report_as(
     bar: bool,
     cancel: Option<Arc<AtomicBool>>,
 ) -> Result<String, AppError> {
-    let printed = |value: serde_json::Value| match style {
-        ReportStyle::JsonLine => value.to_string() + "\n",
-        _ => serde_json::to_string_pretty(&value).unwrap_or_default() + "\n",
+    let printed = |value: serde_json::Value| {
+        let text = match style {
+            ReportStyle::JsonLine => value.to_string(),
+            _ => serde_json::to_string_pretty(&value).unwrap_or_default(),
+        } + "\n";
+        // A pose graph's tree is millions of nodes: freed beside the output, not before it.
+        rayon::spawn(move || drop(value));
+        text
     };
     let options = RunOptions {
         progress: bar,

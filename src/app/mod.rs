@@ -392,6 +392,19 @@ pub fn report_json(
 ) -> serde_json::Value {
     let ran = evaluation.ran_with();
     let sigma = loaded.input.defaults.sigma_points.unwrap_or_default();
+    // The three large parts (a pose graph's are megabytes) become trees side by side.
+    fn value(v: impl serde::Serialize) -> serde_json::Value {
+        serde_json::to_value(v).unwrap_or_default()
+    }
+    let ((results, monte_carlo), optimized) = rayon::join(
+        || {
+            rayon::join(
+                || value(evaluation.records()),
+                || value(evaluation.monte_carlo_records()),
+            )
+        },
+        || evaluation.optimized().map(value),
+    );
     let mut report = serde_json::json!({
         "schema_version": REPORT_SCHEMA_VERSION,
         "posecov_version": POSECOV_VERSION,
@@ -410,17 +423,14 @@ pub fn report_json(
             "methods": ran.methods,
             "sigma_points": { "alpha": sigma.alpha, "beta": sigma.beta, "kappa": sigma.kappa },
         },
-        "results": evaluation.records(),
-        "monte_carlo": evaluation.monte_carlo_records(),
+        "results": results,
+        "monte_carlo": monte_carlo,
         "along_track": evaluation.along_track(),
         "findings": evaluation.findings(),
     });
     // A pose graph's optimisation: poses, marginals, loop closures (eval::graph).
-    if let (Some(optimized), Some(object)) = (evaluation.optimized(), report.as_object_mut()) {
-        object.insert(
-            "optimized".to_owned(),
-            serde_json::to_value(optimized).unwrap_or_default(),
-        );
+    if let (Some(optimized), Some(object)) = (optimized, report.as_object_mut()) {
+        object.insert("optimized".to_owned(), optimized);
     }
     report
 }

@@ -93,13 +93,13 @@ fn edge_cov<G: GraphGroup<N>, const N: usize>(
     let values: Vec<f64> = r.information.iter().map(|v| v.value).collect();
     let information: SMatrix<f64, N, N> = from_upper_triangle::<N>(&values);
     let at = r.information.first().map_or(r.at, |v| v.at);
-    let axes = information_axes(r.tag.dimension).join(", ");
     let error =
         |message: String| locator.error(at..at, &format!("{} information", label(r)), message);
     let Some(cholesky) = information.cholesky() else {
         let smallest = nalgebra::DMatrix::from_iterator(N, N, information.iter().copied())
             .symmetric_eigenvalues()
             .min();
+        let axes = information_axes(r.tag.dimension).join(", ");
         return Err(error(format!(
             "the information matrix over ({axes}) is not positive definite (smallest eigenvalue {smallest:.6e}); an edge's information must be, or the measurement says nothing in some direction"
         )));

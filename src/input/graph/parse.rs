@@ -243,11 +243,12 @@ pub fn read_records(locator: &Locator) -> Result<Records, InputError> {
     let mut out = Records::default();
     let mut dimension: Option<(Dimension, usize)> = None;
     let mut offset = 0;
+    let mut tokens = Vec::new();
     for (index, raw_line) in text.split_inclusive('\n').enumerate() {
         let line_start = offset;
         offset += raw_line.len();
         let content = raw_line.split('#').next().unwrap_or("");
-        let tokens: Vec<(&str, usize)> = tokens(content, line_start);
+        tokens_of(content, line_start, &mut tokens);
         let Some(&(tag_text, tag_at)) = tokens.first() else {
             continue;
         };
@@ -330,9 +331,10 @@ pub fn read_records(locator: &Locator) -> Result<Records, InputError> {
     Ok(out)
 }
 
-/// The whitespace-separated tokens of `content` with their byte offsets in the whole text.
-fn tokens(content: &str, line_start: usize) -> Vec<(&str, usize)> {
-    let mut out = Vec::new();
+/// The whitespace-separated tokens of `content` with their byte offsets in the whole text, in
+/// `out` (emptied first: one buffer serves every line).
+fn tokens_of<'a>(content: &'a str, line_start: usize, out: &mut Vec<(&'a str, usize)>) {
+    out.clear();
     let mut start = None;
     for (i, c) in content.char_indices() {
         match (c.is_whitespace(), start) {
@@ -347,7 +349,6 @@ fn tokens(content: &str, line_start: usize) -> Vec<(&str, usize)> {
     if let Some(s) = start {
         out.push((&content[s..], line_start + s));
     }
-    out
 }
 
 fn record(
@@ -412,11 +413,15 @@ fn record(
         })?;
         ids.push(IdAt { id, at: token_at });
     }
-    let label = {
+    // The record's name in an error ("EDGE_SE3:QUAT 4 7"): written only for one.
+    let label = || {
         let ids: Vec<String> = ids.iter().map(|i| i.id.to_string()).collect();
         format!("{} {}", tag.name, ids.join(" "))
     };
-    let number = |(token, token_at): (&str, usize), name: &str| -> Result<Value, InputError> {
+    // `name` is written only for an error (an edge has 21 numbers of the information).
+    let number = |(token, token_at): (&str, usize),
+                  name: &dyn Fn() -> String|
+     -> Result<Value, InputError> {
         match token.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(Value {
                 value: v,
@@ -424,25 +429,25 @@ fn record(
             }),
             Ok(_) => Err(locator.error(
                 token_at..token_at,
-                &label,
-                format!("{name} = {token} is not a finite number"),
+                &label(),
+                format!("{} = {token} is not a finite number", name()),
             )),
             Err(_) => Err(locator.error(
                 token_at..token_at,
-                &label,
-                format!("{name} = `{token}` is not a number"),
+                &label(),
+                format!("{} = `{token}` is not a number", name()),
             )),
         }
     };
     let pose = values[id_count..id_count + pose_names.len()]
         .iter()
         .zip(pose_names)
-        .map(|(t, name)| number(*t, name))
+        .map(|(t, name)| number(*t, &|| (*name).to_owned()))
         .collect::<Result<Vec<_>, _>>()?;
     let mut information = vec![Value { value: 0.0, at }; info_count];
     for (k, t) in values[id_count + pose_names.len()..].iter().enumerate() {
         let upper = tag.order.upper_index(k);
-        information[upper] = number(*t, &super::convention::upper_triangle_name(axes, upper))?;
+        information[upper] = number(*t, &|| super::convention::upper_triangle_name(axes, upper))?;
     }
     Ok(Record {
         tag,
