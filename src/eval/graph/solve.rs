@@ -100,31 +100,20 @@ impl<'a, G: LieGroup<N>, const N: usize> Problem<'a, G, N> {
             if bi.is_none() && bj.is_none() {
                 continue;
             }
-            // With J_j = J_r⁻¹(r) and J_i = −J_j · Ad (Ad = Ad(X_j⁻¹ X_i), see the module docs),
-            // M = J_jᵀ Λ J_j gives every block: H_jj = M, H_ij = −Adᵀ M, H_ii = Adᵀ M Ad, and
-            // g_j = J_jᵀ Λ r, g_i = −Adᵀ g_j (four 6×6 products an edge, not six).
             let r = e.residual(poses);
-            let jj = G::jr_inv(&r);
+            let (ji, jj) = jacobians_at(e, poses, &r);
             let lambda = e.information_in(self.reading);
-            let lj = lambda * jj;
-            let m = jj.transpose() * lj;
-            let gj = lj.transpose() * r;
-            if let Some(bj) = bj {
-                self.system.add(bj, bj, &m);
-                add_g(bj, &gj);
-            }
+            let (li, lj) = (lambda * ji, lambda * jj);
             if let Some(bi) = bi {
-                let ad_t = poses[e.to]
-                    .inverse()
-                    .compose(&poses[e.from])
-                    .adj()
-                    .transpose();
-                let ad_t_m = ad_t * m;
-                self.system.add(bi, bi, &(ad_t_m * ad_t.transpose()));
-                add_g(bi, &-(ad_t * gj));
-                if let Some(bj) = bj {
-                    self.system.add(bi, bj, &-ad_t_m);
-                }
+                self.system.add(bi, bi, &(ji.transpose() * li));
+                add_g(bi, &(li.transpose() * r));
+            }
+            if let Some(bj) = bj {
+                self.system.add(bj, bj, &(jj.transpose() * lj));
+                add_g(bj, &(lj.transpose() * r));
+            }
+            if let (Some(bi), Some(bj)) = (bi, bj) {
+                self.system.add(bi, bj, &(ji.transpose() * lj));
             }
         }
         for p in &self.graph.priors {
