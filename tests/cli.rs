@@ -41,6 +41,9 @@ fn line_of(text: &str, needle: &str) -> usize {
         + 1
 }
 
+#[path = "common/ports.rs"]
+mod ports;
+
 #[test]
 fn scenario_errors_exit_1_with_file_line_column_and_field() {
     let cases: [(&str, String, &str, &str); 6] = [
@@ -283,12 +286,7 @@ fn live_refuses_a_taken_page_port_with_a_way_out() {
 /// printed (the SDK's gRPC server would only fail later, on its own thread).
 #[test]
 fn serve_refuses_a_taken_viewer_port_up_front() {
-    let free = || {
-        std::net::TcpListener::bind("127.0.0.1:0")
-            .and_then(|l| l.local_addr())
-            .expect("a free port")
-            .port()
-    };
+    let free = ports::free_port;
     let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
     let busy = taken.local_addr().expect("addr").port();
     for (flag, other) in [("--grpc-port", "--web-port"), ("--web-port", "--grpc-port")] {

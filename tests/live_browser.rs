@@ -10,7 +10,6 @@
 //! The same stream check covers `--watch` on a served viewer (no browser needed).
 
 use std::io::{BufRead as _, BufReader};
-use std::net::TcpListener;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
@@ -62,13 +61,9 @@ fn tools_present() -> bool {
     present
 }
 
-fn free_port() -> u16 {
-    TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port()
-}
+#[path = "common/ports.rs"]
+mod ports;
+use ports::free_port;
 
 /// Every message a gRPC client of the served viewer stream has received so far.
 fn read_stream(url: &str) -> Arc<Mutex<Vec<LogMsg>>> {

@@ -78,12 +78,9 @@ fn assert_verifies(file: &std::path::Path) {
     }
 }
 
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .expect("a free port")
-        .port()
-}
+#[path = "common/ports.rs"]
+mod ports;
+use ports::free_port;
 
 #[test]
 fn memory_sink_produces_a_decodable_recording_with_every_entity() {

@@ -362,6 +362,16 @@ fn monte_carlo_progress(multi: MultiProgress) -> StepProgress {
     }))
 }
 
+/// Tells a spinner's ticker thread to end, when dropped.
+struct StopTicker<'a>(&'a AtomicBool, &'a std::thread::Thread);
+
+impl Drop for StopTicker<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Release);
+        self.1.unpark();
+    }
+}
+
 /// Runs `work`, showing a spinner on a terminal (stderr; nothing when it is not one) when it
 /// takes more than 0.3 s; `work` may change its message and add bars under it to the
 /// [`MultiProgress`] it is given.
@@ -387,12 +397,34 @@ pub(crate) fn with_spinner<T>(
                 std::thread::park_timeout(Duration::from_millis(80));
             }
         });
-        let result = work(&spinner, &multi);
-        done.store(true, Ordering::Release);
-        ticker.thread().unpark();
-        result
+        // However `work` ends: a panic unwinding through the scope would otherwise wait for
+        // the ticker forever (a hang, not a crash).
+        let _stop = StopTicker(&done, ticker.thread());
+        work(&spinner, &multi)
     });
     spinner.finish_and_clear();
     let _ = multi.clear();
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A panic inside the spinner's work unwinds out of it (a crash, said), never a hang:
+    /// the ticker thread is told to end however the work ends.
+    #[test]
+    fn a_panic_inside_the_spinner_unwinds_and_does_not_hang() {
+        let (sent, received) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let outcome = std::panic::catch_unwind(|| {
+                with_spinner("working", |_, _| -> () { panic!("inside the work") })
+            });
+            let _ = sent.send(outcome.is_err());
+        });
+        let unwound = received
+            .recv_timeout(Duration::from_secs(10))
+            .expect("with_spinner returned within 10 s of a panic in its work");
+        assert!(unwound);
+    }
 }

@@ -20,11 +20,14 @@
 //! layout plus one |R| × |R| block (≤ 2 nnz(L)), never a dense n×n. Any other pair of poses is
 //! answered by two block solves with the factor ([`joint_by_solves`]).
 
+use std::ops::Range;
+
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
 use faer::{Accum, MatMut, MatRef, Par};
+
 use nalgebra::SMatrix;
 
 use super::sparse::{BlockSystem, Factor, Supernode};
@@ -149,21 +152,64 @@ fn gather(factor: &Factor<'_>, sigma: &[f64], rows: &[usize], out: &mut Vec<f64>
 impl SelectedInverse<'_> {
     /// Σ[a, b] for scalar unknowns a, b in the original order, if in L's pattern.
     pub fn entry(&self, a: usize, b: usize) -> Option<f64> {
-        let (i, j) = (self.factor.inverse[a], self.factor.inverse[b]);
-        let (i, j) = (i.max(j), i.min(j));
-        self.factor.offset(i, j).map(|at| self.sigma[at])
+        self.entry_new(self.factor.inverse[a], self.factor.inverse[b])
     }
 
     /// The N×N block Σ[block a, block b] (original block numbers), if in L's pattern: always
-    /// for a = b and for two blocks an edge joins.
+    /// for a = b and for two blocks an edge joins. A block's N unknowns are consecutive in the
+    /// factor's order ([`BlockSystem`]'s block ordering), so each of its columns is one run of
+    /// Σ's storage, found once ([`Factor::run`]); entry by entry where it is not.
     pub fn block<const N: usize>(&self, a: usize, b: usize) -> Option<SMatrix<f64, N, N>> {
+        let (i, j) = (self.factor.inverse[a * N], self.factor.inverse[b * N]);
         let mut out = SMatrix::<f64, N, N>::zeros();
-        for p in 0..N {
+        let mut column = [0.0; N];
+        if i == j {
             for q in 0..N {
-                out[(p, q)] = self.entry(a * N + p, b * N + q)?;
+                self.column_into(i, j + q, q..N, &mut column)?;
+                for p in q..N {
+                    out[(p, q)] = column[p];
+                    out[(q, p)] = column[p];
+                }
+            }
+        } else if i > j {
+            for q in 0..N {
+                self.column_into(i, j + q, 0..N, &mut column)?;
+                out.column_mut(q).copy_from_slice(&column);
+            }
+        } else {
+            // Σ[a, b] = Σ[b, a]ᵀ, stored with b's rows under a's columns.
+            for p in 0..N {
+                self.column_into(j, i + p, 0..N, &mut column)?;
+                for q in 0..N {
+                    out[(p, q)] = column[q];
+                }
             }
         }
         Some(out)
+    }
+
+    /// Σ[i + p, j] for p in `rows` into `out[p]` (unknowns in the factor's order, i + p ≥ j):
+    /// one run of the storage when the rows are stored as one, else entry by entry.
+    fn column_into(&self, i: usize, j: usize, rows: Range<usize>, out: &mut [f64]) -> Option<()> {
+        match self.factor.run(i + rows.start, j, rows.len()) {
+            Some(at) => {
+                for p in rows.clone() {
+                    out[p] = self.sigma[at + p - rows.start];
+                }
+            }
+            None => {
+                for p in rows {
+                    out[p] = self.entry_new(i + p, j)?;
+                }
+            }
+        }
+        Some(())
+    }
+
+    /// Σ[i, j] for unknowns i, j in the factor's order, if in L's pattern.
+    fn entry_new(&self, i: usize, j: usize) -> Option<f64> {
+        let (i, j) = (i.max(j), i.min(j));
+        self.factor.offset(i, j).map(|at| self.sigma[at])
     }
 }
 

@@ -112,6 +112,10 @@ pub struct SolverSettings {
     /// Whether to compute the marginals once optimised (default true; without them every
     /// covariance and joint is None and [`Solution::marginals_error`] says why).
     pub marginals: bool,
+    /// Whether the marginals include every edge's joint marginal
+    /// ([`Solution::edge_joints`]; default true; the loop-closure timeline's states keep each
+    /// pose's only, and leave these None).
+    pub edge_joints: bool,
 }
 
 impl Default for SolverSettings {
@@ -125,6 +129,7 @@ impl Default for SolverSettings {
             pairs: Vec::new(),
             cancel: None,
             marginals: true,
+            edge_joints: true,
         }
     }
 }
@@ -240,7 +245,7 @@ pub struct Solution<G: LieGroup<N>, const N: usize> {
     /// the marginals failed, see `marginals_error`).
     pub covariances: Vec<Option<TangentMatrix<N>>>,
     /// The joint marginal (Σ_ii, Σ_ij, Σ_jj) of each edge's two poses, by edge (a vertex held
-    /// fixed has zero blocks; None: no marginals).
+    /// fixed has zero blocks; None: no marginals, or [`SolverSettings::edge_joints`] false).
     pub edge_joints: Vec<Option<Joint<N>>>,
     /// The joint marginal of each of [`SolverSettings::pairs`], in order (as `edge_joints`).
     pub joints: Vec<Option<Joint<N>>>,
@@ -283,7 +288,6 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
     } = parts::parts(graph);
     let mut problem = solve::Problem::new(graph, &fixed, settings.reading)?;
     let start = graph.estimates();
-    let chi2_before = problem.chi2(&start);
     let clock = Instant::now();
     let run = solve::run(&mut problem, start, settings, progress);
     let optimize_seconds = clock.elapsed().as_secs_f64();
@@ -297,7 +301,7 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
             &run.poses,
             &settings.pairs,
             &mut covariances,
-            &mut edge_joints,
+            settings.edge_joints.then_some(&mut edge_joints[..]),
             &mut joints,
         )
         .err()
@@ -311,7 +315,7 @@ pub fn optimize<G: LieGroup<N>, const N: usize>(
         iterations: run.log.iter().filter(|i| i.accepted).count(),
         stop: run.stop,
         log: run.log,
-        chi2_before,
+        chi2_before: run.chi2_before,
         chi2_after: run.chi2,
         poses: run.poses,
         covariances,
@@ -335,22 +339,25 @@ pub const NOT_ASKED: &str = "marginals not asked for";
 /// [δ_a; δ_b] (right form, [ρ; θ]; Σ_ba = Σ_abᵀ).
 pub type Joint<const N: usize> = [TangentMatrix<N>; 3];
 
-/// Every unknown pose's marginal, every edge's joint marginal and the joint marginal of each
-/// of `pairs` from the undamped H at `poses`. A block in the factor's pattern (every pose's,
-/// every edge's) comes from the selected inverse; another pair's Σ_ab from two block solves
-/// with the same factor ([`marginals::joint_by_solves`]). A vertex held fixed has zero blocks.
+/// Every unknown pose's marginal, every edge's joint marginal (when `edge_joints` is given)
+/// and the joint marginal of each of `pairs` from the undamped H at `poses`. A block in the
+/// factor's pattern (every pose's, every edge's) comes from the selected inverse; another
+/// pair's Σ_ab from two block solves with the same factor ([`marginals::joint_by_solves`]). A
+/// vertex held fixed has zero blocks.
 fn marginals_at<G: LieGroup<N>, const N: usize>(
     problem: &mut solve::Problem<'_, G, N>,
     poses: &[G],
     pairs: &[(usize, usize)],
     covariances: &mut [Option<TangentMatrix<N>>],
-    edge_joints: &mut [Option<Joint<N>>],
+    edge_joints: Option<&mut [Option<Joint<N>>]>,
     joints: &mut [Option<Joint<N>>],
 ) -> Result<(), String> {
+    let zero = TangentMatrix::<N>::zeros();
     if problem.system.unknowns() == 0 {
-        let zero = [TangentMatrix::<N>::zeros(); 3];
-        edge_joints.iter_mut().for_each(|j| *j = Some(zero));
-        joints.iter_mut().for_each(|j| *j = Some(zero));
+        if let Some(edge_joints) = edge_joints {
+            edge_joints.iter_mut().for_each(|j| *j = Some([zero; 3]));
+        }
+        joints.iter_mut().for_each(|j| *j = Some([zero; 3]));
         return Ok(());
     }
     problem.linearize(poses);
@@ -359,26 +366,29 @@ fn marginals_at<G: LieGroup<N>, const N: usize>(
         .ok_or("selected inversion met an entry outside the factor's pattern")?;
     let system = &problem.system;
     let block_of = &problem.block_of;
+    for (v, block) in block_of.iter().enumerate() {
+        if let Some(b) = block {
+            covariances[v] = inverse.block::<N>(*b, *b);
+        }
+    }
+    let covariances: &[Option<TangentMatrix<N>>] = covariances;
     let diagonal = |v: usize| match block_of[v] {
-        Some(b) => inverse.block::<N>(b, b),
-        None => Some(TangentMatrix::<N>::zeros()),
+        Some(_) => covariances[v],
+        None => Some(zero),
     };
     let joint = |a: usize, b: usize| -> Option<Joint<N>> {
         let cross = match (block_of[a], block_of[b]) {
             (Some(ba), Some(bb)) => inverse
                 .block::<N>(ba, bb)
                 .unwrap_or_else(|| marginals::joint_by_solves(system, ba, bb)),
-            _ => TangentMatrix::<N>::zeros(),
+            _ => zero,
         };
         Some([diagonal(a)?, cross, diagonal(b)?])
     };
-    for (v, block) in block_of.iter().enumerate() {
-        if let Some(b) = block {
-            covariances[v] = inverse.block::<N>(*b, *b);
+    if let Some(edge_joints) = edge_joints {
+        for (k, e) in problem.graph.edges.iter().enumerate() {
+            edge_joints[k] = joint(e.from, e.to);
         }
-    }
-    for (k, e) in problem.graph.edges.iter().enumerate() {
-        edge_joints[k] = joint(e.from, e.to);
     }
     for (k, &(a, b)) in pairs.iter().enumerate() {
         joints[k] = joint(a, b);

@@ -148,6 +148,8 @@ impl<'a, G: LieGroup<N>, const N: usize> Problem<'a, G, N> {
 
 /// What the loop returns: the estimate (the last accepted), its χ², the stop and the log.
 pub(super) struct Run<G> {
+    /// χ² at the start.
+    pub chi2_before: f64,
     pub poses: Vec<G>,
     pub chi2: f64,
     pub stop: Stop,
@@ -168,7 +170,8 @@ pub(super) fn run<G: LieGroup<N>, const N: usize>(
     progress: &mut dyn FnMut(&Iteration),
 ) -> Run<G> {
     let mut poses = start;
-    let mut chi2 = problem.chi2(&poses);
+    let chi2_before = problem.chi2(&poses);
+    let mut chi2 = chi2_before;
     let mut log = Vec::new();
     let lm = settings.optimizer == Optimizer::LevenbergMarquardt;
     let mut lambda = LAMBDA_START;
@@ -252,6 +255,7 @@ pub(super) fn run<G: LieGroup<N>, const N: usize>(
         Stop::MaxIterations
     };
     Run {
+        chi2_before,
         poses,
         chi2,
         stop,

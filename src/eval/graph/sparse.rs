@@ -4,7 +4,6 @@
 //! ever formed: H holds one N×N block per pose and per edge, L what the ordering fills in.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::perm::PermRef;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
@@ -57,18 +56,25 @@ impl std::fmt::Display for SparseError {
 
 impl std::error::Error for SparseError {}
 
-/// The block pattern of H (upper triangle, by block column) and where each block's entries
-/// live in the scalar CSC arrays.
+/// The block pattern of H and where each block's entries live, in the factor's order: H is
+/// stored as its lower triangle, by columns, with the pose blocks already in the
+/// approximate-minimum-degree ordering of the pose blocks, so that faer factors it as given
+/// (no permutation of H at each factorisation; the solves permute the right-hand side).
 pub struct BlockSystem<const N: usize> {
     blocks: usize,
-    /// For block column c: the block rows b ≤ c that are non-zero, ascending (ends with c).
-    upper: Vec<Vec<usize>>,
-    /// Scalar CSC of the upper triangle.
+    /// `position[b]`: where pose block b stands in the factor's order.
+    position: Vec<usize>,
+    /// For block column c (factor's order): the block rows r ≥ c that are non-zero,
+    /// ascending (starts with c).
+    lower: Vec<Vec<usize>>,
+    /// Scalar CSC of the lower triangle (factor's order; each column's diagonal entry first).
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     /// Values of H (same layout as `row_idx`).
     pub values: Vec<f64>,
-    /// Offset of scalar column (c·N + q)'s first entry, per block column c (q = 0).
+    /// `forward[new]` = original scalar index; `inverse[original]` = new.
+    forward: Vec<usize>,
+    inverse: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
     factor: Vec<f64>,
 }
@@ -87,28 +93,48 @@ impl<const N: usize> BlockSystem<N> {
             list.sort_unstable();
             list.dedup();
         }
+        let position = block_ordering(blocks, &upper)?;
+        let mut lower: Vec<Vec<usize>> = (0..blocks).map(|c| vec![c]).collect();
+        for (c, list) in upper.iter().enumerate() {
+            for &b in &list[..list.len() - 1] {
+                let (nb, nc) = (position[b], position[c]);
+                lower[nb.min(nc)].push(nb.max(nc));
+            }
+        }
+        for list in &mut lower {
+            list.sort_unstable();
+        }
         let mut col_ptr = Vec::with_capacity(blocks * N + 1);
         let mut row_idx = Vec::new();
         col_ptr.push(0);
-        for (c, list) in upper.iter().enumerate() {
+        for (c, list) in lower.iter().enumerate() {
             for q in 0..N {
-                for &b in list {
-                    let rows = if b == c { q + 1 } else { N };
-                    row_idx.extend((0..rows).map(|p| b * N + p));
+                for &r in list {
+                    let first = if r == c { q } else { 0 };
+                    row_idx.extend((first..N).map(|p| r * N + p));
                 }
                 col_ptr.push(row_idx.len());
             }
         }
         let values = vec![0.0; row_idx.len()];
-        let ordering = block_ordering::<N>(blocks, &upper)?;
         let n = blocks * N;
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-        let (fwd, inv) = &ordering;
-        let perm = PermRef::new_checked(fwd, inv, n);
+        let mut forward = vec![0; n];
+        let mut inverse = vec![0; n];
+        for (b, &nb) in position.iter().enumerate() {
+            for p in 0..N {
+                forward[nb * N + p] = b * N + p;
+                inverse[b * N + p] = nb * N + p;
+            }
+        }
+        // faer's symbolic analysis reads the upper triangle when given no ordering: the same
+        // pattern, transposed, for it alone.
+        let (upper_col_ptr, upper_row_idx) = transposed_pattern(n, &col_ptr, &row_idx);
+        let pattern =
+            SymbolicSparseColMatRef::new_checked(n, n, &upper_col_ptr, None, &upper_row_idx);
         let symbolic = factorize_symbolic_cholesky(
             pattern,
             Side::Upper,
-            SymmetricOrdering::Custom(perm),
+            SymmetricOrdering::Identity,
             CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
                 ..Default::default()
@@ -123,10 +149,13 @@ impl<const N: usize> BlockSystem<N> {
         }
         Ok(Self {
             blocks,
-            upper,
+            position,
+            lower,
             col_ptr,
             row_idx,
             values,
+            forward,
+            inverse,
             symbolic,
             factor: Vec::new(),
         })
@@ -137,7 +166,7 @@ impl<const N: usize> BlockSystem<N> {
         self.blocks * N
     }
 
-    /// Non-zeros of H's upper triangle.
+    /// Non-zeros of H's lower (equally, upper) triangle.
     pub fn nonzeros(&self) -> usize {
         self.row_idx.len()
     }
@@ -152,26 +181,39 @@ impl<const N: usize> BlockSystem<N> {
         self.values.iter_mut().for_each(|v| *v = 0.0);
     }
 
-    /// H[b, c] += block (b ≤ c: the block as given; b > c: its transpose into H[c, b]).
+    /// H[b, c] += block (pose blocks b, c in the original numbering). H is symmetric and
+    /// stored once: an edge adds its H[i, j] only. A diagonal block is taken from its upper
+    /// triangle (blockᵀ's lower one: JᵀΛJ need not be symmetric to the last bit).
     pub fn add(&mut self, b: usize, c: usize, block: &SMatrix<f64, N, N>) {
-        let (row_block, col_block, transposed) = if b <= c { (b, c, false) } else { (c, b, true) };
-        let list = &self.upper[col_block];
-        let Ok(k) = list.binary_search(&row_block) else {
+        let (nb, nc) = (self.position[b], self.position[c]);
+        // Stored at (rows of block `row`, columns of block `column`), row ≥ column; the
+        // value at (p, q) of that block is block[(p, q)], or block[(q, p)] when transposed.
+        let (row, column, transposed) = if nb > nc {
+            (nb, nc, false)
+        } else {
+            (nc, nb, true)
+        };
+        let list = &self.lower[column];
+        let Ok(k) = list.binary_search(&row) else {
             return;
         };
-        let base = self.col_ptr[col_block * N];
-        let width = (list.len() - 1) * N;
         for q in 0..N {
-            // Column c·N + q starts after the q earlier columns of this block column.
-            let start = base + q * width + q * (q + 1) / 2;
-            let rows = if row_block == col_block { q + 1 } else { N };
-            for p in 0..rows {
-                let v = if transposed {
+            let start = self.col_ptr[column * N + q];
+            if k == 0 {
+                // The diagonal block: rows q … N − 1 of column q.
+                for p in q..N {
+                    self.values[start + p - q] += block[(q, p)];
+                }
+                continue;
+            }
+            // After the diagonal block's N − q rows, N rows for each block before this one.
+            let at = start + (N - q) + (k - 1) * N;
+            for p in 0..N {
+                self.values[at + p] += if transposed {
                     block[(q, p)]
                 } else {
                     block[(p, q)]
                 };
-                self.values[start + k * N + p] += v;
             }
         }
     }
@@ -179,16 +221,17 @@ impl<const N: usize> BlockSystem<N> {
     /// Adds λ to every diagonal entry (Levenberg–Marquardt damping).
     pub fn add_to_diagonal(&mut self, lambda: f64) {
         for col in 0..self.unknowns() {
-            // The diagonal entry is the last of its column.
-            let end = self.col_ptr[col + 1];
-            self.values[end - 1] += lambda;
+            // The diagonal entry is the first of its column.
+            let start = self.col_ptr[col];
+            self.values[start] += lambda;
         }
     }
 
     /// Factors H = Pᵀ L Lᵀ P (numeric; the symbolic part is reused).
     pub fn factorize(&mut self) -> Result<(), SparseError> {
         let n = self.unknowns();
-        self.factor.clear();
+        // faer zeroes L's values itself: the buffer only needs its length (kept between
+        // factorisations, not written twice).
         self.factor.resize(self.symbolic.len_val(), 0.0);
         let pattern =
             SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx);
@@ -202,7 +245,7 @@ impl<const N: usize> BlockSystem<N> {
             .factorize_numeric_llt(
                 &mut self.factor,
                 matrix,
-                Side::Upper,
+                Side::Lower,
                 Default::default(),
                 Par::Seq,
                 MemStack::new(&mut memory),
@@ -214,7 +257,7 @@ impl<const N: usize> BlockSystem<N> {
     }
 
     /// Solves H x = rhs in place (after [`factorize`](Self::factorize)); `rhs` is n × k,
-    /// column-major.
+    /// column-major, in the original order.
     pub fn solve_in_place(&self, rhs: &mut [f64], columns: usize) {
         let n = self.unknowns();
         let llt = LltRef::new(&self.symbolic, &self.factor);
@@ -222,17 +265,22 @@ impl<const N: usize> BlockSystem<N> {
             self.symbolic
                 .solve_in_place_scratch::<f64>(columns, Par::Seq),
         );
-        let x = MatMut::from_column_major_slice_mut(rhs, n, columns);
+        // P rhs, solved, then Pᵀ: the copies faer makes itself for an ordering it holds.
+        let mut permuted: Vec<f64> = (0..columns)
+            .flat_map(|c| self.forward.iter().map(move |&old| (c, old)))
+            .map(|(c, old)| rhs[c * n + old])
+            .collect();
+        let x = MatMut::from_column_major_slice_mut(&mut permuted, n, columns);
         llt.solve_in_place_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut memory));
+        for c in 0..columns {
+            for (new, &old) in self.forward.iter().enumerate() {
+                rhs[c * n + old] = permuted[c * n + new];
+            }
+        }
     }
 
     /// The factor, column by column, in the permuted order (for selected inversion).
     pub fn factor(&self) -> Factor<'_> {
-        let (fwd, inv) = self
-            .symbolic
-            .perm()
-            .map(|p| p.arrays())
-            .expect("a custom ordering is always set");
         let SymbolicCholeskyRaw::Supernodal(s) = self.symbolic.raw() else {
             unreachable!("the supernodal factorisation is forced")
         };
@@ -251,19 +299,37 @@ impl<const N: usize> BlockSystem<N> {
             row_idx: s.row_idx(),
             values: &self.factor,
             supernode_of,
-            forward: fwd,
-            inverse: inv,
+            forward: &self.forward,
+            inverse: &self.inverse,
         }
     }
 }
 
-/// An approximate-minimum-degree ordering of the pose blocks (faer's AMD on the block
-/// graph), expanded to the scalar unknowns: a block's N unknowns stay together, so the
-/// supernodes follow the poses. Returns (forward, inverse) scalar permutations.
-fn block_ordering<const N: usize>(
-    blocks: usize,
-    upper: &[Vec<usize>],
-) -> Result<(Vec<usize>, Vec<usize>), SparseError> {
+/// The scalar CSC pattern (col_ptr, row_idx) of the transpose of the n × n pattern given,
+/// rows ascending in each column.
+fn transposed_pattern(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> (Vec<usize>, Vec<usize>) {
+    let mut counts = vec![0usize; n + 1];
+    for &i in row_idx {
+        counts[i + 1] += 1;
+    }
+    for i in 0..n {
+        counts[i + 1] += counts[i];
+    }
+    let mut next = counts.clone();
+    let mut rows = vec![0; row_idx.len()];
+    for j in 0..n {
+        for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+            rows[next[i]] = j;
+            next[i] += 1;
+        }
+    }
+    (counts, rows)
+}
+
+/// An approximate-minimum-degree ordering of the pose blocks (faer's AMD on the block graph
+/// `upper`: for each block, the blocks ≤ it it is joined to): `position[b]`, where block b
+/// stands. A block's N unknowns stay together, so the supernodes follow the poses.
+fn block_ordering(blocks: usize, upper: &[Vec<usize>]) -> Result<Vec<usize>, SparseError> {
     let mut col_ptr = Vec::with_capacity(blocks + 1);
     col_ptr.push(0);
     let mut row_idx = Vec::new();
@@ -286,15 +352,7 @@ fn block_ordering<const N: usize>(
         MemStack::new(&mut memory),
     )
     .map_err(|e| SparseError::Faer(format!("{e:?}")))?;
-    let scalar_fwd: Vec<usize> = fwd
-        .iter()
-        .flat_map(|&b| (0..N).map(move |p| b * N + p))
-        .collect();
-    let mut scalar_inv = vec![0; blocks * N];
-    for (new, &old) in scalar_fwd.iter().enumerate() {
-        scalar_inv[old] = new;
-    }
-    Ok((scalar_fwd, scalar_inv))
+    Ok(inv)
 }
 
 /// Read access to a supernodal factor L in the permuted order, supernode by supernode: the
@@ -349,19 +407,45 @@ impl Factor<'_> {
 
     /// The value-storage offset of entry (i, j), i ≥ j, if it is in L's pattern.
     pub fn offset(&self, i: usize, j: usize) -> Option<usize> {
+        self.run(i, j, 1)
+    }
+
+    /// The value-storage offset of entry (i, j) when rows i … i + len − 1 of column j (i ≥ j)
+    /// are all in L's pattern and stored one after another (then entry (i + p, j) is at the
+    /// offset + p); None otherwise (some row outside the pattern, or the run crosses from the
+    /// supernode's own rows into the rows below it).
+    ///
+    /// ```
+    /// use posecov::eval::graph::sparse::BlockSystem;
+    /// use nalgebra::Matrix3;
+    /// // Two SE(2) poses joined by one edge: H = [[2I, −I], [−I, 2I]].
+    /// let mut h = BlockSystem::<3>::new(2, &[(0, 1)]).unwrap();
+    /// h.add(0, 0, &(Matrix3::identity() * 2.0));
+    /// h.add(1, 1, &(Matrix3::identity() * 2.0));
+    /// h.add(0, 1, &-Matrix3::identity());
+    /// h.factorize().unwrap();
+    /// let l = h.factor();
+    /// let at = l.run(0, 0, 6).unwrap(); // column 0, rows 0 … 5
+    /// assert_eq!((1..6).map(|p| l.run(p, 0, 1)).collect::<Vec<_>>(), (1..6).map(|p| Some(at + p)).collect::<Vec<_>>());
+    /// assert_eq!(l.run(0, 1, 1), None); // above the diagonal
+    /// ```
+    pub fn run(&self, i: usize, j: usize, len: usize) -> Option<usize> {
         let Supernode {
             columns,
             pattern,
             at,
         } = self.supernode(self.supernode_of[j]);
         let column = at + (j - columns.start) * (columns.len() + pattern.len());
-        if i < columns.end {
+        let last = i + len.max(1) - 1;
+        if last < columns.end {
             (i >= j).then(|| column + (i - columns.start))
+        } else if i >= columns.end {
+            // The pattern is ascending without repeats: rows i … last are consecutive in it
+            // when the one len − 1 places after i is last.
+            let k = pattern.binary_search(&i).ok()?;
+            (pattern.get(k + len.max(1) - 1) == Some(&last)).then(|| column + columns.len() + k)
         } else {
-            pattern
-                .binary_search(&i)
-                .ok()
-                .map(|k| column + columns.len() + k)
+            None
         }
     }
 

@@ -113,6 +113,8 @@ pub(super) fn closure_timeline<G: LieGroup<N>, const N: usize>(
         let solver = SolverSettings {
             pairs: Vec::new(),
             marginals: k == 0 || marginals == StepMarginals::Every,
+            // A state keeps each pose's marginal only.
+            edge_joints: false,
             relative_tolerance: if k == 0 {
                 settings.relative_tolerance
             } else {
@@ -196,6 +198,7 @@ pub(super) fn dead_reckoning<G: LieGroup<N>, const N: usize>(
     }
     let solver = SolverSettings {
         pairs: Vec::new(),
+        edge_joints: false,
         ..settings.clone()
     };
     let sub = first_closures(graph, &ranks(graph, loop_edges), 0, &graph.estimates());
