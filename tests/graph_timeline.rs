@@ -1,8 +1,8 @@
 //! What the loop closures did, one by one (`eval::graph` timeline): step 0 is the graph
 //! without loop closures, each later step adds the next ones in file order and re-optimises,
 //! the last is the full solution; the marginals never grow as closures arrive; the after view
-//! follows the steps on the `step` timeline after the chain's; a graph beyond the size limit
-//! gets no timeline and says so.
+//! follows the steps on the `step` timeline after the chain's, and leaves out (and says so)
+//! marginals wider than the map; a graph beyond the size limit gets no timeline and says so.
 
 use posecov::app::{Loaded, Overrides, pipeline};
 use posecov::eval::graph::{MAX_TIMELINE_POSES, SolverSettings, optimize};
@@ -135,4 +135,65 @@ fn a_graph_beyond_the_limit_gets_no_timeline_and_says_so() {
     let g = evaluate_default(&graph);
     assert!(g.timeline.steps.is_empty());
     assert_eq!(g.timeline.too_large, Some(n));
+}
+
+/// The after view's final state on a graph whose information is weak (pose2example's divided by
+/// 10⁴: σ of metres per edge on a map a few metres wide): its marginal ellipses would cover the
+/// map many times over, so none is drawn and the legend says so; with the file's own
+/// information every drawn ellipse is there and the legend says nothing of the kind.
+#[test]
+fn marginals_wider_than_the_map_are_left_out_of_the_final_state_and_said() {
+    let weak: String = POSE2
+        .lines()
+        .map(|line| {
+            let mut fields: Vec<String> = line.split_whitespace().map(str::to_owned).collect();
+            if fields.first().is_some_and(|f| f == "EDGE_SE2") {
+                for f in &mut fields[6..] {
+                    *f = (f.parse::<f64>().expect("a number") * 1e-4).to_string();
+                }
+            }
+            fields.join(" ") + "\n"
+        })
+        .collect();
+    let dir = std::env::temp_dir().join(format!("posecov-weak-graph-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let final_ellipses_and_note = |text: &str| {
+        let file = dir.join("g.g2o");
+        std::fs::write(&file, text).unwrap();
+        let (source, input) = open(file.to_str().unwrap()).expect("readable");
+        let overrides = Overrides {
+            samples: Some(64),
+            ..Overrides::default()
+        };
+        let (_, scene) = pipeline(&Loaded { source, input }, &overrides, None).expect("drawn");
+        let last = scene
+            .items
+            .iter()
+            .filter_map(|i| match i.timing {
+                Timing::Step(k) if i.path.starts_with("world/optimized/marginals/") => Some(k),
+                _ => None,
+            })
+            .max()
+            .expect("the after view's states");
+        let ellipses: usize = scene
+            .items
+            .iter()
+            .filter(|i| i.path.starts_with("world/optimized/marginals/"))
+            .filter(|i| i.timing == Timing::Step(last))
+            .map(|i| match &i.kind {
+                posecov::scene::ItemKind::Ellipsoids(e) => e.shapes.len(),
+                _ => 0,
+            })
+            .sum();
+        let said = scene.legend.iter().any(|e| {
+            e.label
+                .starts_with("after: marginals wider than the map not drawn")
+        });
+        (ellipses, said)
+    };
+    let (weak_ellipses, weak_said) = final_ellipses_and_note(&weak);
+    assert_eq!((weak_ellipses, weak_said), (0, true));
+    let (ellipses, said) = final_ellipses_and_note(POSE2);
+    assert!(ellipses > 0 && !said, "{ellipses} ellipses, said: {said}");
+    std::fs::remove_dir_all(&dir).ok();
 }

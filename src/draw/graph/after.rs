@@ -97,28 +97,26 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     };
     // Under the trajectory: its colours stay on top.
     loop_closure_lines(p, g, &index_of, radius);
-    let mut left_out = 0;
+    // Regions left out (half-size beyond the map's longest side): on the timeline's states
+    // before the final solution, and on the final solution.
+    let (mut left_out, mut left_out_final) = (0, 0);
     if g.timeline.steps.is_empty() {
-        state(p, g, &s.poses, &s.covariances, None, &look);
+        left_out_final = state(p, g, &s.poses, &s.covariances, None, &look);
     } else {
         let chain_end = p.scene.steps().last().copied().unwrap_or(0).max(0) as u64;
         let mut states = Vec::new();
         for (i, step) in g.timeline.steps.iter().enumerate() {
             let at = if i == 0 { 0 } else { chain_end + i as u64 };
             let last = i + 1 == g.timeline.steps.len();
-            left_out += state(
-                p,
-                g,
-                &step.poses,
-                &step.covariances,
-                Some(at),
-                &Look {
-                    // The final state draws what the figure draws; an earlier one (dead reckoning,
-                    // a few loop closures) leaves out what would cover the map.
-                    map: if last { f64::INFINITY } else { look.map },
-                    ..look
-                },
-            );
+            // Every state leaves out what would cover the map many times over: dead reckoning's
+            // and a few loop closures' marginals, and a final solution's on a graph whose
+            // information is weak (parking-garage's: σ ≈ 1 km on a 60 m garage).
+            let n = state(p, g, &step.poses, &step.covariances, Some(at), &look);
+            if last {
+                left_out_final += n;
+            } else {
+                left_out += n;
+            }
             closed_so_far(p, g, (step, last), at, radius);
             states.push(scene::State {
                 closures: step.closures as u64,
@@ -139,6 +137,15 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
         ramp::RAMP[2],
         Swatch::Dashed,
     );
+    if left_out_final > 0 {
+        p.legend(
+            "after: marginals wider than the map not drawn (the trajectory's σ colours carry \
+             them, the close-up shows the largest at true size)"
+                .to_owned(),
+            ramp::RAMP[ramp::RAMP.len() - 1],
+            Swatch::Dashed,
+        );
+    }
     if left_out > 0 {
         p.legend(
             "after, on the step timeline before the final solution: marginals wider than the \
@@ -300,9 +307,9 @@ struct Look<'a> {
     ellipses: &'a BTreeSet<usize>,
     bananas: &'a [usize],
     ramp: &'a Ramp,
-    /// The largest half-size of a marginal region drawn (∞: every one): the final
-    /// solution's map size (the longest side of [`box_sides`]) for the timeline's earlier states, whose marginals
-    /// (dead reckoning's: hundreds of metres on a map of tens) would cover the view.
+    /// The largest half-size of a marginal region drawn: the final solution's map size (the
+    /// longest side of [`box_sides`]). A wider region (dead reckoning's: hundreds of metres on a
+    /// map of tens) would cover the view; the trajectory's σ colours carry it.
     map: f64,
 }
 
