@@ -110,7 +110,7 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
             let last = i + 1 == g.timeline.steps.len();
             // Every state leaves out what would cover the map many times over: dead reckoning's
             // and a few loop closures' marginals, and a final solution's on a graph whose
-            // information is weak (parking-garage's: σ ≈ 1 km on a 60 m garage).
+            // information is weak (parking-garage's: σ ≈ 1 km on a 265 m garage).
             let n = state(p, g, &step.poses, &step.covariances, Some(at), &look);
             if last {
                 left_out_final += n;

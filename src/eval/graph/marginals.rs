@@ -27,7 +27,6 @@ use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
 use faer::{Accum, MatMut, MatRef, Par};
-
 use nalgebra::SMatrix;
 
 use super::sparse::{BlockSystem, Factor, Supernode};
@@ -152,7 +151,7 @@ fn gather(factor: &Factor<'_>, sigma: &[f64], rows: &[usize], out: &mut Vec<f64>
 impl SelectedInverse<'_> {
     /// Σ[a, b] for scalar unknowns a, b in the original order, if in L's pattern.
     pub fn entry(&self, a: usize, b: usize) -> Option<f64> {
-        self.entry_new(self.factor.inverse[a], self.factor.inverse[b])
+        self.entry_in_factor_order(self.factor.inverse[a], self.factor.inverse[b])
     }
 
     /// The N×N block Σ[block a, block b] (original block numbers), if in L's pattern: always
@@ -199,7 +198,7 @@ impl SelectedInverse<'_> {
             }
             None => {
                 for p in rows {
-                    out[p] = self.entry_new(i + p, j)?;
+                    out[p] = self.entry_in_factor_order(i + p, j)?;
                 }
             }
         }
@@ -207,7 +206,7 @@ impl SelectedInverse<'_> {
     }
 
     /// Σ[i, j] for unknowns i, j in the factor's order, if in L's pattern.
-    fn entry_new(&self, i: usize, j: usize) -> Option<f64> {
+    fn entry_in_factor_order(&self, i: usize, j: usize) -> Option<f64> {
         let (i, j) = (i.max(j), i.min(j));
         self.factor.offset(i, j).map(|at| self.sigma[at])
     }

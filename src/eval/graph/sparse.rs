@@ -57,9 +57,9 @@ impl std::fmt::Display for SparseError {
 impl std::error::Error for SparseError {}
 
 /// The block pattern of H and where each block's entries live, in the factor's order: H is
-/// stored as its lower triangle, by columns, with the pose blocks already in the
-/// approximate-minimum-degree ordering of the pose blocks, so that faer factors it as given
-/// (no permutation of H at each factorisation; the solves permute the right-hand side).
+/// stored as its lower triangle, by columns, its pose blocks already placed in an
+/// approximate-minimum-degree order, so that faer factors it as given (no permutation of H at
+/// each factorisation; the solves permute the right-hand side).
 pub struct BlockSystem<const N: usize> {
     blocks: usize,
     /// `position[b]`: where pose block b stands in the factor's order.
