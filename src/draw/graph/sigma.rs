@@ -72,7 +72,7 @@ pub(in crate::draw) fn sigma_plot<G: LieGroup<N>, const N: usize>(
         ScalarSeries::new(
             id.clone(),
             "position_before",
-            "position σ √tr Σ_ρρ before (dead reckoning), m",
+            "position σ √tr Σ_ρρ before, m",
             BEFORE,
             2.0,
             line(&position, true),
@@ -80,7 +80,7 @@ pub(in crate::draw) fn sigma_plot<G: LieGroup<N>, const N: usize>(
         ScalarSeries::new(
             id.clone(),
             "position_after",
-            "position σ after (optimised), m",
+            "position σ after, m",
             OPTIMIZED,
             2.0,
             line(&position, false),
@@ -129,11 +129,7 @@ pub(in crate::draw) fn sigma_plot<G: LieGroup<N>, const N: usize>(
             ScalarSeries::new(
                 id.clone(),
                 "loop_closure_ends",
-                format!(
-                    "where loop closures join ({} closures, {} poses)",
-                    g.loop_closures.len(),
-                    ends.len()
-                ),
+                format!("loop closures' ends ({} poses)", ends.len()),
                 scene::LINK,
                 5.0,
                 ends.iter().map(|&k| (k as i64, rug)).collect(),
