@@ -266,10 +266,12 @@ impl<const N: usize> BlockSystem<N> {
                 .solve_in_place_scratch::<f64>(columns, Par::Seq),
         );
         // P rhs, solved, then Pᵀ: the copies faer makes itself for an ordering it holds.
-        let mut permuted: Vec<f64> = (0..columns)
-            .flat_map(|c| self.forward.iter().map(move |&old| (c, old)))
-            .map(|(c, old)| rhs[c * n + old])
-            .collect();
+        let mut permuted = vec![0.0; n * columns];
+        for c in 0..columns {
+            for (new, &old) in self.forward.iter().enumerate() {
+                permuted[c * n + new] = rhs[c * n + old];
+            }
+        }
         let x = MatMut::from_column_major_slice_mut(&mut permuted, n, columns);
         llt.solve_in_place_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut memory));
         for c in 0..columns {
