@@ -4,7 +4,8 @@
 //! relative pose's covariance against a numeric Jacobian; `--joint`, `--optimizer` and
 //! `--graph-reading` refused by name where they do not apply; mutated GTSAM files refused or
 //! drawn, never a panic; each pose's σ before (dead reckoning) and after the loop closures, never
-//! larger after, in `report --json` and plotted in the figure.
+//! larger after, in `report --json` and plotted in the figure; the vertex estimates drawn as one
+//! batch of frames.
 
 use nalgebra::{DMatrix, SVector};
 use posecov::app::{Loaded, Overrides, pipeline};
@@ -17,7 +18,9 @@ use posecov::uncertain::Confidence;
 
 #[path = "common/graph.rs"]
 mod graph_common;
-use graph_common::{block, dense_information, pose2_slam_example, se2_graph, se3_graph};
+use graph_common::{
+    block, dense_information, pose2_slam_example, pose2example_drawn, se2_graph, se3_graph,
+};
 
 const POSE2: &str = include_str!("data/gtsam/pose2example.txt");
 const POSE3: &str = include_str!("data/gtsam/pose3example.txt");
@@ -327,15 +330,46 @@ fn gtsam_joint_marginal_covariance_of_the_pose2_slam_example() {
 }
 
 #[test]
-fn joint_pairs_are_in_report_json_and_drawn() {
-    let (source, input) = open("tests/data/gtsam/pose2example.txt").expect("readable");
-    let loaded = Loaded { source, input };
-    let overrides = Overrides {
-        samples: Some(64),
-        joints: vec![(5, 9)],
-        ..Overrides::default()
+fn the_vertex_estimates_are_one_batch_of_frames_at_the_files_estimates() {
+    let (_, evaluation, scene) = pose2example_drawn(Vec::new());
+    let posecov::eval::AnyEvaluation::Se2(e) = &evaluation else {
+        panic!("pose2example is SE(2)")
     };
-    let (evaluation, scene) = pipeline(&loaded, &overrides, None).expect("drawn");
+    let vertices: Vec<_> = scene
+        .items
+        .iter()
+        .filter(|i| i.path == posecov::scene::paths::vertices())
+        .collect();
+    let [item] = vertices[..] else {
+        panic!("one vertices item, got {}", vertices.len())
+    };
+    let posecov::scene::ItemKind::Triads(t) = &item.kind else {
+        panic!("triads, got {:?}", item.kind)
+    };
+    // All 11 vertices are drawn, each at the file's estimate (x of VERTEX_SE2 1 is 1.03039).
+    assert_eq!(t.translations.len(), 11);
+    let v1 = e
+        .nodes
+        .iter()
+        .find(|n| n.name == "v1")
+        .expect("v1 is a node");
+    assert_eq!(t.translations[1][0], v1.nominal.x());
+    assert!((t.translations[1][0] - 1.03039).abs() < 1e-12);
+    let own_entity = |path: &str| {
+        let name = path
+            .strip_prefix("world/v")
+            .and_then(|p| p.strip_suffix("/frame"));
+        name.is_some_and(|id| id.chars().all(|c| c.is_ascii_digit()))
+    };
+    assert!(
+        !scene.items.iter().any(|i| own_entity(&i.path)),
+        "no vertex has an entity of its own"
+    );
+}
+
+#[test]
+fn joint_pairs_are_in_report_json_and_drawn() {
+    let (loaded, evaluation, scene) = pose2example_drawn(vec![(5, 9)]);
     let json = posecov::app::report_json("p", &loaded, &evaluation, Confidence::DEFAULT);
     let joint = &json["optimized"]["joints"][0];
     assert_eq!(
@@ -598,13 +632,7 @@ fn sigma_after_the_loop_closures_is_at_most_dead_reckonings_at_every_pose() {
 
 #[test]
 fn sigma_before_and_after_are_in_report_json_and_the_figure_plots_them() {
-    let (source, input) = open("tests/data/gtsam/pose2example.txt").expect("readable");
-    let loaded = Loaded { source, input };
-    let overrides = Overrides {
-        samples: Some(64),
-        ..Overrides::default()
-    };
-    let (evaluation, scene) = pipeline(&loaded, &overrides, None).expect("drawn");
+    let (loaded, evaluation, scene) = pose2example_drawn(Vec::new());
     let json = posecov::app::report_json("p", &loaded, &evaluation, Confidence::DEFAULT);
     let poses = json["optimized"]["poses"].as_array().expect("poses");
     let mut with_sigma = 0;

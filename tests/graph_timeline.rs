@@ -11,7 +11,7 @@ use posecov::scene::Timing;
 
 #[path = "common/graph.rs"]
 mod graph_common;
-use graph_common::{evaluate_default, se2_graph};
+use graph_common::{evaluate_default, pose2example_drawn, se2_graph};
 
 const POSE2: &str = include_str!("data/gtsam/pose2example.txt");
 
@@ -80,13 +80,7 @@ fn each_step_adds_loop_closures_and_no_marginal_grows() {
 
 #[test]
 fn the_after_view_follows_the_steps_after_the_chain() {
-    let (source, input) = open("tests/data/gtsam/pose2example.txt").expect("readable");
-    let loaded = Loaded { source, input };
-    let overrides = Overrides {
-        samples: Some(64),
-        ..Overrides::default()
-    };
-    let (evaluation, scene) = pipeline(&loaded, &overrides, None).expect("drawn");
+    let (loaded, evaluation, scene) = pose2example_drawn(Vec::new());
     let steps_of = |path: &str| -> Vec<i64> {
         scene
             .items

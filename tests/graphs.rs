@@ -528,7 +528,7 @@ fn large_graphs_are_drawn_bounded_and_said_so() {
     assert!(!input.draw.labels);
     assert_eq!(input.draw.links.len(), s.loop_closures_drawn);
     let d = &posecov::draw::input_description(&input.about, &input.draw);
-    assert!(d.contains("30 of the 50 loop closures are drawn"), "{d}");
+    assert!(d.contains("12 of the 50 loop closures are drawn"), "{d}");
     assert!(
         d.contains(&format!(
             "{} of the 1000 vertex estimates are drawn",

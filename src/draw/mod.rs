@@ -349,10 +349,14 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     if choices.layout.is_none() {
         p.layout = default_layout(e, &shown);
     }
+    // A graph's drawn vertex estimates (its fixed poses, hundreds) are one batch of frames.
+    let mut vertices = Vec::new();
     for node in &e.nodes {
         // Every item of a node carries it as its origin (an undrawable one is reported there).
         p.origin = Some(Origin::Node(node.name.clone()));
-        if shown.node(node) {
+        if shown.node(node) && e.graph.is_some() && node.role == Role::Fixed {
+            vertices.push(node.nominal.to_se3());
+        } else if shown.node(node) {
             draw_node(&mut p, node, settings);
         } else if let Some(via) = shown.through(e, node) {
             draw_through(&mut p, node, via, settings);
@@ -361,6 +365,9 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     }
     if choices.trajectories {
         extras::trajectories(&mut p, e);
+    }
+    if choices.axes {
+        graph::vertex_frames(&mut p, &vertices);
     }
     extras::links(&mut p, e, &choices.links);
     let zooms = match &e.graph {

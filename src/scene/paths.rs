@@ -123,6 +123,15 @@ pub fn links() -> String {
     format!("{WORLD}/links")
 }
 
+/// A pose graph's drawn vertex estimates, one batch of frames: `world/vertices`.
+///
+/// ```
+/// assert_eq!(posecov::scene::paths::vertices(), "world/vertices");
+/// ```
+pub fn vertices() -> String {
+    format!("{WORLD}/vertices")
+}
+
 /// A pose graph's picture before optimisation: the initial labels `world/labels`.
 ///
 /// ```

@@ -13,6 +13,27 @@ use posecov::plan::graph::{GraphEdge, GraphVertex, PoseGraph};
 use posecov::uncertain::Confidence;
 use rand::{Rng, SeedableRng};
 
+/// `tests/data/gtsam/pose2example.txt` opened, evaluated with 64 samples and the joint
+/// marginals of `joints`, and drawn, as the CLI does: the input, its evaluation and its scene.
+pub fn pose2example_drawn(
+    joints: Vec<(u64, u64)>,
+) -> (
+    posecov::app::Loaded,
+    posecov::eval::AnyEvaluation,
+    posecov::scene::Scene,
+) {
+    let (source, input) =
+        posecov::input::open("tests/data/gtsam/pose2example.txt").expect("readable");
+    let loaded = posecov::app::Loaded { source, input };
+    let overrides = posecov::app::Overrides {
+        samples: Some(64),
+        joints,
+        ..posecov::app::Overrides::default()
+    };
+    let (evaluation, scene) = posecov::app::pipeline(&loaded, &overrides, None).expect("drawn");
+    (loaded, evaluation, scene)
+}
+
 /// The SE(2) pose graph of g2o text.
 pub fn se2_graph(text: &str) -> PoseGraph<Se2, 3> {
     match read_text(text, "g.g2o").expect("valid").1.plan {

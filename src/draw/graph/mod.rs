@@ -7,9 +7,11 @@
 
 use std::fmt::Write;
 
+use super::{Painter, legend, v3};
 use crate::eval::Finding;
 use crate::eval::graph::{Anchor, GraphEvaluation, MAX_TIMELINE_POSES, Optimizer, Part, Stop};
-use crate::lie::LieGroup;
+use crate::lie::{LieGroup, Se3};
+use crate::scene::{ItemKind, Triads, paths};
 
 mod about;
 mod after;
@@ -22,6 +24,33 @@ pub(super) use about::description as file_description;
 pub(super) use after::draw_optimized;
 pub(super) use sigma::sigma_plot;
 pub(super) use zoom::Zoom;
+
+/// A graph's drawn vertex estimates (the fixed poses of its plan: evenly chosen, plus the drawn
+/// loop closures' ends) as one batch of frames at [`paths::vertices`], drawn in the before
+/// view: one entity, not one per vertex (a recording of hundreds of entities is slow to write
+/// and to browse). Nothing when there are none.
+pub(super) fn vertex_frames(p: &mut Painter, world_from_vertex: &[Se3]) {
+    if world_from_vertex.is_empty() {
+        return;
+    }
+    p.scene.add_legend(legend::axes("pose frames"));
+    p.push(
+        paths::vertices(),
+        None,
+        ItemKind::Triads(Triads {
+            translations: world_from_vertex
+                .iter()
+                .map(|x| v3(x.translation()))
+                .collect(),
+            rotations: world_from_vertex
+                .iter()
+                .map(|x| x.rotation().to_quaternion_xyzw())
+                .collect(),
+            axis_length: p.axis_length,
+            line_radius: after::line_radius(p),
+        }),
+    );
+}
 
 /// The sentence of a graph finding (`None` for any other finding).
 pub(super) fn finding_text(f: &Finding) -> Option<String> {

@@ -6,9 +6,11 @@
 //!   first vertex's estimate, propagated as [`Op::Odometry`](crate::plan::Op::Odometry) with
 //!   each edge's own covariance (first order and Monte Carlo): the banana grows along the
 //!   chain on the `step` timeline (step k = vertex first + k);
-//! - the **vertex estimates** of the file as axes (`v<id>`);
-//! - each **loop closure** (every other edge i → j) as a line between the two estimates and
-//!   the pose it predicts for j, X_i · Z with Z's uncertainty (`v<j>_via_v<i>`).
+//! - the **vertex estimates** of the file as axes (`v<id>`: at most 300, evenly chosen, plus
+//!   the drawn loop closures' ends; drawn as one batch of frames);
+//! - each **loop closure** (every other edge i → j; at most [`MAX_LOOP_CLOSURES`], evenly
+//!   chosen) as a line between the two estimates and the pose it predicts for j, X_i · Z with
+//!   Z's uncertainty (`v<j>_via_v<i>`).
 //!
 //! The edge covariance is posecov's right-perturbation Σ over [ρ; θ] — for `EDGE_SE3:QUAT`
 //! with the rotation block scaled from the quaternion's vector part, see [`convention`] and
