@@ -46,8 +46,8 @@ pub(super) fn position_sigma<G: LieGroup<N>, const N: usize>(
         .map_or(0.0, |c| PoseSigma::of::<G, N>(c).position)
 }
 
-/// A graph's line radius: 0.3 % of the scene's extent, as the links between poses; the poses'
-/// frames are half as thick.
+/// A graph's line radius: 0.3 % of the scene's extent, as the links between poses and the
+/// before view's vertex frames (the after view's optimised poses are half as thick).
 pub(super) fn line_radius(p: &Painter) -> f64 {
     0.003 * p.extent.max(0.25)
 }
