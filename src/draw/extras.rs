@@ -143,7 +143,7 @@ pub(super) fn links<G: LieGroup<N>, const N: usize>(
             ItemKind::LineStrips(LineStrips {
                 strips,
                 color: scene::LINK,
-                radius: 0.003 * p.extent.max(0.25),
+                radius: p.link_radius(),
             }),
         );
     }

@@ -354,10 +354,12 @@ fn build<G: LieGroup<N>, const N: usize>(e: &Evaluation<G, N>, settings: &DrawSe
     for node in &e.nodes {
         // Every item of a node carries it as its origin (an undrawable one is reported there).
         p.origin = Some(Origin::Node(node.name.clone()));
-        if shown.node(node) && e.graph.is_some() && node.role == Role::Fixed {
-            vertices.push(node.nominal.to_se3());
-        } else if shown.node(node) {
-            draw_node(&mut p, node, settings);
+        if shown.node(node) {
+            if e.graph.is_some() && node.role == Role::Fixed {
+                vertices.push(node.nominal.to_se3());
+            } else {
+                draw_node(&mut p, node, settings);
+            }
         } else if let Some(via) = shown.through(e, node) {
             draw_through(&mut p, node, via, settings);
         }

@@ -194,6 +194,12 @@ impl Painter {
         );
     }
 
+    /// The radius of a line between poses (links, a graph's trajectory and loop closures,
+    /// its vertex frames): 0.3 % of the scene's extent, or of 0.25 m when it is smaller.
+    pub(super) fn link_radius(&self) -> f64 {
+        0.003 * self.extent.max(0.25)
+    }
+
     /// The line radius of region outlines.
     pub(super) fn outline_radius(&self) -> f64 {
         0.004 * self.axis_length.min(0.5)

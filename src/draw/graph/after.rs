@@ -46,12 +46,6 @@ pub(super) fn position_sigma<G: LieGroup<N>, const N: usize>(
         .map_or(0.0, |c| PoseSigma::of::<G, N>(c).position)
 }
 
-/// A graph's line radius: 0.3 % of the scene's extent, as the links between poses and the
-/// before view's vertex frames (the after view's optimised poses are half as thick).
-pub(super) fn line_radius(p: &Painter) -> f64 {
-    0.003 * p.extent.max(0.25)
-}
-
 /// The "after" picture at `world/optimized/…`: the optimised trajectory and every drawn
 /// pose's marginal position ellipse at the confidence, true to scale, both coloured by the
 /// pose's position σ on the [`Ramp`] fitted to the final solution (one entity per colour,
@@ -70,7 +64,7 @@ pub(in crate::draw) fn draw_optimized<G: LieGroup<N>, const N: usize>(
     g: &GraphEvaluation<G, N>,
 ) -> Vec<Zoom> {
     let s = &g.solution;
-    let radius = line_radius(p);
+    let radius = p.link_radius();
     // Which poses get an ellipse: evenly chosen, plus the worst loop closures' ends.
     let n = s.poses.len();
     let mut drawn: BTreeSet<usize> = (0..MAX_DRAWN_MARGINALS.min(n))

@@ -47,7 +47,7 @@ pub(super) fn vertex_frames(p: &mut Painter, world_from_vertex: &[Se3]) {
                 .map(|x| x.rotation().to_quaternion_xyzw())
                 .collect(),
             axis_length: p.axis_length,
-            line_radius: after::line_radius(p),
+            line_radius: p.link_radius(),
         }),
     );
 }
